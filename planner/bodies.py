@@ -1,0 +1,69 @@
+"""The moving body during a push: the slider and the pusher stuck to it, in the slider frame.
+
+The pusher face is centred on the pushed edge's midpoint; its body is the ``width x depth``
+rectangle behind the face, outside the part (the edge lies on the convex hull, so it cannot
+overlap the part).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike
+
+from mechanics import Slider
+
+__all__ = ["body_outline", "pusher_polygon", "convex_pieces", "slider_at", "transform_points"]
+
+
+def transform_points(points: ArrayLike, pose: ArrayLike) -> np.ndarray:
+    """Slider-frame points placed at ``pose = (x, y, theta)`` in the world.
+
+    >>> transform_points([[1.0, 0.0]], [0.0, 1.0, np.pi / 2]).round(12).tolist()
+    [[0.0, 2.0]]
+    """
+    p = np.asarray(points, dtype=float)
+    x, y, theta = pose
+    c, s = np.cos(theta), np.sin(theta)
+    return p @ np.array([[c, s], [-s, c]]) + [x, y]
+
+
+def slider_at(polygon: shapely.Polygon, pose: ArrayLike) -> shapely.Polygon:
+    """``polygon`` (slider frame) placed at ``pose`` in the world."""
+    return shapely.Polygon(transform_points(np.asarray(polygon.exterior.coords), pose))
+
+
+def pusher_polygon(slider: Slider, edge: int, width: float, depth: float) -> shapely.Polygon:
+    """The pusher's ``width x depth`` body behind edge ``edge``, in the slider frame.
+
+    >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+    >>> sorted(map(tuple, np.asarray(pusher_polygon(block, 0, 0.5, 0.1).exterior.coords)[:4].round(12).tolist()))
+    [(-0.25, -0.1), (-0.25, 0.0), (0.25, -0.1), (0.25, 0.0)]
+    """
+    a, b = slider.edge(edge)
+    mid, along = (a + b) / 2, (b - a) / np.linalg.norm(b - a)
+    back = -slider.inward_normal(edge) * depth
+    half = along * width / 2
+    return shapely.Polygon([mid - half, mid + half, mid + half + back, mid - half + back])
+
+
+def convex_pieces(polygon: shapely.Polygon) -> list[np.ndarray]:
+    """Counter-clockwise convex pieces covering ``polygon``: itself if convex, else triangles.
+
+    >>> [len(p) for p in convex_pieces(shapely.box(0, 0, 1, 1))]
+    [4]
+    >>> len(convex_pieces(shapely.Polygon([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]])))
+    4
+    """
+    if polygon.convex_hull.area - polygon.area <= 1e-12 * polygon.area:
+        pieces = [polygon]
+    else:
+        pieces = list(shapely.constrained_delaunay_triangles(polygon).geoms)
+    return [np.asarray(shapely.orient_polygons(p).exterior.coords)[:-1] for p in pieces]
+
+
+def body_outline(slider: Slider, edge: int, width: float, depth: float) -> np.ndarray:
+    """Vertices of the slider and of the pusher on ``edge`` (slider frame): the points where any
+    convex function of position, such as a point's speed or its distance to a wall, peaks."""
+    pusher = np.asarray(pusher_polygon(slider, edge, width, depth).exterior.coords)[:-1]
+    return np.vstack([slider.vertices, pusher])

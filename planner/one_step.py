@@ -1,0 +1,79 @@
+"""One-step planning (Lynch 1992, §5.1): reach the goal by one constant push.
+
+The displacement from start to goal is one body twist, ``COR_total`` (turning by the smaller
+angle). If that twist lies in an edge's stable region and the motion is collision-free, pushing
+about ``COR_total`` reaches the goal exactly. The planner also uses this as its goal test: every
+state from which the goal is one stable push away is in the goal's preimage (Lynch & Mason 1996,
+§4.4's suggested refinement), so searches stop as soon as they reach it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from mechanics import exp_twist, log_pose, wrap_angle
+
+from .plan_file import Segment
+from .pushes import EdgePush, edge_pushes, resolution
+from .scene import Scene
+from .validity import CollisionModel
+
+__all__ = ["OneStep", "one_step", "connect"]
+
+
+def connect(start: ArrayLike, goal: ArrayLike, push: EdgePush, model: CollisionModel, step: float) -> Segment | str:
+    """The single stable push of ``push.edge`` from ``start`` to ``goal``, or why there is none."""
+    total = log_pose(start, goal)
+    speed = float(push.speed(total))
+    if speed == 0.0:
+        return "the start is the goal"
+    if not push.region.contains(total):
+        return "COR_total is not a stable push"
+    twist, duration = total / speed, speed
+    times = np.linspace(0.0, duration, max(2, math.ceil(duration / step) + 1))
+    poses = exp_twist(start, twist, times)
+    if not model.motion_is_free(poses, push.edge, times[1]):
+        return "the push collides"
+    end = poses[-1].copy()
+    end[2] = wrap_angle(end[2])
+    return Segment(push.edge, push.region.contact, twist, duration, np.asarray(start, dtype=float), end)
+
+
+@dataclass(frozen=True)
+class OneStep:
+    """Answer of :func:`one_step`: the push (``segment``) if reachable, else the ``reason``."""
+
+    reachable: bool
+    segment: Segment | None
+    reason: str
+
+    @property
+    def edge(self) -> int | None:
+        return self.segment.edge if self.segment else None
+
+    @property
+    def twist(self) -> np.ndarray | None:
+        return self.segment.twist if self.segment else None
+
+
+def one_step(scene: Scene, start: ArrayLike | None = None, goal: ArrayLike | None = None) -> OneStep:
+    """Is ``goal`` reachable from ``start`` (default: the scene's, radians) by one constant stable
+    push about ``COR_total`` on some allowed edge, without collision?
+
+    Edges are tried in the order the scene allows them; the first that works is returned.
+    """
+    start = scene.start if start is None else np.asarray(start, dtype=float)
+    goal = scene.goal if goal is None else np.asarray(goal, dtype=float)
+    pushes = edge_pushes(scene)
+    model = CollisionModel(scene, [p.edge for p in pushes])
+    reasons = []
+    for push in pushes:
+        result = connect(start, goal, push, model, resolution(scene))
+        if isinstance(result, Segment):
+            return OneStep(True, result, "")
+        reasons.append(f"edge {push.edge}: {result}")
+    return OneStep(False, None, "; ".join(reasons))

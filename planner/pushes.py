@@ -1,0 +1,65 @@
+"""The pushes available on each edge, scaled for planning.
+
+Each allowed edge with a non-empty stable region becomes an :class:`EdgePush`: its STABLE region,
+the steering map from the unit control box onto it, and the body outline used to scale twists so
+that no point of the slider or pusher moves faster than 1 m/s. With that scale, a push's
+``duration`` bounds how far any point travels, which is what the collision rule of
+:mod:`planner.validity` needs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from mechanics import StableRegion, StableSteering, point_velocity, stable_region
+
+from .bodies import body_outline
+from .scene import Scene, SceneError
+
+__all__ = ["EdgePush", "edge_pushes", "resolution"]
+
+
+def resolution(scene: Scene) -> float:
+    """Largest distance any body point moves between two collision checks (a tenth of the part's
+    radius about its CF)."""
+    return scene.slider.radius / 10.0
+
+
+@dataclass(frozen=True)
+class EdgePush:
+    edge: int
+    region: StableRegion
+    steering: StableSteering
+    outline: np.ndarray  # slider + pusher vertices, slider frame
+
+    def speed(self, twist: ArrayLike) -> np.ndarray:
+        """Largest point speed of the body under ``twist`` (attained at an outline vertex)."""
+        v = np.asarray(twist, dtype=float)
+        return np.linalg.norm(point_velocity(v[..., None, :], self.outline), axis=-1).max(axis=-1)
+
+    def control_twist(self, u: ArrayLike) -> np.ndarray:
+        """The unit-speed stable twist for control ``u`` in ``[0, 1]^2``."""
+        v = self.steering.twist(u)
+        return v / self.speed(v)[..., None]
+
+
+def edge_pushes(scene: Scene) -> list[EdgePush]:
+    """An :class:`EdgePush` for each allowed edge that has stable pushes.
+
+    Raises
+    ------
+    SceneError
+        If no allowed edge has any (the friction cone of the contact cannot push through the CF).
+    """
+    p = scene.pusher
+    out = []
+    for e in p.edges:
+        region = stable_region(scene.slider, e, p.mu, width=p.width)
+        if not region.is_empty:
+            out.append(EdgePush(e, region, StableSteering(region), body_outline(scene.slider, e, p.width, p.depth)))
+    if not out:
+        raise SceneError("pusher.edges", "no allowed edge has a stable push (no contact force can pass through the cf)")
+    return out

@@ -1,0 +1,248 @@
+"""Scene files: the part, the pusher, the table and the task, read from YAML and validated.
+
+Every problem is reported as a :class:`SceneError` naming the offending field, so the command
+line can print one line and exit 1. The format is documented in the README.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import shapely
+import yaml
+
+from mechanics import Slider
+
+from .bodies import slider_at
+
+__all__ = ["SceneError", "Pusher", "PlannerOptions", "Scene", "load_scene", "parse_scene", "PLANNERS"]
+
+PLANNERS = ("rrt", "kpiece", "est")
+
+
+class SceneError(ValueError):
+    """Bad input, with the dotted name of the field at fault (``str()`` is ``"field: problem"``)."""
+
+    def __init__(self, field: str, problem: str):
+        super().__init__(f"{field}: {problem}")
+        self.field = field
+        self.problem = problem
+
+
+@dataclass(frozen=True)
+class Pusher:
+    width: float
+    depth: float
+    mu: float
+    edges: tuple[int, ...]  # the edges that may be pushed
+
+
+@dataclass(frozen=True)
+class PlannerOptions:
+    name: str = "kpiece"
+    time_limit: float = 10.0
+    seed: int = 1
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene. Poses are ``(x, y, theta)`` in metres and **radians**."""
+
+    name: str
+    slider: Slider
+    pusher: Pusher
+    obstacles: tuple[shapely.Polygon, ...]
+    workspace: tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
+    start: np.ndarray
+    goal: np.ndarray
+    tolerance_position: float = 0.01
+    tolerance_angle: float = math.radians(2.0)
+    planner: PlannerOptions = field(default_factory=PlannerOptions)
+    path: str | None = None  # the file it was read from
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a YAML scene file.
+
+    Raises
+    ------
+    SceneError
+        If the file cannot be read or any field is missing, unknown or invalid.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as err:
+        raise SceneError("scene", f"cannot read {str(path)!r}: {err.strerror or err}") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        raise SceneError("scene", f"malformed YAML{where}: {getattr(err, 'problem', None) or err}") from None
+    return parse_scene(data, default_name=path.stem, path=str(path))
+
+
+def _keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> dict:
+    if not isinstance(value, dict):
+        raise SceneError(name, f"must be a mapping with keys {', '.join(required + optional)}")
+    for key in value:
+        if key not in required + optional:
+            raise SceneError(f"{name}.{key}" if name != "scene" else str(key), "unknown key")
+    for key in required:
+        if key not in value:
+            raise SceneError(f"{name}.{key}" if name != "scene" else key, "missing")
+    return value
+
+
+def _number(value: Any, name: str, positive: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise SceneError(name, f"must be a number, got {value!r}")
+    if positive and not value > 0:
+        raise SceneError(name, f"must be > 0, got {value!r}")
+    return float(value)
+
+
+def _integer(value: Any, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise SceneError(name, f"must be an integer, got {value!r}")
+    return value
+
+
+def _vector(value: Any, name: str, size: int) -> np.ndarray:
+    if not isinstance(value, (list, tuple)) or len(value) != size:
+        raise SceneError(name, f"must be a list of {size} numbers, got {value!r}")
+    return np.array([_number(v, f"{name}[{i}]") for i, v in enumerate(value)])
+
+
+def _points(value: Any, name: str) -> np.ndarray:
+    if not isinstance(value, (list, tuple)):
+        raise SceneError(name, "must be a list of [x, y] points")
+    if len(value) < 3:
+        raise SceneError(name, f"needs at least 3 vertices, got {len(value)}")
+    return np.array([_vector(p, f"{name}[{i}]", 2) for i, p in enumerate(value)])
+
+
+def _polygon(value: Any, name: str) -> shapely.Polygon:
+    pts = _points(value, name)
+    if not shapely.LinearRing(pts).is_simple:
+        raise SceneError(name, "polygon is self-intersecting")
+    poly = shapely.Polygon(pts)
+    if not poly.area > 0 or not poly.is_valid:
+        raise SceneError(name, "polygon has zero area")
+    return poly
+
+
+def _obstacle(value: Any, name: str) -> shapely.Polygon:
+    if not isinstance(value, dict) or len(value) != 1 or next(iter(value)) not in ("polygon", "box"):
+        raise SceneError(name, "must be {polygon: [[x, y], ...]} or {box: {center, size, angle}}")
+    if "polygon" in value:
+        return _polygon(value["polygon"], f"{name}.polygon")
+    box = _keys(value["box"], f"{name}.box", ("center", "size"), ("angle",))
+    cx, cy = _vector(box["center"], f"{name}.box.center", 2)
+    w, h = _vector(box["size"], f"{name}.box.size", 2)
+    if not (w > 0 and h > 0):
+        raise SceneError(f"{name}.box.size", f"must be positive, got {[w, h]}")
+    angle = math.radians(_number(box.get("angle", 0.0), f"{name}.box.angle"))
+    corners = np.array([[-w, -h], [w, -h], [w, h], [-w, h]]) / 2
+    rot = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
+    return shapely.Polygon(corners @ rot.T + [cx, cy])
+
+
+def _slider(value: Any) -> Slider:
+    spec = _keys(value, "slider", ("vertices",), ("cf",))
+    vertices = _points(spec["vertices"], "slider.vertices")
+    try:
+        Slider(vertices)
+    except ValueError as err:
+        raise SceneError("slider.vertices", str(err)) from None
+    if "cf" not in spec:
+        return Slider(vertices)
+    try:
+        return Slider(vertices, _vector(spec["cf"], "slider.cf", 2))
+    except ValueError as err:
+        raise SceneError("slider.cf", str(err)) from None
+
+
+def _pusher(value: Any, slider: Slider) -> Pusher:
+    spec = _keys(value, "pusher", ("width", "depth", "mu"), ("edges",))
+    width = _number(spec["width"], "pusher.width", positive=True)
+    depth = _number(spec["depth"], "pusher.depth", positive=True)
+    mu = _number(spec["mu"], "pusher.mu", positive=True)
+    if "edges" not in spec:
+        return Pusher(width, depth, mu, slider.pushable_edges)
+    listed = spec["edges"]
+    if not isinstance(listed, (list, tuple)) or not listed:
+        raise SceneError("pusher.edges", "must be a non-empty list of edge indices")
+    edges = []
+    for i, e in enumerate(listed):
+        e = _integer(e, f"pusher.edges[{i}]")
+        if not 0 <= e < slider.n:
+            raise SceneError("pusher.edges", f"edge {e} does not exist (the part has edges 0..{slider.n - 1})")
+        if not slider.is_pushable(e):
+            raise SceneError("pusher.edges", f"edge {e} is not on the convex hull, so a flat pusher cannot push it")
+        if e in edges:
+            raise SceneError("pusher.edges", f"edge {e} is listed twice")
+        edges.append(e)
+    return Pusher(width, depth, mu, tuple(edges))
+
+
+def _pose(value: Any, name: str, slider: Slider, obstacles, workspace) -> np.ndarray:
+    x, y, theta = _vector(value, name, 3)
+    pose = np.array([x, y, math.radians(theta)])
+    body = slider_at(slider.polygon, pose)
+    if not shapely.box(*workspace).contains(body):
+        raise SceneError(name, "the part is not inside the workspace")
+    for k, obstacle in enumerate(obstacles):
+        if body.intersects(obstacle):
+            raise SceneError(name, f"the part collides with obstacle {k}")
+    return pose
+
+
+def parse_scene(data: Any, default_name: str = "scene", path: str | None = None) -> Scene:
+    """Validate a scene given as the parsed YAML mapping (see :func:`load_scene`)."""
+    spec = _keys(data, "scene", ("slider", "pusher", "workspace", "start", "goal"),
+                 ("name", "obstacles", "tolerance", "planner"))
+    name = spec.get("name", default_name)
+    if not isinstance(name, str) or not name or any(c in name for c in "/\\"):
+        raise SceneError("name", f"must be a plain non-empty string, got {name!r}")
+    slider = _slider(spec["slider"])
+    pusher = _pusher(spec["pusher"], slider)
+    obstacles_spec = spec.get("obstacles") or []
+    if not isinstance(obstacles_spec, list):
+        raise SceneError("obstacles", "must be a list")
+    obstacles = tuple(_obstacle(o, f"obstacles[{k}]") for k, o in enumerate(obstacles_spec))
+    ws = _keys(spec["workspace"], "workspace", ("min", "max"))
+    lo, hi = _vector(ws["min"], "workspace.min", 2), _vector(ws["max"], "workspace.max", 2)
+    if not np.all(hi > lo):
+        raise SceneError("workspace", f"is empty or inverted: max {hi.tolist()} must exceed min {lo.tolist()}")
+    workspace = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+    start = _pose(spec["start"], "start", slider, obstacles, workspace)
+    goal = _pose(spec["goal"], "goal", slider, obstacles, workspace)
+    tol = _keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
+    tol_pos = _number(tol.get("position", 0.01), "tolerance.position", positive=True)
+    tol_ang = math.radians(_number(tol.get("angle", 2.0), "tolerance.angle", positive=True))
+    opts = _keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed"))
+    planner = PlannerOptions(
+        name=_planner_name(opts.get("name", "kpiece"), "planner.name"),
+        time_limit=_number(opts.get("time_limit", 10.0), "planner.time_limit", positive=True),
+        seed=_seed(opts.get("seed", 1), "planner.seed"),
+    )
+    return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path)
+
+
+def _planner_name(value: Any, name: str) -> str:
+    if value not in PLANNERS:
+        raise SceneError(name, f"must be one of {', '.join(PLANNERS)}, got {value!r}")
+    return value
+
+
+def _seed(value: Any, name: str) -> int:
+    seed = _integer(value, name)
+    if seed < 1:
+        raise SceneError(name, f"must be a positive integer, got {seed}")
+    return seed

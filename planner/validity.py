@@ -1,0 +1,100 @@
+"""Collision checking of the pushed body (slider + pusher) against obstacles and the workspace.
+
+Resolution rule (why nothing is skipped). Push twists are scaled so that no point of the body
+moves faster than 1 m/s, so between two poses ``delta`` seconds apart every point moves at most
+``delta``. Let ``d0``, ``d1`` be the clearances (distance from the body to the nearest obstacle or
+workspace wall) at the two poses. At time ``tau`` in between, every point is within ``tau`` of its
+place at the first pose and within ``delta - tau`` of its place at the second, so a collision
+needs ``d0 <= tau`` and ``d1 <= delta - tau``, i.e. ``d0 + d1 <= delta``. Hence:
+
+* a motion sampled every ``delta`` is free if ``d_i + d_(i+1) > delta`` for consecutive samples;
+* in particular, a search state is *valid* when its clearance exceeds ``delta / 2``: a step of at
+  most ``delta`` between two valid states never touches an obstacle, however thin.
+
+Obstacles are python-fcl convex prisms in a broad-phase manager; non-convex shapes are split into
+convex pieces (STACK.md §2: solid ``Convex`` detects containment, meshes do not).
+"""
+
+from __future__ import annotations
+
+import math
+
+import fcl
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .bodies import body_outline, convex_pieces, pusher_polygon
+from .scene import Scene
+
+__all__ = ["CollisionModel"]
+
+_HEIGHT = 1.0  # every 2-D shape is a prism over the same z-range
+
+
+def _prism(points: np.ndarray) -> fcl.Convex:
+    n = len(points)
+    verts = np.vstack([np.c_[points, np.full(n, -_HEIGHT / 2)], np.c_[points, np.full(n, _HEIGHT / 2)]])
+    faces = [n, *range(n - 1, -1, -1), n, *range(n, 2 * n)]
+    for i in range(n):
+        j = (i + 1) % n
+        faces += [4, i, j, n + j, n + i]
+    return fcl.Convex(verts, n + 2, faces)
+
+
+class CollisionModel:
+    """Clearance of the slider with the pusher on a given edge, at any pose of the scene.
+
+    Parameters
+    ----------
+    scene : Scene
+    edges : sequence of int
+        The edges a pusher may be placed on (each gets its own body).
+    """
+
+    def __init__(self, scene: Scene, edges):
+        self.workspace = tuple(float(v) for v in scene.workspace)
+        self._manager = fcl.DynamicAABBTreeCollisionManager()
+        self._obstacles = [fcl.CollisionObject(_prism(p)) for o in scene.obstacles for p in convex_pieces(o)]
+        self._manager.registerObjects(self._obstacles)
+        self._manager.setup()
+        self._pieces: dict[int, list[fcl.CollisionObject]] = {}
+        self.hull: dict[int, list] = {}  # body outline vertices per edge (slider frame), as floats
+        p = scene.pusher
+        for e in edges:
+            pusher = pusher_polygon(scene.slider, e, p.width, p.depth)
+            shapes = convex_pieces(scene.slider.polygon) + convex_pieces(pusher)
+            self._pieces[e] = [fcl.CollisionObject(_prism(s)) for s in shapes]
+            self.hull[e] = body_outline(scene.slider, e, p.width, p.depth).tolist()
+
+    def clearance(self, pose: ArrayLike, edge: int) -> float:
+        """Distance from the body to the nearest obstacle or workspace wall; <= 0 if colliding."""
+        x, y, theta = (float(v) for v in pose)
+        c, s = math.cos(theta), math.sin(theta)
+        xmin, ymin, xmax, ymax = self.workspace
+        # The workspace is convex, so the body's distance to its walls is attained at a vertex.
+        best = math.inf
+        for px, py in self.hull[edge]:
+            wx, wy = x + c * px - s * py, y + s * px + c * py
+            best = min(best, wx - xmin, xmax - wx, wy - ymin, ymax - wy)
+        if best <= 0 or not self._obstacles:
+            return best
+        tf = fcl.Transform(np.array([math.cos(theta / 2), 0.0, 0.0, math.sin(theta / 2)]), np.array([x, y, 0.0]))
+        for piece in self._pieces[edge]:
+            piece.setTransform(tf)
+            data = fcl.DistanceData()
+            self._manager.distance(piece, data, fcl.defaultDistanceCallback)
+            best = min(best, float(data.result.min_distance))
+            if best <= 0:
+                break
+        return best
+
+    def motion_is_free(self, poses: ArrayLike, edge: int, step: float) -> bool:
+        """True if the body moving through ``poses`` (no point moving more than ``step`` between
+        consecutive poses) never touches an obstacle or leaves the workspace (rule above)."""
+        previous = None
+        for pose in poses:
+            d = self.clearance(pose, edge)
+            if d <= 0 or (previous is not None and previous + d <= step):
+                return False
+            previous = d
+        return True
