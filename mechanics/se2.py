@@ -13,9 +13,6 @@ from numpy.typing import ArrayLike
 
 __all__ = ["exp_twist", "log_pose", "relative_pose", "wrap_angle"]
 
-_SMALL = 1e-6
-
-
 def wrap_angle(theta: ArrayLike) -> np.ndarray:
     """Angle in ``[-pi, pi)``.
 
@@ -26,15 +23,13 @@ def wrap_angle(theta: ArrayLike) -> np.ndarray:
 
 
 def _sin_ratio(phi: np.ndarray) -> np.ndarray:
-    """sin(phi)/phi, by its Taylor series near 0 to avoid 0/0."""
-    safe = np.where(np.abs(phi) < _SMALL, 1.0, phi)
-    return np.where(np.abs(phi) < _SMALL, 1.0 - phi**2 / 6.0, np.sin(safe) / safe)
+    """sin(phi)/phi, continuous at 0 (numpy's normalised sinc)."""
+    return np.sinc(phi / np.pi)
 
 
 def _cos_ratio(phi: np.ndarray) -> np.ndarray:
-    """(1 - cos(phi))/phi, by its Taylor series near 0."""
-    safe = np.where(np.abs(phi) < _SMALL, 1.0, phi)
-    return np.where(np.abs(phi) < _SMALL, phi / 2.0 - phi**3 / 24.0, (1.0 - np.cos(safe)) / safe)
+    """(1 - cos(phi))/phi = (phi/2) sinc^2(phi/2), continuous at 0."""
+    return phi / 2 * np.sinc(phi / (2 * np.pi)) ** 2
 
 
 def exp_twist(pose: ArrayLike, twist: ArrayLike, t: ArrayLike = 1.0) -> np.ndarray:

@@ -9,7 +9,6 @@ state from which the goal is one stable push away is in the goal's preimage (Lyn
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,15 +17,16 @@ from numpy.typing import ArrayLike
 from mechanics import exp_twist, log_pose, wrap_angle
 
 from .plan_file import Segment
-from .pushes import EdgePush, edge_pushes, resolution
+from .pushes import EdgePush, clearance_margin, edge_pushes
 from .scene import Scene
 from .validity import CollisionModel
 
 __all__ = ["OneStep", "one_step", "connect"]
 
 
-def connect(start: ArrayLike, goal: ArrayLike, push: EdgePush, model: CollisionModel, step: float) -> Segment | str:
-    """The single stable push of ``push.edge`` from ``start`` to ``goal``, or why there is none."""
+def connect(start: ArrayLike, goal: ArrayLike, push: EdgePush, model: CollisionModel, margin: float) -> Segment | str:
+    """The single stable push of ``push.edge`` from ``start`` to ``goal`` keeping ``margin`` from
+    obstacles, or why there is none."""
     total = log_pose(start, goal)
     speed = float(push.speed(total))
     if speed == 0.0:
@@ -34,11 +34,9 @@ def connect(start: ArrayLike, goal: ArrayLike, push: EdgePush, model: CollisionM
     if not push.region.contains(total):
         return "COR_total is not a stable push"
     twist, duration = total / speed, speed
-    times = np.linspace(0.0, duration, max(2, math.ceil(duration / step) + 1))
-    poses = exp_twist(start, twist, times)
-    if not model.motion_is_free(poses, push.edge, times[1]):
+    if not model.push_is_free(start, twist, duration, push.edge, margin):
         return "the push collides"
-    end = poses[-1].copy()
+    end = exp_twist(start, twist, duration)
     end[2] = wrap_angle(end[2])
     return Segment(push.edge, push.region.contact, twist, duration, np.asarray(start, dtype=float), end)
 
@@ -72,7 +70,7 @@ def one_step(scene: Scene, start: ArrayLike | None = None, goal: ArrayLike | Non
     model = CollisionModel(scene, [p.edge for p in pushes])
     reasons = []
     for push in pushes:
-        result = connect(start, goal, push, model, resolution(scene))
+        result = connect(start, goal, push, model, clearance_margin(scene))
         if isinstance(result, Segment):
             return OneStep(True, result, "")
         reasons.append(f"edge {push.edge}: {result}")

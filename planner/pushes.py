@@ -19,13 +19,19 @@ from mechanics import StableRegion, StableSteering, point_velocity, stable_regio
 from .bodies import body_outline
 from .scene import Scene, SceneError
 
-__all__ = ["EdgePush", "edge_pushes", "resolution"]
+__all__ = ["EdgePush", "clearance_margin", "edge_pushes", "resolution"]
 
 
 def resolution(scene: Scene) -> float:
-    """Largest distance any body point moves between two collision checks (a tenth of the part's
-    radius about its CF)."""
+    """The search's propagation step: the largest distance any body point moves between two
+    collision checks (a tenth of the part's radius about its CF)."""
     return scene.slider.radius / 10.0
+
+
+def clearance_margin(scene: Scene) -> float:
+    """The least clearance a whole push must keep (a fortieth of the part's radius): small enough
+    to reach goals close to obstacles, large enough that near-tangent passes end quickly."""
+    return scene.slider.radius / 40.0
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,239 @@
-"""Rerun recording of a plan (stub, being written)."""
+"""Rerun recording of a plan: the scene, the search tree and the pushes, animated.
+
+:func:`write_recording` writes one ``.rrd`` file (application ``stablepush``, recording id
+``<scene>-<planner>-seed<seed>``, no wall-clock timeline, so the same plan gives the same file).
+Everything is in world coordinates, metres; outlines are closed ``LineStrips2D``. Entities:
+
+Static (no timeline, always visible)
+
+* ``/world/workspace`` -- ``Boxes2D``, the workspace bounds;
+* ``/world/obstacles`` -- one strip per obstacle, labelled ``obstacle <k>`` in scene order;
+* ``/world/start``, ``/world/goal`` -- the slider's outline at the start and goal poses (ghosts);
+* ``/world/tree`` -- one strip per search-tree edge (``Plan.tree``; empty after a one-step plan);
+* ``/log`` -- ``TextLog``, one summary line (``WARN`` when not solved).
+
+Animated, one row per frame on the timelines ``time`` (push time in seconds: twists are scaled
+so that no body point moves faster than 1 m/s) and ``step`` (frame index), only for a plan with
+segments. Frames are ``FRAMES_PER_RADIUS`` per slider radius of point travel, at most
+``MAX_FRAMES`` in all:
+
+* ``/world/slider``, ``/world/pusher`` -- the slider's outline and the pusher's on the pushed edge;
+* ``/world/cf_path`` -- the path of the centre of friction so far (thinned to about
+  ``PATH_POINTS`` points, always through the segments' ends);
+* ``/world/cor`` -- ``Points2D``, the current push's centre of rotation (no point for a
+  translation, whose COR is at infinity);
+* ``/world/stable/ccw``, ``/world/stable/cw`` -- the pushed edge's stable COR regions, clipped to
+  a square of half-side 4 slider radii about the CF and carried with the slider (no strip where
+  a region is empty).
+
+Styles (colours, line widths in UI points) are logged statically on the animated entities. The
+default blueprint shows ``/world`` in a 2-D view bounded by the workspace, above the text log.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+import shapely
+from numpy.typing import ArrayLike
+
+from mechanics import exp_twist, twist_to_cor
+
+from .bodies import pusher_polygon
+from .plan_file import Plan
+from .pushes import edge_pushes
+from .scene import Scene
+
+__all__ = ["FRAMES_PER_RADIUS", "MAX_FRAMES", "PATH_POINTS", "write_recording"]
+
+#: Animation frames while a body point travels one slider radius (fewer if that exceeds MAX_FRAMES).
+FRAMES_PER_RADIUS = 20
+#: Most animation frames a recording holds (for plans of fewer than ``MAX_FRAMES - 1`` pushes).
+MAX_FRAMES = 600
+#: About the most points of the CF path drawn in one frame (it is redrawn every frame).
+PATH_POINTS = 100
+
+_THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0.5, 1.0, 2.0, 4.0]))
+_GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
+_SLIDER, _GOAL, _CF = [40, 110, 220], [40, 170, 70], [90, 160, 255]
+_CCW, _CW, _COR = [20, 170, 150], [230, 130, 20], [210, 40, 190]
 
 
-def write_recording(path, scene, plan) -> None:
-    raise NotImplementedError
+def _closed(points: ArrayLike) -> np.ndarray:
+    """A polygon's vertices as a closed strip (the first vertex repeated at the end)."""
+    p = np.asarray(points, dtype=float)
+    return np.vstack([p, p[:1]])
+
+
+def _place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """Slider-frame ``points`` (shape ``(m, 2)``) placed at each of ``poses`` (shape ``(f, 3)``): ``(f, m, 2)``.
+
+    >>> _place(np.array([[1.0, 0.0]]), np.array([[0.0, 1.0, np.pi / 2]])).round(12).tolist()
+    [[[0.0, 2.0]]]
+    """
+    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
+    x, y = points[:, 0], points[:, 1]
+    return np.stack([c * x - s * y + poses[:, :1], s * x + c * y + poses[:, 1:2]], axis=-1)
+
+
+def _summary(scene: Scene, plan: Plan) -> str:
+    """One line; no planning time, so that the same plan always gives the same recording."""
+    head = f"{scene.name}: planner {plan.planner}, seed {plan.seed}"
+    if not plan.solved:
+        return f"{head}: not solved: {plan.reason}; {len(plan.tree)} tree edges"
+    push_time = sum(s.duration for s in plan.segments)
+    return (f"{head}: solved with {plan.pushes} push{'' if plan.pushes == 1 else 'es'}, "
+            f"CF path {plan.path_length(scene.slider.cf):.4f} m, push time {push_time:.4f} s; "
+            f"{len(plan.tree)} tree edges")
+
+
+def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
+    xmin, ymin, xmax, ymax = scene.workspace
+    outline = _closed(scene.slider.vertices)
+    ghosts = _place(outline, np.array([scene.start, scene.goal]))
+    rec.log("world/workspace", rr.Boxes2D(mins=[xmin, ymin], sizes=[xmax - xmin, ymax - ymin],
+                                          colors=_DARK, radii=_LINE), static=True)
+    rec.log("world/obstacles", rr.LineStrips2D(
+        [_closed(o.exterior.coords[:-1]) for o in scene.obstacles], colors=_RED, radii=_BOLD,
+        labels=[f"obstacle {k}" for k in range(len(scene.obstacles))]), static=True)
+    rec.log("world/start", rr.LineStrips2D(ghosts[:1], colors=_GREY, radii=_LINE, labels="start"), static=True)
+    rec.log("world/goal", rr.LineStrips2D(ghosts[1:], colors=_GOAL, radii=_LINE, labels="goal"), static=True)
+    rec.log("world/tree", rr.LineStrips2D(np.asarray(plan.tree, dtype=float).reshape(-1, 2, 2),
+                                          colors=_GREY, radii=_THIN, draw_order=-1.0), static=True)
+    rec.log("log", rr.TextLog(_summary(scene, plan), level="INFO" if plan.solved else "WARN"), static=True)
+
+
+def _frames(plan: Plan, step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Segment index, push time and pose of each animation frame.
+
+    No body point moves more than ``step`` between frames (push time bounds point travel), unless
+    that would take more than ``MAX_FRAMES``: then frames are shared out in proportion to the
+    segments' durations. Every segment gets at least its first frame, and a last frame shows the
+    final pose, so there are at most ``max(MAX_FRAMES, pushes + 1)`` frames.
+    """
+    segments = plan.segments
+    durations = np.array([s.duration for s in segments])
+    counts = np.maximum(np.ceil(durations / step), 1).astype(int)
+    if counts.sum() > MAX_FRAMES - 1:
+        budget = max(MAX_FRAMES - 1 - len(segments), 0)
+        counts = 1 + (budget * durations / durations.sum()).astype(int)
+    index, times, poses = [], [], []
+    clock = 0.0
+    for k, (s, n) in enumerate(zip(segments, counts)):
+        t = np.arange(n) * (s.duration / n)
+        index.append(np.full(n, k))
+        times.append(clock + t)
+        poses.append(exp_twist(s.start, s.twist, t))
+        clock += s.duration
+    index.append([len(segments) - 1])
+    times.append([clock])
+    poses.append([plan.final])
+    return np.concatenate(index), np.concatenate(times), np.concatenate(poses)
+
+
+def _history(points: np.ndarray, index: np.ndarray) -> list[np.ndarray]:
+    """For each frame, the path of ``points`` (one per frame) so far, thinned to at most about
+    ``PATH_POINTS`` points: every few frames plus the first frame of each segment (where the path
+    may turn sharply) and the current one."""
+    keep = np.zeros(len(points), dtype=bool)
+    keep[:: -(-len(points) // PATH_POINTS)] = True
+    keep[np.flatnonzero(np.diff(index, prepend=-1))] = True
+    kept = np.flatnonzero(keep)
+    return [points[np.r_[kept[: np.searchsorted(kept, i)], i]] for i in range(len(points))]
+
+
+def _outline(region: shapely.Geometry) -> np.ndarray | None:
+    """Closed outline of a convex COR region, or None if it is empty or has no area."""
+    return np.asarray(region.exterior.coords) if isinstance(region, shapely.Polygon) and region.area > 0 else None
+
+
+def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
+    index, times, poses = _frames(plan, scene.slider.radius / FRAMES_PER_RADIUS)
+    steps = [rr.TimeColumn("step", sequence=np.arange(len(times))), rr.TimeColumn("time", duration=times)]
+    slider, width, depth = scene.slider, scene.pusher.width, scene.pusher.depth
+    window = (*(slider.cf - 4 * slider.radius), *(slider.cf + 4 * slider.radius))
+    regions = {push.edge: {sense: _outline(poly) for sense, poly in push.region.cor_polygons(window).items()}
+               for push in edge_pushes(scene)}
+    # Per frame: the pusher's outline; the COR and the regions' outlines, none or one each.
+    pusher: list[np.ndarray] = []
+    cor: list[np.ndarray] = []
+    stable: dict[int, list[np.ndarray]] = {1: [], -1: []}
+    for k, s in enumerate(plan.segments):
+        at = poses[index == k]
+        pusher.append(_place(_closed(pusher_polygon(slider, s.edge, width, depth).exterior.coords[:-1]), at))
+        centre, sense = twist_to_cor(s.twist)
+        cor += list(_place(centre[None], at)) if sense != 0 else [np.zeros((0, 2))] * len(at)
+        for side, outline in regions[s.edge].items():
+            empty = [np.zeros((0, 0, 2))] * len(at)
+            stable[side] += empty if outline is None else list(_place(outline, at)[:, None])
+
+    def send(entity: str, columns: rr.ComponentColumnList, rows: list[np.ndarray] | None = None) -> None:
+        """One row per frame; ``rows`` (the items of each frame) splits ``columns`` into them."""
+        rec.send_columns(entity, indexes=steps,
+                         columns=columns if rows is None else columns.partition([len(r) for r in rows]))
+
+    send("world/slider", rr.LineStrips2D.columns(strips=_place(_closed(slider.vertices), poses)))
+    send("world/pusher", rr.LineStrips2D.columns(strips=np.concatenate(pusher)))
+    send("world/cf_path", rr.LineStrips2D.columns(strips=_history(_place(slider.cf[None], poses)[:, 0], index)))
+    send("world/cor", rr.Points2D.columns(positions=np.concatenate(cor)), cor)
+    for name, side in (("ccw", -1), ("cw", 1)):
+        send(f"world/stable/{name}", rr.LineStrips2D.columns(strips=[o for row in stable[side] for o in row]),
+             stable[side])
+    for entity, color, radius in (("world/slider", _SLIDER, _BOLD), ("world/pusher", _DARK, _BOLD),
+                                  ("world/cf_path", _CF, _LINE), ("world/stable/ccw", _CCW, _LINE),
+                                  ("world/stable/cw", _CW, _LINE)):
+        rec.log(entity, rr.LineStrips2D.from_fields(colors=color, radii=radius), static=True)
+    rec.log("world/cor", rr.Points2D.from_fields(colors=_COR, radii=_DOT), static=True)
+
+
+def write_recording(path: str | Path, scene: Scene, plan: Plan) -> None:
+    """Write a rerun recording of ``plan`` for ``scene`` to ``path`` (layout: module docstring).
+
+    The file is written atomically: a temporary file in the same folder is completed (footer
+    included) and then renamed onto ``path``, so readers see the old file or the whole new one,
+    and a failure leaves any previous file untouched and no temporary file behind.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.rrd`` file to write; its folder must exist.
+    scene : Scene
+        The scene that was planned.
+    plan : Plan
+        The planner's result, solved or not (an unsolved plan gives the static scene only).
+
+    Raises
+    ------
+    OSError
+        If the temporary file cannot be created or renamed.
+    """
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".rrd.tmp")
+    os.close(fd)
+    try:
+        xmin, ymin, xmax, ymax = scene.workspace
+        blueprint = rrb.Blueprint(rrb.Vertical(
+            rrb.Spatial2DView(origin="/world", name=scene.name,
+                              visual_bounds=rrb.VisualBounds2D(x_range=[xmin, xmax], y_range=[ymin, ymax])),
+            rrb.TextLogView(origin="/log", name="summary"),
+            row_shares=[6, 1]))
+        rec = rr.RecordingStream("stablepush", recording_id=f"{scene.name}-{plan.planner}-seed{plan.seed}")
+        rec.set_log_time_enabled(False)
+        rec.save(tmp, default_blueprint=blueprint)
+        try:
+            _log_static(rec, scene, plan)
+            if plan.segments:
+                _log_motion(rec, scene, plan)
+        finally:
+            rec.disconnect()  # flushes and writes the footer
+        with open(tmp, "rb") as f:
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -28,7 +28,7 @@ from mechanics import exp_twist, wrap_angle
 
 from .one_step import connect
 from .plan_file import Plan, Segment
-from .pushes import EdgePush, edge_pushes, resolution
+from .pushes import EdgePush, clearance_margin, edge_pushes, resolution
 from .scene import Scene, SceneError
 from .validity import CollisionModel
 
@@ -50,12 +50,34 @@ def _seed_ompl(seed: int) -> None:
     ou.setLogLevel(ou.LOG_ERROR)
 
 
+class _PoseProjection(ob.ProjectionEvaluator):
+    """Projects a state to ``(x, y, r theta)`` for KPIECE's and EST's grids.
+
+    Including the heading matters: the system is a forward-only car, so states at one place but
+    turned differently reach different places; a position-only grid treats them as one cell.
+    """
+
+    def __init__(self, space, radius: float):
+        super().__init__(space)
+        self.radius = radius
+
+    def getDimension(self) -> int:
+        return 3
+
+    def defaultCellSizes(self) -> None:
+        pass  # OMPL infers them from samples (setting them here fails before setup; STACK.md §1.3)
+
+    def project(self, state, out) -> None:
+        p = state[0]
+        out[0], out[1], out[2] = p.getX(), p.getY(), p.getYaw() * self.radius
+
+
 class _PushGoal(ob.GoalSampleableRegion):
     """Within the scene tolerance of the goal, or one stable collision-free push away from it."""
 
-    def __init__(self, si, scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: float):
+    def __init__(self, si, scene: Scene, pushes: list[EdgePush], model: CollisionModel, margin: float):
         super().__init__(si)
-        self.scene, self.pushes, self.model, self.step = scene, pushes, model, step
+        self.scene, self.pushes, self.model, self.margin = scene, pushes, model, margin
         self.setThreshold(1e-9)  # OMPL accepts distances strictly below the threshold
 
     def within_tolerance(self, pose: np.ndarray) -> bool:
@@ -68,7 +90,7 @@ class _PushGoal(ob.GoalSampleableRegion):
         pose = np.array([p.getX(), p.getY(), p.getYaw()])
         if self.within_tolerance(pose):
             return 0.0
-        if isinstance(connect(pose, self.scene.goal, self.pushes[state[1].value], self.model, self.step), Segment):
+        if isinstance(connect(pose, self.scene.goal, self.pushes[state[1].value], self.model, self.margin), Segment):
             return 0.0
         g = self.scene.goal
         return math.hypot(pose[0] - g[0], pose[1] - g[1]) + self.scene.slider.radius * abs(
@@ -103,7 +125,7 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     clock = time.perf_counter()
     pushes = edge_pushes(scene)
     model = CollisionModel(scene, [p.edge for p in pushes])
-    step = resolution(scene)
+    step, margin = resolution(scene), clearance_margin(scene)
     result = Plan(scene.path, False, name, seed, 0.0, scene.start.copy(), scene.goal.copy())
 
     def done(segments: list[Segment], reason: str = "", tree=None) -> Plan:
@@ -119,7 +141,7 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     if not starts:
         raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
     for k in starts:
-        first = connect(scene.start, scene.goal, pushes[k], model, step)
+        first = connect(scene.start, scene.goal, pushes[k], model, margin)
         if isinstance(first, Segment):
             return done([first])
         if first == "the start is the goal":
@@ -133,14 +155,14 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
         s[0].setYaw(float(wrap_angle(scene.start[2])))
         s[1].value = k
         ss.addStartState(s)
-    goal_test = _PushGoal(si, scene, pushes, model, step)
+    goal_test = _PushGoal(si, scene, pushes, model, margin)
     ss.setGoal(goal_test)
     ss.setPlanner(_PLANNERS[name](si))
     ss.solve(float(time_limit))
     tree = _tree(ss, si)
     if not ss.haveExactSolutionPath():
         return done([], f"no plan found within the time limit of {time_limit:g} s", tree)
-    segments = _segments(ss.getSolutionPath(), scene, pushes, model, step, goal_test)
+    segments = _segments(ss.getSolutionPath(), scene, pushes, model, margin, goal_test)
     if segments is None:
         return done([], "the final push failed its re-check after rounding", tree)
     return done(segments, tree=tree)
@@ -156,7 +178,7 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
     space.addSubspace(se2, 1.0)
     space.addSubspace(ob.DiscreteStateSpace(0, len(pushes) - 1), 0.0)
     space.lock()
-    space.registerDefaultProjection(ob.SubspaceProjectionEvaluator(space, 0))
+    space.registerDefaultProjection(_PoseProjection(space, scene.slider.radius))
     controls = oc.RealVectorControlSpace(space, 2)
     unit = ob.RealVectorBounds(2)
     unit.setLow(0.0), unit.setHigh(1.0)
@@ -197,7 +219,7 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
     return space, si
 
 
-def _segments(path, scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: float,
+def _segments(path, scene: Scene, pushes: list[EdgePush], model: CollisionModel, margin: float,
               goal: _PushGoal) -> list[Segment] | None:
     """Segments of an OMPL control path (copied out at once: its states live in C++), merged where
     consecutive controls are equal, plus the final push onto the goal if the path stops short."""
@@ -222,11 +244,32 @@ def _segments(path, scene: Scene, pushes: list[EdgePush], model: CollisionModel,
         pose = end
     if not goal.within_tolerance(pose):
         # The goal test accepted the tree's last state; the re-composed pose differs by rounding only.
-        last = connect(pose, scene.goal, push, model, step)
+        last = connect(pose, scene.goal, push, model, margin)
         if not isinstance(last, Segment):
             return None
         segments.append(last)
-    return segments
+    return _shortcut(segments, push, model, margin)
+
+
+def _shortcut(segments: list[Segment], push: EdgePush, model: CollisionModel, margin: float) -> list[Segment]:
+    """Replace runs of pushes by one push wherever one stable collision-free push joins their
+    ends (the one-step test between plan waypoints); greedy, farthest waypoint first.
+
+    Random controls make plans zig-zag; this keeps the guarantee (every replacement is checked
+    like any push) and usually removes most pushes.
+    """
+    out, i = [], 0
+    while i < len(segments):
+        for j in range(len(segments) - 1, i, -1):
+            joined = connect(segments[i].start, segments[j].end, push, model, margin)
+            if isinstance(joined, Segment):
+                out.append(joined)
+                i = j + 1
+                break
+        else:
+            out.append(segments[i])
+            i += 1
+    return out
 
 
 def _tree(ss, si) -> np.ndarray:

@@ -1,15 +1,15 @@
 """Collision checking of the pushed body (slider + pusher) against obstacles and the workspace.
 
 Resolution rule (why nothing is skipped). Push twists are scaled so that no point of the body
-moves faster than 1 m/s, so between two poses ``delta`` seconds apart every point moves at most
-``delta``. Let ``d0``, ``d1`` be the clearances (distance from the body to the nearest obstacle or
-workspace wall) at the two poses. At time ``tau`` in between, every point is within ``tau`` of its
-place at the first pose and within ``delta - tau`` of its place at the second, so a collision
-needs ``d0 <= tau`` and ``d1 <= delta - tau``, i.e. ``d0 + d1 <= delta``. Hence:
+moves faster than 1 m/s; then from a pose with clearance ``d`` (distance from the body to the
+nearest obstacle or workspace wall) the body can move for ``d`` seconds without touching
+anything, however thin the obstacle. Two uses:
 
-* a motion sampled every ``delta`` is free if ``d_i + d_(i+1) > delta`` for consecutive samples;
-* in particular, a search state is *valid* when its clearance exceeds ``delta / 2``: a step of at
-  most ``delta`` between two valid states never touches an obstacle, however thin.
+* search states: a state is *valid* when its clearance exceeds ``delta / 2``, where ``delta`` is
+  the propagation step; a step joins two such states, and at any instant of it the body is within
+  ``delta / 2`` of one of them, so no step between valid states touches an obstacle;
+* whole pushes (:meth:`CollisionModel.push_is_free`): conservative advancement, stepping by the
+  clearance itself, and rejecting the push if the clearance ever drops below ``margin``.
 
 Obstacles are python-fcl convex prisms in a broad-phase manager; non-convex shapes are split into
 convex pieces (STACK.md §2: solid ``Convex`` detects containment, meshes do not).
@@ -22,6 +22,8 @@ import math
 import fcl
 import numpy as np
 from numpy.typing import ArrayLike
+
+from mechanics import exp_twist
 
 from .bodies import body_outline, convex_pieces, pusher_polygon
 from .scene import Scene
@@ -88,13 +90,14 @@ class CollisionModel:
                 break
         return best
 
-    def motion_is_free(self, poses: ArrayLike, edge: int, step: float) -> bool:
-        """True if the body moving through ``poses`` (no point moving more than ``step`` between
-        consecutive poses) never touches an obstacle or leaves the workspace (rule above)."""
-        previous = None
-        for pose in poses:
-            d = self.clearance(pose, edge)
-            if d <= 0 or (previous is not None and previous + d <= step):
+    def push_is_free(self, pose: ArrayLike, twist: ArrayLike, duration: float, edge: int, margin: float) -> bool:
+        """True if pushing from ``pose`` with unit-speed ``twist`` for ``duration`` keeps the body
+        at least ``margin`` away from obstacles and walls all the way (rule above)."""
+        t = 0.0
+        while True:
+            d = self.clearance(exp_twist(pose, twist, t), edge)
+            if d < margin:
                 return False
-            previous = d
-        return True
+            if t >= duration:
+                return True
+            t = min(duration, t + d)

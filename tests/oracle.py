@@ -203,6 +203,14 @@ class Reference:
         keep = [k for k in range(len(out)) if all(np.hypot(*(out[k] - out[j])) > 1e-9 for j in range(k))]
         return out[keep]
 
+    def extremal(self) -> np.ndarray:
+        """Corner twists of the region: CCW corners, end translations, CW corners (maybe empty)."""
+        iv = self.translation_interval()
+        parts = [twist_of_cor(self.corners(1), 1).reshape(-1, 3),
+                 self.translation(np.unique(iv)) if iv is not None else np.zeros((0, 3)),
+                 twist_of_cor(self.corners(-1), -1).reshape(-1, 3)]
+        return np.vstack(parts)
+
     def translation_interval(self):
         lo = max(-self.alpha, np.arctan(self.t @ (self.eL - self.cf) / self.h))
         hi = min(self.alpha, np.arctan(self.t @ (self.eR - self.cf) / self.h))
@@ -350,7 +358,7 @@ def random_geometry(rng, kind=None) -> dict:
 
 def random_twists(rng, ref: Reference, n: int) -> np.ndarray:
     """Twists that probe the region: CORs near the part and far out, both senses, translations."""
-    k = n // 4
+    k = n // 5
     scale = ref.r
     c1 = ref.cf + rng.normal(size=(k, 2)) * 3 * scale
     c2 = ref.cf + rng.normal(size=(k, 2)) * 15 * scale
@@ -359,6 +367,12 @@ def random_twists(rng, ref: Reference, n: int) -> np.ndarray:
     rots = twist_of_cor(cors, sense) * rng.uniform(0.1, 10, size=(len(cors), 1))
     phi = rng.uniform(-np.pi, np.pi, size=k)
     trans = np.column_stack([np.cos(phi), np.sin(phi), np.zeros(k)])
-    th = rng.uniform(-1.2 * ref.alpha - 0.1, 1.2 * ref.alpha + 0.1, size=n - 3 * k)
+    th = rng.uniform(-1.2 * ref.alpha - 0.1, 1.2 * ref.alpha + 0.1, size=k)
     near = ref.translation(th)
-    return np.vstack([rots, trans, near])
+    E = ref.extremal() * np.array([1.0, 1.0, scale])
+    if len(E):  # mixtures of the corners: inside the region (and on its faces for 2-sparse weights)
+        w = rng.dirichlet(np.full(len(E), 0.5), size=n - 4 * k)
+        mix = (w @ E) / np.array([1.0, 1.0, scale])
+    else:
+        mix = np.zeros((0, 3))
+    return np.vstack([rots, trans, near, mix])

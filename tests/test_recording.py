@@ -1,0 +1,281 @@
+"""The rerun recording of a plan (planner.recording), read back from the file.
+
+Sources of truth, none of them the code under test: ``rerun rrd verify`` for the file format; the
+scene's own numbers (the YAML written here) and poses applied to the slider's vertices by the
+rotation written out below; and a rigid-body fact: while a part turns about a centre of rotation,
+that centre stays put in the world.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pytest
+import shapely
+from rerun.chunk import RrdReader
+
+import planner
+from mechanics import exp_twist
+from planner import recording
+
+RERUN = Path(sys.executable).parent / "rerun"
+
+SLIDER = [[-0.04, -0.03], [0.04, -0.03], [0.04, 0.03], [-0.04, 0.03]]
+TRIANGLE = [[0.2, 0.1], [0.3, 0.1], [0.25, 0.18]]
+BOX = {"center": [0.0, -0.15], "size": [0.1, 0.04], "angle": 30.0}
+COR = [0.0, 0.15]  # inside edge 3's CCW stable region (mu = 0.5): a stable turn about it
+TURN_START = [0.02, -0.03, math.radians(20.0)]
+TURN = math.radians(30.0)
+
+STATIC = {"/log", "/world/workspace", "/world/obstacles", "/world/start", "/world/goal", "/world/tree"}
+ANIMATED = {"/world/slider", "/world/pusher", "/world/cf_path", "/world/cor", "/world/stable/ccw", "/world/stable/cw"}
+
+
+def write_scene(folder: Path, name: str, goal: list[float], start: list[float] = (0.0, 0.0, 0.0)) -> planner.Scene:
+    # Edge 3 is the face at x = -0.04; pushing it drives the part along +x.
+    text = f"""
+name: {name}
+slider:
+  vertices: {SLIDER}
+pusher: {{width: 0.05, depth: 0.015, mu: 0.5, edges: [3]}}
+obstacles:
+  - polygon: {TRIANGLE}
+  - box: {{center: {BOX['center']}, size: {BOX['size']}, angle: {BOX['angle']}}}
+workspace: {{min: [-0.2, -0.25], max: [0.35, 0.25]}}
+start: [{", ".join(repr(float(v)) for v in start)}]
+goal: [{", ".join(repr(float(v)) for v in goal)}]
+planner: {{time_limit: 1.0}}
+"""
+    path = folder / f"{name}.yaml"
+    path.write_text(text)
+    return planner.load_scene(path)
+
+
+def placed(points, pose) -> np.ndarray:
+    """``points`` (body frame) at ``pose = (x, y, theta)``: rotate by theta, then translate."""
+    x, y, theta = pose
+    rot = np.array([[math.cos(theta), -math.sin(theta)], [math.sin(theta), math.cos(theta)]])
+    return np.asarray(points, dtype=float) @ rot.T + [x, y]
+
+
+def closed(points) -> np.ndarray:
+    p = np.asarray(points, dtype=float)
+    return np.vstack([p, p[:1]])
+
+
+def column(batch: pa.RecordBatch, name: str) -> list:
+    """A column as Python values; durations as integer nanoseconds (timedelta has only µs)."""
+    values = batch.column(batch.schema.names.index(name))
+    return (values.cast(pa.int64()) if pa.types.is_duration(values.type) else values).to_pylist()
+
+
+def rrd_rows(path: Path, entity: str, component: str, timeline: str | None = None) -> list[tuple]:
+    """[(time, value)] of one component of one entity, over all chunks, sorted (STACK.md §3.6)."""
+    rows = []
+    for chunk in RrdReader(str(path)).store().stream():
+        if chunk.entity_path != entity:
+            continue
+        batch = chunk.to_record_batch()
+        names = batch.schema.names
+        if component not in names:
+            continue
+        values = column(batch, component)
+        index = column(batch, timeline) if timeline in names else [None] * len(values)
+        rows += zip(index, values)
+    return sorted(rows, key=lambda r: (r[0] is not None, r[0] or 0))
+
+
+def entities(path: Path) -> set[str]:
+    return {chunk.entity_path for chunk in RrdReader(str(path)).store().stream()} - {"/__properties"}
+
+
+def verify(path: Path) -> None:
+    if not RERUN.exists():
+        pytest.skip(f"no rerun CLI next to {sys.executable}")
+    done = subprocess.run([str(RERUN), "rrd", "verify", str(path)], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+
+
+@pytest.fixture(scope="module")
+def straight(tmp_path_factory):
+    """A one-step plan: a straight push along edge 3's normal, recorded."""
+    folder = tmp_path_factory.mktemp("straight")
+    scene = write_scene(folder, "straight", [0.12, 0.0, 0.0])
+    plan = planner.plan(scene)
+    assert plan.solved and plan.pushes == 1
+    recording.write_recording(folder / "straight.rrd", scene, plan)
+    return scene, plan, folder / "straight.rrd"
+
+
+@pytest.fixture(scope="module")
+def turn(tmp_path_factory):
+    """A one-step plan: a 30 degree CCW turn about ``COR`` (slider frame), recorded."""
+    folder = tmp_path_factory.mktemp("turn")
+    centre = placed([COR], TURN_START)[0]
+    goal = [*placed([TURN_START[:2] - centre], [*centre, TURN])[0], TURN_START[2] + TURN]
+    scene = write_scene(folder, "turn", [goal[0], goal[1], math.degrees(goal[2])],
+                        [TURN_START[0], TURN_START[1], math.degrees(TURN_START[2])])
+    plan = planner.plan(scene)
+    assert plan.solved and plan.pushes == 1
+    recording.write_recording(folder / "turn.rrd", scene, plan)
+    return scene, plan, folder / "turn.rrd"
+
+
+def test_the_file_is_complete_and_has_every_entity(straight):
+    _, _, path = straight
+    verify(path)
+    assert entities(path) == STATIC | ANIMATED
+    assert RrdReader(str(path)).recordings()[0].recording_id == "straight-kpiece-seed1"
+
+
+def test_the_slider_moves_from_the_start_to_the_plans_final_pose(straight, turn):
+    for scene, plan, path in (straight, turn):
+        rows = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
+        assert [t for t, _ in rows] == list(range(len(rows)))
+        assert 10 <= len(rows) <= recording.MAX_FRAMES
+        outlines = np.array([strips[0] for _, strips in rows])
+        # Smooth: no vertex jumps more than a twentieth of the part's radius (0.05) between frames.
+        assert np.linalg.norm(np.diff(outlines, axis=0), axis=-1).max() <= 0.05 / 20 + 1e-6
+        first, last = outlines[0], outlines[-1]
+        np.testing.assert_allclose(first, closed(placed(SLIDER, scene.start)), atol=1e-5)
+        np.testing.assert_allclose(last, closed(placed(SLIDER, plan.final)), atol=1e-5)
+        np.testing.assert_allclose(last, closed(placed(SLIDER, scene.goal)), atol=1e-5)
+        cf = rrd_rows(path, "/world/cf_path", "LineStrips2D:strips", "step")
+        np.testing.assert_allclose(cf[-1][1][0][-1], plan.final[:2], atol=1e-5)  # the CF is the centroid (0, 0)
+        assert len(cf[-1][1][0]) == len(rows)
+        times = [t for _, t in rrd_rows(path, "/world/slider", "time", "step")]
+        assert times[0] == 0 and np.all(np.diff(times) > 0)
+        assert times[-1] == pytest.approx(plan.segments[0].duration * 1e9, abs=1)
+
+
+def test_the_pusher_stays_behind_the_pushed_edge(straight):
+    _, _, path = straight
+    slider = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
+    pusher = rrd_rows(path, "/world/pusher", "LineStrips2D:strips", "step")
+    for (_, part), (_, face) in zip(slider, pusher):
+        body, tool = shapely.Polygon(part[0]), shapely.Polygon(face[0])
+        assert tool.area == pytest.approx(0.05 * 0.015, rel=1e-4)
+        assert body.intersection(tool).area < 1e-9 and body.distance(tool) < 1e-6
+
+
+def test_the_obstacles_and_the_ghosts_match_the_scene(straight):
+    scene, _, path = straight
+    (_, strips), = rrd_rows(path, "/world/obstacles", "LineStrips2D:strips")
+    (_, labels), = rrd_rows(path, "/world/obstacles", "LineStrips2D:labels")
+    assert labels == ["obstacle 0", "obstacle 1"]
+    np.testing.assert_allclose(strips[0], closed(TRIANGLE), atol=1e-6)
+    w, h = BOX["size"]
+    box = placed([[-w / 2, -h / 2], [w / 2, -h / 2], [w / 2, h / 2], [-w / 2, h / 2]],
+                 [*BOX["center"], math.radians(BOX["angle"])])
+    np.testing.assert_allclose(strips[1], closed(box), atol=1e-6)
+    (_, goal), = rrd_rows(path, "/world/goal", "LineStrips2D:strips")
+    np.testing.assert_allclose(goal[0], closed(placed(SLIDER, [0.12, 0.0, 0.0])), atol=1e-6)
+    (_, half), = rrd_rows(path, "/world/workspace", "Boxes2D:half_sizes")
+    np.testing.assert_allclose(half, [[0.275, 0.25]], atol=1e-6)
+
+
+def test_the_centre_of_a_turn_stays_put_and_lies_in_its_stable_region(turn, straight):
+    _, _, path = turn
+    cors = rrd_rows(path, "/world/cor", "Points2D:positions", "step")
+    assert len(cors) == len(rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step"))
+    centre = placed([COR], TURN_START)[0]
+    np.testing.assert_allclose(np.array([c for _, c in cors]).reshape(-1, 2), [centre] * len(cors), atol=1e-5)
+    ccw = rrd_rows(path, "/world/stable/ccw", "LineStrips2D:strips", "step")
+    cw = rrd_rows(path, "/world/stable/cw", "LineStrips2D:strips", "step")
+    for k in (0, len(ccw) // 2, len(ccw) - 1):
+        assert shapely.Polygon(ccw[k][1][0]).contains(shapely.Point(centre))
+        assert not shapely.Polygon(cw[k][1][0]).contains(shapely.Point(centre))
+    # A translation has no centre of rotation: no point is drawn.
+    assert all(c == [] for _, c in rrd_rows(straight[2], "/world/cor", "Points2D:positions", "step"))
+
+
+def test_an_unsolved_plan_records_the_scene_and_the_tree(tmp_path):
+    scene = write_scene(tmp_path, "stuck", [0.12, 0.0, 0.0])
+    plan = planner.Plan(scene.path, False, "rrt", 1, 0.0, scene.start, scene.goal, reason="no plan found")
+    plan.tree = np.array([[[0.0, 0.0], [0.05, 0.01]], [[0.05, 0.01], [0.08, -0.02]]])
+    path = tmp_path / "stuck.rrd"
+    recording.write_recording(path, scene, plan)
+    verify(path)
+    assert entities(path) == STATIC
+    (_, tree), = rrd_rows(path, "/world/tree", "LineStrips2D:strips")
+    np.testing.assert_allclose(tree, plan.tree, atol=1e-6)
+    (_, text), = rrd_rows(path, "/log", "TextLog:text")
+    assert "not solved: no plan found" in text[0]
+
+
+def test_the_same_plan_gives_the_same_file(straight, tmp_path):
+    if not RERUN.exists():
+        pytest.skip(f"no rerun CLI next to {sys.executable}")
+    scene, plan, path = straight
+    again = tmp_path / "again.rrd"
+    recording.write_recording(again, scene, plan)
+    done = subprocess.run([str(RERUN), "rrd", "compare", "--unordered", str(path), str(again)],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr[-2000:]
+
+
+def test_a_long_plan_is_capped_and_its_cf_path_thinned(straight, tmp_path):
+    scene, _, _ = straight
+    twists = [[1.0, 0.0, 0.0], [0.1, 0.0, 1.0], [0.8, 0.2, 0.0]]  # 1800 frames' worth at 0.0025 m each
+    durations = [2.0, 1.5, 1.0]
+    segments, pose = [], np.array(scene.start)
+    for twist, duration in zip(twists, durations):
+        end = exp_twist(pose, twist, duration)
+        segments.append(planner.Segment(3, np.array(SLIDER[3::-3]), np.array(twist), duration, pose, end))
+        pose = end
+    plan = planner.Plan(scene.path, True, "rrt", 1, 0.0, scene.start, pose, segments)
+    path = tmp_path / "long.rrd"
+    recording.write_recording(path, scene, plan)
+    slider = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
+    assert 0.9 * recording.MAX_FRAMES <= len(slider) <= recording.MAX_FRAMES
+    times = [t for _, t in rrd_rows(path, "/world/slider", "time", "step")]
+    for s, t in zip(segments, np.cumsum([0.0] + durations)):  # each push starts on a frame
+        k = int(np.argmin(np.abs(np.array(times) - t * 1e9)))
+        assert abs(times[k] - t * 1e9) <= 1
+        np.testing.assert_allclose(slider[k][1][0], closed(placed(SLIDER, s.start)), atol=1e-5)
+    np.testing.assert_allclose(slider[-1][1][0], closed(placed(SLIDER, pose)), atol=1e-5)
+    cf = rrd_rows(path, "/world/cf_path", "LineStrips2D:strips", "step")
+    assert max(len(strips[0]) for _, strips in cf) <= recording.PATH_POINTS + len(segments) + 1
+    drawn = np.array(cf[-1][1][0])
+    for s in segments:  # the path keeps its corners
+        assert np.linalg.norm(drawn - s.start[:2], axis=1).min() < 1e-5
+    np.testing.assert_allclose(drawn[-1], pose[:2], atol=1e-5)
+
+
+def test_a_failed_write_keeps_the_old_file_and_leaves_no_temporary(straight, tmp_path, monkeypatch):
+    scene, plan, _ = straight
+    path = tmp_path / "straight.rrd"
+    path.write_bytes(b"the previous recording")
+    calls = []
+
+    def fail(*args, **kwargs):  # the animation is sampled after the file sink has started
+        calls.append(args)
+        raise RuntimeError("disk on fire")
+
+    monkeypatch.setattr(recording, "exp_twist", fail)
+    with pytest.raises(RuntimeError, match="disk on fire"):
+        recording.write_recording(path, scene, plan)
+    assert calls
+    assert path.read_bytes() == b"the previous recording"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["straight.rrd"]
+    monkeypatch.undo()
+
+    renamed = []
+
+    def replace(src, dst):  # the file must be finished (footer written) before it is put in place
+        renamed.append(Path(src).read_bytes())
+        real_replace(src, dst)
+
+    real_replace = os.replace
+    monkeypatch.setattr(os, "replace", replace)
+    recording.write_recording(path, scene, plan)  # a good write replaces the old file
+    monkeypatch.undo()
+    assert renamed == [path.read_bytes()]
+    verify(path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["straight.rrd"]
