@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 from .plan_file import write_atomic
-from .scene import PLANNERS, SceneError, load_scene
+from .scene import DEFAULT_PLANNER, PLANNERS, SceneError, load_scene
 from .search import plan
 
 __all__ = ["main"]
@@ -31,7 +31,7 @@ def _silence_nanobind_leak_report() -> None:
 def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="plan", description="Plan guaranteed-stable pushes for a YAML scene.")
     p.add_argument("scene", help="scene file (YAML)")
-    p.add_argument("--planner", choices=PLANNERS, help="OMPL control planner (default: the scene's, else kpiece)")
+    p.add_argument("--planner", choices=PLANNERS, help=f"OMPL control planner (default: the scene's, else {DEFAULT_PLANNER})")
     p.add_argument("--time-limit", type=float, metavar="S", help="planning time limit in seconds")
     p.add_argument("--seed", type=int, metavar="N", help="random seed (>= 1); the same seed gives the same plan")
     p.add_argument("--out", metavar="DIR", help="output folder (default: logs/<name>-<timestamp>/)")

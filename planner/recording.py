@@ -181,7 +181,7 @@ def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
     send("world/pusher", rr.LineStrips2D.columns(strips=np.concatenate(pusher)))
     send("world/cf_path", rr.LineStrips2D.columns(strips=_history(_place(slider.cf[None], poses)[:, 0], index)))
     send("world/cor", rr.Points2D.columns(positions=np.concatenate(cor)), cor)
-    for name, side in (("ccw", -1), ("cw", 1)):
+    for name, side in (("ccw", 1), ("cw", -1)):
         send(f"world/stable/{name}", rr.LineStrips2D.columns(strips=[o for row in stable[side] for o in row]),
              stable[side])
     for entity, color, radius in (("world/slider", _SLIDER, _BOLD), ("world/pusher", _DARK, _BOLD),

@@ -19,9 +19,11 @@ from mechanics import Slider
 
 from .bodies import slider_at
 
-__all__ = ["SceneError", "Pusher", "PlannerOptions", "Scene", "load_scene", "parse_scene", "PLANNERS"]
+__all__ = ["DEFAULT_PLANNER", "SceneError", "Pusher", "PlannerOptions", "Scene", "load_scene", "parse_scene", "PLANNERS"]
 
 PLANNERS = ("rrt", "kpiece", "est")
+#: The planner used when neither the scene nor the caller names one (chosen by planner.bench).
+DEFAULT_PLANNER = "kpiece"
 
 
 class SceneError(ValueError):
@@ -43,7 +45,7 @@ class Pusher:
 
 @dataclass(frozen=True)
 class PlannerOptions:
-    name: str = "kpiece"
+    name: str = DEFAULT_PLANNER
     time_limit: float = 10.0
     seed: int = 1
 
@@ -228,7 +230,7 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     tol_ang = math.radians(_number(tol.get("angle", 2.0), "tolerance.angle", positive=True))
     opts = _keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed"))
     planner = PlannerOptions(
-        name=_planner_name(opts.get("name", "kpiece"), "planner.name"),
+        name=_planner_name(opts.get("name", DEFAULT_PLANNER), "planner.name"),
         time_limit=_number(opts.get("time_limit", 10.0), "planner.time_limit", positive=True),
         seed=_seed(opts.get("seed", 1), "planner.seed"),
     )

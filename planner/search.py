@@ -32,10 +32,7 @@ from .pushes import EdgePush, clearance_margin, edge_pushes, resolution
 from .scene import Scene, SceneError
 from .validity import CollisionModel
 
-__all__ = ["plan", "DEFAULT_PLANNER", "MAX_CONTROL_STEPS"]
-
-#: The planner used when neither the scene nor the caller names one (chosen by planner.bench).
-DEFAULT_PLANNER = "kpiece"
+__all__ = ["plan", "MAX_CONTROL_STEPS"]
 #: Longest constant push the planners sample, in collision-check steps.
 MAX_CONTROL_STEPS = 30
 
