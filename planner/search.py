@@ -173,7 +173,8 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
     se2.setBounds(bounds)
     space = ob.CompoundStateSpace()
     space.addSubspace(se2, 1.0)
-    space.addSubspace(ob.DiscreteStateSpace(0, len(pushes) - 1), 0.0)
+    # OMPL needs a discrete range of positive extent; with one edge, index 1 exists but is invalid.
+    space.addSubspace(ob.DiscreteStateSpace(0, max(1, len(pushes) - 1)), 0.0)
     space.lock()
     space.registerDefaultProjection(_PoseProjection(space, scene.slider.radius))
     controls = oc.RealVectorControlSpace(space, 2)
@@ -204,9 +205,9 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
         result[1].value = k
 
     def is_valid(state) -> bool:
-        p = state[0]
-        return si.satisfiesBounds(state) and model.clearance(
-            (p.getX(), p.getY(), p.getYaw()), pushes[state[1].value].edge) > step / 2
+        p, k = state[0], state[1].value
+        return k < len(pushes) and si.satisfiesBounds(state) and model.clearance(
+            (p.getX(), p.getY(), p.getYaw()), pushes[k].edge) > step / 2
 
     si.setStatePropagator(propagate)
     si.setStateValidityChecker(is_valid)

@@ -1,0 +1,68 @@
+"""The collision rule never skips a thin obstacle, in one push or in a planned path."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from planner import parse_scene, plan
+from planner.pushes import clearance_margin, edge_pushes, resolution
+from planner.validity import CollisionModel
+from replay import advance, place, pusher_body
+
+BLOCK = [[-0.04, -0.025], [0.04, -0.025], [0.04, 0.025], [-0.04, 0.025]]
+WALL = 0.0005  # 0.5 mm thick: a tenth of the search step
+
+
+def scene(obstacles, start=(-0.2, 0.0, 0.0), goal=(0.2, 0.0, 0.0), **extra):
+    return parse_scene({
+        "slider": {"vertices": BLOCK},
+        "pusher": {"width": 0.05, "depth": 0.015, "mu": 0.5, "edges": [3]},
+        "obstacles": obstacles,
+        "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]},
+        "start": list(start), "goal": list(goal), **extra})
+
+
+THIN = [{"box": {"center": [0.0, 0.0], "size": [WALL, 0.3]}}]
+
+
+def test_wall_is_much_thinner_than_the_search_step():
+    s = scene(THIN)
+    assert s.obstacles[0].bounds[2] - s.obstacles[0].bounds[0] < resolution(s) / 5
+
+
+def test_push_through_thin_wall_is_rejected():
+    s = scene(THIN)
+    push = edge_pushes(s)[0]
+    model = CollisionModel(s, [push.edge])
+    straight = np.array([1.0, 0.0, 0.0]) / push.speed([1.0, 0.0, 0.0])
+    assert not model.push_is_free(s.start, straight, 0.4, push.edge, clearance_margin(s))
+    # The same push with the wall moved out of the way is free.
+    clear = scene([{"box": {"center": [0.0, 0.3], "size": [WALL, 0.1]}}])
+    model = CollisionModel(clear, [push.edge])
+    assert model.push_is_free(clear.start, straight, 0.4, push.edge, clearance_margin(clear))
+
+
+def test_clearance_is_distance_to_nearest_obstacle_or_wall():
+    s = scene([{"box": {"center": [0.0, 0.0], "size": [0.02, 0.02]}}])
+    model = CollisionModel(s, [3])
+    # Body at x = -0.2: slider spans x in [-0.24, -0.16], the pusher 1.5 cm behind its -x face.
+    assert math.isclose(model.clearance((-0.2, 0.0, 0.0), 3), 0.16 - 0.01, rel_tol=1e-9)
+    # Near the workspace wall: the pusher's back is at x = -0.455 -> 0.045 from x = -0.5.
+    assert math.isclose(model.clearance((-0.4, 0.2, 0.0), 3), 0.045, rel_tol=1e-9)
+    assert model.clearance((0.0, 0.0, 0.0), 3) <= 0
+
+
+def test_planned_path_goes_around_a_thin_wall():
+    # The goal is straight ahead, one push away but for the wall, which leaves gaps above/below.
+    s = scene([{"box": {"center": [0.0, 0.0], "size": [WALL, 0.3]}}], goal=(0.25, 0.05, 0.0))
+    result = plan(s, seed=1)
+    assert result.solved, result.reason
+    wall = s.obstacles[0]
+    body = [np.array(BLOCK), pusher_body(BLOCK, 3, 0.05, 0.015)]
+    for seg in result.segments:
+        n = max(2, math.ceil(seg.duration / 0.0002))
+        for t in np.linspace(0.0, seg.duration, n):  # points move <= 0.2 mm between samples
+            q = advance(seg.start, seg.twist, t)
+            assert not any(place(b, q).intersects(wall) for b in body), f"crossed the wall at {q}"
