@@ -7,6 +7,8 @@ line can print one line and exit 1. The format is documented in the README.
 from __future__ import annotations
 
 import math
+import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -19,11 +21,19 @@ from mechanics import Slider
 
 from .bodies import slider_at
 
-__all__ = ["DEFAULT_PLANNER", "SceneError", "Pusher", "PlannerOptions", "Scene", "load_scene", "parse_scene", "PLANNERS"]
+__all__ = ["DEFAULT_PLANNER", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
+           "check_seed", "check_time_limit", "load_scene", "parse_scene", "PLANNERS"]
 
 PLANNERS = ("rrt", "kpiece", "est")
 #: The planner used when neither the scene nor the caller names one (chosen by planner.bench).
 DEFAULT_PLANNER = "kpiece"
+#: Seeds are OMPL's ``std::uint_fast32_t``: 32 bits is the most every platform takes.
+MAX_SEED = 2**32 - 1
+#: One day. OMPL's deadline (now + limit) overflows for limits of some years and then ends the
+#: search at once, so a huge or infinite limit would report failure without having searched.
+MAX_TIME_LIMIT = 86400.0
+#: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
+MAX_NAME_BYTES = 200
 
 
 class SceneError(ValueError):
@@ -76,17 +86,36 @@ def load_scene(path: str | Path) -> Scene:
         If the file cannot be read or any field is missing, unknown or invalid.
     """
     path = Path(path)
+    return parse_scene(_read_yaml(path), default_name=path.stem, path=str(path))
+
+
+def _read_yaml(path: Path) -> Any:
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as err:
         raise SceneError("scene", f"cannot read {str(path)!r}: {err.strerror or err}") from None
+    except UnicodeDecodeError as err:
+        raise SceneError("scene", f"{str(path)!r} is not UTF-8 text (bad byte at offset {err.start})") from None
     try:
-        data = yaml.safe_load(text)
+        return yaml.load(text, Loader=_Loader)
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise SceneError("scene", f"malformed YAML{where}: {getattr(err, 'problem', None) or err}") from None
-    return parse_scene(data, default_name=path.stem, path=str(path))
+        problem = getattr(err, "problem", None) or " ".join(str(err).split())  # some messages span two lines
+        raise SceneError("scene", f"malformed YAML{where}: {problem}") from None
+    except RecursionError:
+        raise SceneError("scene", "malformed YAML: nested too deeply") from None
+    except ValueError as err:  # PyYAML lets Python's own limits through, e.g. on ints of over 4300 digits
+        raise SceneError("scene", f"malformed YAML: {err}") from None
+
+
+class _Loader(yaml.SafeLoader):
+    """PyYAML's safe loader that also reads ``1e-3`` as a number: YAML 1.1 wants a dot (``1.0e-3``)
+    and PyYAML would otherwise hand the scene the string ``"1e-3"``."""
+
+
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"), list("-+0123456789"))
 
 
 def _keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> dict:
@@ -102,8 +131,9 @@ def _keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str,
 
 
 def _number(value: Any, name: str, positive: bool = False) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise SceneError(name, f"must be a number, got {value!r}")
+    # Comparing (exactly, for ints) rather than math.isfinite(), which raises on ints beyond a float.
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not abs(value) <= sys.float_info.max:
+        raise SceneError(name, f"must be a finite number, got {value!r}")
     if positive and not value > 0:
         raise SceneError(name, f"must be > 0, got {value!r}")
     return float(value)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import shapely
 
 from planner import parse_scene, plan
 from planner.pushes import clearance_margin, edge_pushes, resolution
@@ -66,3 +67,33 @@ def test_planned_path_goes_around_a_thin_wall():
         for t in np.linspace(0.0, seg.duration, n):  # points move <= 0.2 mm between samples
             q = advance(seg.start, seg.twist, t)
             assert not any(place(b, q).intersects(wall) for b in body), f"crossed the wall at {q}"
+
+
+def test_clearance_matches_shapely_distance_on_random_poses():
+    # Non-convex part, a polygon and a rotated box: fcl's distances must be exact (they bound
+    # how far the body may move), so compare with shapely's, computed independently.
+    ell = [[0.0, 0.0], [0.09, 0.0], [0.09, 0.035], [0.035, 0.035], [0.035, 0.09], [0.0, 0.09]]
+    s = parse_scene({
+        "slider": {"vertices": ell},
+        "pusher": {"width": 0.05, "depth": 0.015, "mu": 0.5},
+        "obstacles": [{"box": {"center": [0.1, 0.1], "size": [0.1, 0.04], "angle": 30}},
+                      {"polygon": [[-0.2, -0.1], [-0.1, -0.15], [-0.05, 0.0], [-0.15, -0.02]]}],
+        "workspace": {"min": [-0.4, -0.4], "max": [0.4, 0.4]},
+        "start": [0.2, -0.2, 0.0], "goal": [-0.2, 0.2, 0.0]})
+    walls = shapely.box(-1, -1, 1, 1).difference(shapely.box(-0.4, -0.4, 0.4, 0.4))
+    blocked = shapely.union_all([*s.obstacles, walls])
+    rng = np.random.default_rng(7)
+    model = CollisionModel(s, s.pusher.edges)
+    checked = 0
+    for _ in range(300):
+        q = (*rng.uniform(-0.35, 0.35, 2), rng.uniform(-math.pi, math.pi))
+        edge = int(rng.choice(s.pusher.edges))
+        body = shapely.union_all([place(ell, q), place(pusher_body(ell, edge, 0.05, 0.015), q)])
+        expected = body.distance(blocked)
+        got = model.clearance(q, edge)
+        if expected > 0:
+            assert math.isclose(got, expected, rel_tol=1e-7, abs_tol=1e-9), (q, edge)
+            checked += 1
+        else:
+            assert got <= 1e-12, (q, edge)
+    assert checked > 100

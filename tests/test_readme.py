@@ -1,0 +1,51 @@
+"""The README's promises: its two opening commands, CI running the same tests, the API example."""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+README = (ROOT / "README.md").read_text()
+
+
+def opening_commands() -> list[str]:
+    block = re.search(r"```bash\n(.*?)```", README, re.S).group(1)
+    return [line.split("#")[0].strip() for line in block.strip().splitlines()]
+
+
+def test_readme_opens_with_install_and_plan_then_tests():
+    assert README.index("```bash") < 30
+    install, tests = opening_commands()
+    assert install.startswith("pip install -e . && plan scenes/")
+    assert (ROOT / install.split("plan ")[1]).is_file()
+    assert tests == "pip install -e '.[test]' && python -m pytest -q"
+
+
+def test_ci_runs_the_readme_test_command():
+    ci = (ROOT / ".ci" / "run").read_text()
+    test_command = opening_commands()[1].split("&& ")[1]
+    assert test_command in ci.splitlines()
+
+
+def test_python_api_example_runs(capsys):
+    code = re.search(r"## Python API\n\n```python\n(.*?)```", README, re.S).group(1)
+    cwd = os.getcwd()
+    os.chdir(ROOT)
+    try:
+        exec(compile(code, "README.md", "exec"), {})
+    finally:
+        os.chdir(cwd)
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "[ True  True False]"
+    assert out[-1].startswith("True ")
+
+
+def test_picture_of_a_plan(tmp_path):
+    from planner import load_scene, plan
+    from planner.picture import draw_plan
+
+    scene = load_scene(ROOT / "scenes" / "battery.yaml")
+    draw_plan(scene, plan(scene, seed=1), str(tmp_path / "battery.png"))
+    assert (tmp_path / "battery.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
