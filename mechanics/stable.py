@@ -21,7 +21,7 @@ import shapely
 from numpy.typing import ArrayLike
 
 from .slider import Slider
-from .twist import cor_to_twist, twist_to_cor
+from .twist import cor_to_twist
 
 __all__ = ["StableRegion", "stable_region", "DEFAULT_TIP_FACTOR"]
 

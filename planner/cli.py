@@ -13,8 +13,9 @@ import sys
 import time
 from pathlib import Path
 
-from .plan_file import write_atomic
-from .scene import DEFAULT_PLANNER, PLANNERS, SceneError, load_scene
+from .plan_file import Plan, write_atomic
+from .scene import (DEFAULT_PLANNER, MAX_SEED, MAX_TIME_LIMIT, PLANNERS, Scene, SceneError, check_seed,
+                    check_time_limit, load_scene)
 from .search import plan
 
 __all__ = ["main"]
@@ -32,8 +33,10 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="plan", description="Plan guaranteed-stable pushes for a YAML scene.")
     p.add_argument("scene", help="scene file (YAML)")
     p.add_argument("--planner", choices=PLANNERS, help=f"OMPL control planner (default: the scene's, else {DEFAULT_PLANNER})")
-    p.add_argument("--time-limit", type=float, metavar="S", help="planning time limit in seconds")
-    p.add_argument("--seed", type=int, metavar="N", help="random seed (>= 1); the same seed gives the same plan")
+    p.add_argument("--time-limit", type=float, metavar="S",
+                   help=f"planning time limit in seconds (at most {MAX_TIME_LIMIT:g})")
+    p.add_argument("--seed", type=int, metavar="N",
+                   help=f"random seed (1..{MAX_SEED}); the same seed gives the same plan")
     p.add_argument("--out", metavar="DIR", help="output folder (default: logs/<name>-<timestamp>/)")
     return p
 
@@ -49,25 +52,19 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    if args.time_limit is not None and not args.time_limit > 0:
-        raise SceneError("--time-limit", f"must be > 0, got {args.time_limit}")
-    if args.seed is not None and args.seed < 1:
-        raise SceneError("--seed", f"must be a positive integer, got {args.seed}")
+    limit = None if args.time_limit is None else check_time_limit(args.time_limit, "--time-limit")
+    seed = None if args.seed is None else check_seed(args.seed, "--seed")
     scene = load_scene(args.scene)
     name = args.planner or scene.planner.name
-    limit = args.time_limit or scene.planner.time_limit
-    seed = args.seed or scene.planner.seed
-    print(f"planning {scene.name} with {name} (seed {seed}, limit {limit:g} s) ...", file=sys.stderr, flush=True)
-    result = plan(scene, seed=seed, time_limit=limit, planner=name)
+    limit = limit or scene.planner.time_limit
+    seed = seed or scene.planner.seed
     out = Path(args.out) if args.out else Path("logs") / f"{scene.name}-{time.strftime('%Y%m%d-%H%M%S')}"
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        raise SceneError("--out", f"cannot create {str(out)!r}: {err.strerror or err}") from None
-    write_atomic(out / f"{scene.name}.json", result.to_json())
-    from .recording import write_recording  # rerun takes half a second to import
-
-    write_recording(out / f"{scene.name}.rrd", scene, result)
+    if out.exists() and not out.is_dir():  # found now, not after the search
+        raise SceneError("--out", f"{str(out)!r} exists and is not a folder")
+    if sys.stderr.isatty():  # a search can take seconds; scripts get just the one line of outcome
+        print(f"planning {scene.name} with {name} (seed {seed}, limit {limit:g} s) ...", file=sys.stderr, flush=True)
+    result = plan(scene, seed=seed, time_limit=limit, planner=name)
+    _write_outputs(out, scene, result)
     if not result.solved:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
         return 2
@@ -76,6 +73,18 @@ def _run(args: argparse.Namespace) -> int:
         f"planning time {result.planning_time_s:.2f} s -> {out}/{scene.name}.json, {scene.name}.rrd"
     )
     return 0
+
+
+def _write_outputs(out: Path, scene: Scene, result: Plan) -> None:
+    """Write the plan JSON and the recording into ``out``, creating it if need be."""
+    from .recording import write_recording  # rerun takes half a second to import
+
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        write_atomic(out / f"{scene.name}.json", result.to_json())
+        write_recording(out / f"{scene.name}.rrd", scene, result)
+    except OSError as err:
+        raise SceneError("--out", f"cannot write to {str(out)!r}: {err.strerror or err}") from None
 
 
 if __name__ == "__main__":

@@ -33,7 +33,7 @@ MAX_SEED = 2**32 - 1
 #: search at once, so a huge or infinite limit would report failure without having searched.
 MAX_TIME_LIMIT = 86400.0
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
-MAX_NAME_BYTES = 200
+_MAX_NAME_BYTES = 200
 
 
 class SceneError(ValueError):
@@ -160,13 +160,17 @@ def _points(value: Any, name: str) -> np.ndarray:
 
 
 def _polygon(value: Any, name: str) -> shapely.Polygon:
-    pts = _points(value, name)
+    return _simple_polygon(_points(value, name), name)
+
+
+def _simple_polygon(pts: np.ndarray, name: str) -> shapely.Polygon:
+    # Area first: the ring of collinear points doubles back on itself, and "self-intersecting"
+    # would send the reader looking for a crossing. The threshold is the one Slider uses.
+    if shapely.MultiPoint(pts).convex_hull.area <= 1e-12 * max(1.0, float(np.ptp(pts)) ** 2):
+        raise SceneError(name, "polygon has zero area (its vertices are collinear or too close together)")
     if not shapely.LinearRing(pts).is_simple:
         raise SceneError(name, "polygon is self-intersecting")
-    poly = shapely.Polygon(pts)
-    if not poly.area > 0 or not poly.is_valid:
-        raise SceneError(name, "polygon has zero area")
-    return poly
+    return shapely.Polygon(pts)
 
 
 def _obstacle(value: Any, name: str) -> shapely.Polygon:
@@ -188,14 +192,22 @@ def _obstacle(value: Any, name: str) -> shapely.Polygon:
 def _slider(value: Any) -> Slider:
     spec = _keys(value, "slider", ("vertices",), ("cf",))
     vertices = _points(spec["vertices"], "slider.vertices")
+    _simple_polygon(vertices, "slider.vertices")
+    # A repeated vertex makes an edge of no length, with no normal to push along; shapely accepts it.
+    repeated = np.flatnonzero(np.all(vertices == np.roll(vertices, -1, axis=0), axis=1))
+    if len(repeated):
+        k = int(repeated[0])
+        raise SceneError("slider.vertices", f"vertices {k} and {(k + 1) % len(vertices)} coincide, so edge {k} "
+                                            "has no length (do not repeat the first vertex at the end)")
     try:
         Slider(vertices)
     except ValueError as err:
         raise SceneError("slider.vertices", str(err)) from None
     if "cf" not in spec:
         return Slider(vertices)
+    cf = _vector(spec["cf"], "slider.cf", 2)  # outside the try: a SceneError is a ValueError too
     try:
-        return Slider(vertices, _vector(spec["cf"], "slider.cf", 2))
+        return Slider(vertices, cf)
     except ValueError as err:
         raise SceneError("slider.cf", str(err)) from None
 
@@ -239,12 +251,10 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     """Validate a scene given as the parsed YAML mapping (see :func:`load_scene`)."""
     spec = _keys(data, "scene", ("slider", "pusher", "workspace", "start", "goal"),
                  ("name", "obstacles", "tolerance", "planner"))
-    name = spec.get("name", default_name)
-    if not isinstance(name, str) or not name or any(c in name for c in "/\\"):
-        raise SceneError("name", f"must be a plain non-empty string, got {name!r}")
+    name = _name(spec.get("name", default_name))
     slider = _slider(spec["slider"])
     pusher = _pusher(spec["pusher"], slider)
-    obstacles_spec = spec.get("obstacles") or []
+    obstacles_spec = [] if spec.get("obstacles") is None else spec["obstacles"]  # None: a bare "obstacles:"
     if not isinstance(obstacles_spec, list):
         raise SceneError("obstacles", "must be a list")
     obstacles = tuple(_obstacle(o, f"obstacles[{k}]") for k, o in enumerate(obstacles_spec))
@@ -261,10 +271,19 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     opts = _keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed"))
     planner = PlannerOptions(
         name=_planner_name(opts.get("name", DEFAULT_PLANNER), "planner.name"),
-        time_limit=_number(opts.get("time_limit", 10.0), "planner.time_limit", positive=True),
-        seed=_seed(opts.get("seed", 1), "planner.seed"),
+        time_limit=check_time_limit(opts.get("time_limit", 10.0), "planner.time_limit"),
+        seed=check_seed(opts.get("seed", 1), "planner.seed"),
     )
     return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path)
+
+
+def _name(value: Any) -> str:
+    # The name names the output files, so it must make a plain file name.
+    if not isinstance(value, str) or not value or not value.isprintable() or any(c in value for c in "/\\"):
+        raise SceneError("name", f"must be a plain non-empty string, got {value!r}")
+    if len(value.encode()) > _MAX_NAME_BYTES:
+        raise SceneError("name", f"must be at most {_MAX_NAME_BYTES} bytes long, got {len(value.encode())}")
+    return value
 
 
 def _planner_name(value: Any, name: str) -> str:
@@ -273,8 +292,17 @@ def _planner_name(value: Any, name: str) -> str:
     return value
 
 
-def _seed(value: Any, name: str) -> int:
+def check_seed(value: Any, name: str) -> int:
+    """``value`` as a planner seed; else a :class:`SceneError` naming ``name`` (a field or a flag)."""
     seed = _integer(value, name)
-    if seed < 1:
-        raise SceneError(name, f"must be a positive integer, got {seed}")
+    if not 1 <= seed <= MAX_SEED:
+        raise SceneError(name, f"must be an integer in 1..{MAX_SEED}, got {seed}")
     return seed
+
+
+def check_time_limit(value: Any, name: str) -> float:
+    """``value`` as a planning time limit in seconds; else a :class:`SceneError` naming ``name``."""
+    limit = _number(value, name, positive=True)
+    if limit > MAX_TIME_LIMIT:
+        raise SceneError(name, f"must be at most {MAX_TIME_LIMIT:g} s, got {value!r}")
+    return limit

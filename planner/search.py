@@ -7,7 +7,8 @@ The OMPL objects are kept separate, as OMPL intends, and none of them knows abou
   :class:`~mechanics.StableSteering`, so every control is a guaranteed-stable push, and applies it
   exactly (SE(2) exponential, no integration);
 * validity: :class:`~planner.validity.CollisionModel` with its clearance rule;
-* goal: the pose tolerance, or one stable collision-free push away (:func:`~planner.one_step.connect`).
+* goal: the pose tolerance, or one or two stable collision-free pushes away
+  (:class:`~planner.preimage.GoalPreimage`).
 
 Every allowed edge gets a start state, so the trees of all edges grow at once and a plan uses
 the one edge whose tree reaches the goal first; no time is split between edges.
@@ -28,6 +29,7 @@ from mechanics import exp_twist, wrap_angle
 
 from .one_step import connect
 from .plan_file import Plan, Segment
+from .preimage import GoalPreimage
 from .pushes import EdgePush, clearance_margin, edge_pushes, resolution
 from .scene import Scene, SceneError
 from .validity import CollisionModel
@@ -69,25 +71,24 @@ class _PoseProjection(ob.ProjectionEvaluator):
         out[0], out[1], out[2] = p.getX(), p.getY(), p.getYaw() * self.radius
 
 
+def _within_tolerance(scene: Scene, pose: np.ndarray) -> bool:
+    g = scene.goal
+    return (math.hypot(pose[0] - g[0], pose[1] - g[1]) <= scene.tolerance_position
+            and abs(float(wrap_angle(pose[2] - g[2]))) <= scene.tolerance_angle)
+
+
 class _PushGoal(ob.GoalSampleableRegion):
-    """Within the scene tolerance of the goal, or one stable collision-free push away from it."""
+    """Within the scene tolerance of the goal, or in its preimage under one or two stable pushes."""
 
-    def __init__(self, si, scene: Scene, pushes: list[EdgePush], model: CollisionModel, margin: float):
+    def __init__(self, si, scene: Scene, preimage: GoalPreimage):
         super().__init__(si)
-        self.scene, self.pushes, self.model, self.margin = scene, pushes, model, margin
+        self.scene, self.preimage = scene, preimage
         self.setThreshold(1e-9)  # OMPL accepts distances strictly below the threshold
-
-    def within_tolerance(self, pose: np.ndarray) -> bool:
-        g = self.scene.goal
-        return (math.hypot(pose[0] - g[0], pose[1] - g[1]) <= self.scene.tolerance_position
-                and abs(float(wrap_angle(pose[2] - g[2]))) <= self.scene.tolerance_angle)
 
     def distanceGoal(self, state) -> float:
         p = state[0]
         pose = np.array([p.getX(), p.getY(), p.getYaw()])
-        if self.within_tolerance(pose):
-            return 0.0
-        if isinstance(connect(pose, self.scene.goal, self.pushes[state[1].value], self.model, self.margin), Segment):
+        if _within_tolerance(self.scene, pose) or self.preimage.connect(pose, state[1].value) is not None:
             return 0.0
         g = self.scene.goal
         return math.hypot(pose[0] - g[0], pose[1] - g[1]) + self.scene.slider.radius * abs(
@@ -126,7 +127,7 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     result = Plan(scene.path, False, name, seed, 0.0, scene.start.copy(), scene.goal.copy())
 
     def done(segments: list[Segment], reason: str = "", tree=None) -> Plan:
-        result.solved = bool(segments) or reason == ""
+        result.solved = not reason
         result.segments = segments
         result.reason = reason
         if tree is not None:
@@ -137,12 +138,13 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     starts = [k for k, p in enumerate(pushes) if model.clearance(scene.start, p.edge) > step / 2]
     if not starts:
         raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
-    for k in starts:
-        first = connect(scene.start, scene.goal, pushes[k], model, margin)
-        if isinstance(first, Segment):
-            return done([first])
-        if first == "the start is the goal":
-            return done([])
+    if _within_tolerance(scene, scene.start):
+        return done([])
+    preimage = GoalPreimage(scene.goal, pushes, model, margin, scene.slider.radius)
+    for k in starts:  # one or two pushes may do, as in the paper's one-step planning
+        direct = preimage.connect(scene.start, k)
+        if direct is not None:
+            return done(_shortcut(direct, pushes[k], model, margin))
     _seed_ompl(seed)
     space, si = _spaces(scene, pushes, model, step)
     ss = oc.SimpleSetup(si)
@@ -152,14 +154,13 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
         s[0].setYaw(float(wrap_angle(scene.start[2])))
         s[1].value = k
         ss.addStartState(s)
-    goal_test = _PushGoal(si, scene, pushes, model, margin)
-    ss.setGoal(goal_test)
+    ss.setGoal(_PushGoal(si, scene, preimage))
     ss.setPlanner(_PLANNERS[name](si))
     ss.solve(float(time_limit))
     tree = _tree(ss, si)
     if not ss.haveExactSolutionPath():
         return done([], f"no plan found within the time limit of {time_limit:g} s", tree)
-    segments = _segments(ss.getSolutionPath(), scene, pushes, model, margin, goal_test)
+    segments = _segments(ss.getSolutionPath(), scene, pushes, model, margin, preimage)
     if segments is None:
         return done([], "the final push failed its re-check after rounding", tree)
     return done(segments, tree=tree)
@@ -218,7 +219,7 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
 
 
 def _segments(path, scene: Scene, pushes: list[EdgePush], model: CollisionModel, margin: float,
-              goal: _PushGoal) -> list[Segment] | None:
+              preimage: GoalPreimage) -> list[Segment] | None:
     """Segments of an OMPL control path (copied out at once: its states live in C++), merged where
     consecutive controls are equal, plus the final push onto the goal if the path stops short."""
     states = [(s[0].getX(), s[0].getY(), s[0].getYaw(), s[1].value) for s in path.getStates()]
@@ -240,12 +241,12 @@ def _segments(path, scene: Scene, pushes: list[EdgePush], model: CollisionModel,
         end[2] = wrap_angle(end[2])
         segments.append(Segment(push.edge, push.region.contact, twist, float(d), pose, end))
         pose = end
-    if not goal.within_tolerance(pose):
+    if not _within_tolerance(scene, pose):
         # The goal test accepted the tree's last state; the re-composed pose differs by rounding only.
-        last = connect(pose, scene.goal, push, model, margin)
-        if not isinstance(last, Segment):
+        last = preimage.connect(pose, k)
+        if last is None:
             return None
-        segments.append(last)
+        segments += last
     return _shortcut(segments, push, model, margin)
 
 
