@@ -2,9 +2,8 @@
 
 The displacement from start to goal is one body twist, ``COR_total`` (turning by the smaller
 angle). If that twist lies in an edge's stable region and the motion is collision-free, pushing
-about ``COR_total`` reaches the goal exactly. The planner also uses this as its goal test: every
-state from which the goal is one stable push away is in the goal's preimage (Lynch & Mason 1996,
-§4.4's suggested refinement), so searches stop as soon as they reach it.
+about ``COR_total`` reaches the goal exactly. The planner's goal region is built on it
+(:mod:`planner.preimage`).
 """
 
 from __future__ import annotations

@@ -1,11 +1,12 @@
 """The goal's preimage under one or two constant stable pushes: the planner's goal region.
 
-Lynch & Mason (1996, §4.4) suggest taking as goal region the set of poses from which one constant
-stable push reaches the goal exactly (the paper's one-step planning from every tree state). This
-module extends it by one push, which makes the region much larger where the goal must be
-approached at a particular heading: a *waypoint* ``m = goal * exp(-W tau)`` is one push ``W`` (for
-``tau`` seconds) before the goal; a state ``s`` is in the two-push preimage if ``COR_total(s -> m)``
-is a stable push for some waypoint and both pushes are collision-free.
+Among the variations of their planner, Lynch & Mason (1996) suggest taking as goal region the
+set of poses from which one constant stable push reaches the goal exactly (Lynch 1992's one-step
+planning, from every tree state). This module extends it by one push, which makes the region
+much larger where the goal must be approached at a particular heading: a *waypoint*
+``m = goal * exp(-W tau)`` is one push ``W`` (for ``tau`` seconds) before the goal; a state ``s``
+is in the two-push preimage if ``COR_total(s -> m)`` is a stable push for some waypoint and both
+pushes are collision-free.
 
 Waypoints are a fixed set per edge (a grid of controls times durations growing geometrically),
 screened with vectorised ``log_pose`` and ``contains``; collision checks run only for the few
