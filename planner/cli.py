@@ -49,6 +49,9 @@ def main(argv: list[str] | None = None) -> int:
     except SceneError as err:
         print(f"plan: error: {err}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        print("plan: interrupted", file=sys.stderr)
+        return 130
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -58,7 +61,7 @@ def _run(args: argparse.Namespace) -> int:
     name = args.planner or scene.planner.name
     limit = limit or scene.planner.time_limit
     seed = seed or scene.planner.seed
-    out = Path(args.out) if args.out else Path("logs") / f"{scene.name}-{time.strftime('%Y%m%d-%H%M%S')}"
+    out = Path(args.out) if args.out else _fresh_folder(Path("logs") / f"{scene.name}-{time.strftime('%Y%m%d-%H%M%S')}")
     if out.exists() and not out.is_dir():  # found now, not after the search
         raise SceneError("--out", f"{str(out)!r} exists and is not a folder")
     if sys.stderr.isatty():  # a search can take seconds; scripts get just the one line of outcome
@@ -73,6 +76,15 @@ def _run(args: argparse.Namespace) -> int:
         f"planning time {result.planning_time_s:.2f} s -> {out}/{scene.name}.json, {scene.name}.rrd"
     )
     return 0
+
+
+def _fresh_folder(base: Path) -> Path:
+    """``base``, or ``base-2``, ``base-3``... if runs started in the same second took it."""
+    out, k = base, 1
+    while out.exists():
+        k += 1
+        out = base.with_name(f"{base.name}-{k}")
+    return out
 
 
 def _write_outputs(out: Path, scene: Scene, result: Plan) -> None:

@@ -32,8 +32,6 @@ default blueprint shows ``/world`` in a 2-D view bounded by the workspace, above
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -45,7 +43,7 @@ from numpy.typing import ArrayLike
 from mechanics import exp_twist, twist_to_cor
 
 from .bodies import pusher_polygon
-from .plan_file import Plan
+from .plan_file import Plan, atomic_path
 from .pushes import edge_pushes
 from .scene import Scene
 
@@ -212,28 +210,19 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan) -> None:
     OSError
         If the temporary file cannot be created or renamed.
     """
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".rrd.tmp")
-    os.close(fd)
-    try:
-        xmin, ymin, xmax, ymax = scene.workspace
-        blueprint = rrb.Blueprint(rrb.Vertical(
-            rrb.Spatial2DView(origin="/world", name=scene.name,
-                              visual_bounds=rrb.VisualBounds2D(x_range=[xmin, xmax], y_range=[ymin, ymax])),
-            rrb.TextLogView(origin="/log", name="summary"),
-            row_shares=[6, 1]))
+    xmin, ymin, xmax, ymax = scene.workspace
+    blueprint = rrb.Blueprint(rrb.Vertical(
+        rrb.Spatial2DView(origin="/world", name=scene.name,
+                          visual_bounds=rrb.VisualBounds2D(x_range=[xmin, xmax], y_range=[ymin, ymax])),
+        rrb.TextLogView(origin="/log", name="summary"),
+        row_shares=[6, 1]))
+    with atomic_path(path) as tmp:
         rec = rr.RecordingStream("stablepush", recording_id=f"{scene.name}-{plan.planner}-seed{plan.seed}")
         rec.set_log_time_enabled(False)
-        rec.save(tmp, default_blueprint=blueprint)
+        rec.save(str(tmp), default_blueprint=blueprint)
         try:
             _log_static(rec, scene, plan)
             if plan.segments:
                 _log_motion(rec, scene, plan)
         finally:
             rec.disconnect()  # flushes and writes the footer
-        with open(tmp, "rb") as f:
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise

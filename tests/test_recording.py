@@ -128,10 +128,10 @@ def turn(tmp_path_factory):
 
 
 def test_the_file_is_complete_and_has_every_entity(straight):
-    _, _, path = straight
+    _, plan, path = straight
     verify(path)
     assert entities(path) == STATIC | ANIMATED
-    assert RrdReader(str(path)).recordings()[0].recording_id == "straight-kpiece-seed1"
+    assert RrdReader(str(path)).recordings()[0].recording_id == f"straight-{plan.planner}-seed1"
 
 
 def test_the_slider_moves_from_the_start_to_the_plans_final_pose(straight, turn):
