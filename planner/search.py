@@ -83,6 +83,7 @@ class _PushGoal(ob.GoalSampleableRegion):
     def __init__(self, si, scene: Scene, preimage: GoalPreimage):
         super().__init__(si)
         self.scene, self.preimage = scene, preimage
+        self._samples = 0
         self.setThreshold(1e-9)  # OMPL accepts distances strictly below the threshold
 
     def distanceGoal(self, state) -> float:
@@ -96,8 +97,10 @@ class _PushGoal(ob.GoalSampleableRegion):
 
     def sampleGoal(self, state) -> None:
         state[0].setXY(float(self.scene.goal[0]), float(self.scene.goal[1]))
-        state[0].setYaw(float(self.scene.goal[2]))
-        state[1].value = 0
+        state[0].setYaw(float(wrap_angle(self.scene.goal[2])))
+        # Goal samples take turns among the edges, so goal bias pulls every edge's tree.
+        self._samples += 1
+        state[1].value = self._samples % len(self.preimage.pushes)
 
     def maxSampleCount(self) -> int:
         return 1
@@ -175,7 +178,11 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
     space = ob.CompoundStateSpace()
     space.addSubspace(se2, 1.0)
     # OMPL needs a discrete range of positive extent; with one edge, index 1 exists but is invalid.
-    space.addSubspace(ob.DiscreteStateSpace(0, max(1, len(pushes) - 1)), 0.0)
+    # The index weighs as much as crossing the workspace: nearest-neighbour planners (RRT) then
+    # extend each edge's tree towards samples of that edge, instead of only the first edge's tree
+    # (all start states share one pose, so ties would always go to edge 0).
+    span = math.hypot(xmax - xmin, ymax - ymin)
+    space.addSubspace(ob.DiscreteStateSpace(0, max(1, len(pushes) - 1)), span)
     space.lock()
     space.registerDefaultProjection(_PoseProjection(space, scene.slider.radius))
     controls = oc.RealVectorControlSpace(space, 2)
