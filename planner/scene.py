@@ -26,7 +26,7 @@ __all__ = ["DEFAULT_PLANNER", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pushe
 
 PLANNERS = ("rrt", "kpiece", "est")
 #: The planner used when neither the scene nor the caller names one (chosen by planner.bench).
-DEFAULT_PLANNER = "est"
+DEFAULT_PLANNER = "rrt"
 #: Seeds are OMPL's ``std::uint_fast32_t``: 32 bits is the most every platform takes.
 MAX_SEED = 2**32 - 1
 #: One day. OMPL's deadline (now + limit) overflows for limits of some years and then ends the
