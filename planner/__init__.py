@@ -8,8 +8,9 @@ pusher geometry), :mod:`.validity` (fcl collision rule), :mod:`.pushes` (stable 
 """
 
 from .one_step import OneStep, one_step
-from .plan_file import Plan, Segment
+from .plan_file import Plan, Segment, load_plan
 from .scene import DEFAULT_PLANNER, Scene, SceneError, load_scene, parse_scene
 from .search import plan
 
-__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Scene", "SceneError", "Segment", "load_scene", "one_step", "parse_scene", "plan"]
+__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Scene", "SceneError", "Segment", "load_plan", "load_scene", "one_step",
+           "parse_scene", "plan"]

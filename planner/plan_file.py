@@ -14,12 +14,15 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from mechanics import point_velocity
 
-__all__ = ["FORMAT", "Segment", "Plan", "atomic_path", "write_atomic"]
+from .fields import SceneError, integer, keys, number, vector
+
+__all__ = ["FORMAT", "Segment", "Plan", "atomic_path", "load_plan", "write_atomic"]
 
 FORMAT = "stablepush.plan/1"
 
@@ -49,6 +52,27 @@ class Segment:
             "start": _floats(self.start),
             "end": _floats(self.end),
         }
+
+    @classmethod
+    def from_dict(cls, data: Any, name: str) -> "Segment":
+        """Read a segment of a plan file, checking every field (errors name ``name``.field)."""
+        spec = keys(data, name, ("kind", "edge", "contact", "twist", "duration", "start", "end"))
+        if spec["kind"] != "push":
+            raise SceneError(f"{name}.kind", f"must be 'push', got {spec['kind']!r}")
+        contact = spec["contact"]
+        if not isinstance(contact, list) or len(contact) != 2:
+            raise SceneError(f"{name}.contact", "must be two [x, y] points")
+        duration = number(spec["duration"], f"{name}.duration")
+        if duration < 0:
+            raise SceneError(f"{name}.duration", f"must be >= 0, got {duration}")
+        return cls(
+            edge=integer(spec["edge"], f"{name}.edge"),
+            contact=np.array([vector(p, f"{name}.contact[{i}]", 2) for i, p in enumerate(contact)]),
+            twist=vector(spec["twist"], f"{name}.twist", 3),
+            duration=duration,
+            start=vector(spec["start"], f"{name}.start", 3),
+            end=vector(spec["end"], f"{name}.end", 3),
+        )
 
     def cf_path_length(self, cf: np.ndarray) -> float:
         """Distance the centre of friction travels: its speed is constant under a constant twist."""
@@ -98,6 +122,49 @@ class Plan:
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=1)
+
+    @classmethod
+    def from_dict(cls, data: Any) -> "Plan":
+        """A plan from its JSON form (``stablepush.plan/1``), every field checked."""
+        spec = keys(data, "plan", ("format", "scene", "solved", "planner", "seed", "planning_time_s", "start",
+                                   "goal", "final", "segments"))
+        if spec["format"] != FORMAT:
+            raise SceneError("plan.format", f"must be {FORMAT!r}, got {spec['format']!r}")
+        if not isinstance(spec["solved"], bool):
+            raise SceneError("plan.solved", f"must be true or false, got {spec['solved']!r}")
+        if not isinstance(spec["segments"], list):
+            raise SceneError("plan.segments", "must be a list")
+        plan = cls(
+            scene=spec["scene"] if isinstance(spec["scene"], str) else None,
+            solved=spec["solved"],
+            planner=str(spec["planner"]),
+            seed=integer(spec["seed"], "plan.seed"),
+            planning_time_s=number(spec["planning_time_s"], "plan.planning_time_s"),
+            start=vector(spec["start"], "plan.start", 3),
+            goal=vector(spec["goal"], "plan.goal", 3),
+            segments=[Segment.from_dict(s, f"plan.segments[{i}]") for i, s in enumerate(spec["segments"])],
+        )
+        final = vector(spec["final"], "plan.final", 3)
+        if not np.allclose(final, plan.final, atol=1e-9):
+            raise SceneError("plan.final", "is not the end of the last segment")
+        return plan
+
+
+def load_plan(path: str | Path) -> Plan:
+    """Read a plan file written by ``plan`` (or by hand, or another tool), checking every field.
+
+    Raises
+    ------
+    SceneError
+        Naming the field at fault (``plan.segments[2].twist: ...``) or the file if unreadable.
+    """
+    try:
+        data = json.loads(Path(path).read_text())
+    except OSError as err:
+        raise SceneError("plan", f"cannot read {str(path)!r}: {err.strerror or err}") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise SceneError("plan", f"{str(path)!r} is not valid JSON: {err}") from None
+    return Plan.from_dict(data)
 
 
 @contextmanager

@@ -1,6 +1,6 @@
 """Scene files: the part, the pusher, the table and the task, read from YAML and validated.
 
-Every problem is reported as a :class:`SceneError` naming the offending field, so the command
+Every problem is reported as a :class:`~planner.fields.SceneError` naming the offending field, so the command
 line can print one line and exit 1. The format is documented in the README.
 """
 
@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import math
 import re
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,6 +19,7 @@ import yaml
 from mechanics import Slider
 
 from .bodies import slider_at
+from .fields import SceneError, integer, keys, number, vector
 
 __all__ = ["DEFAULT_PLANNER", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
            "check_seed", "check_time_limit", "load_scene", "parse_scene", "PLANNERS"]
@@ -34,15 +34,6 @@ MAX_SEED = 2**32 - 1
 MAX_TIME_LIMIT = 86400.0
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
 _MAX_NAME_BYTES = 200
-
-
-class SceneError(ValueError):
-    """Bad input, with the dotted name of the field at fault (``str()`` is ``"field: problem"``)."""
-
-    def __init__(self, field: str, problem: str):
-        super().__init__(f"{field}: {problem}")
-        self.field = field
-        self.problem = problem
 
 
 @dataclass(frozen=True)
@@ -118,45 +109,12 @@ _Loader.add_implicit_resolver(
     "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"), list("-+0123456789"))
 
 
-def _keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> dict:
-    if not isinstance(value, dict):
-        raise SceneError(name, f"must be a mapping with keys {', '.join(required + optional)}")
-    for key in value:
-        if key not in required + optional:
-            raise SceneError(f"{name}.{key}" if name != "scene" else str(key), "unknown key")
-    for key in required:
-        if key not in value:
-            raise SceneError(f"{name}.{key}" if name != "scene" else key, "missing")
-    return value
-
-
-def _number(value: Any, name: str, positive: bool = False) -> float:
-    # Comparing (exactly, for ints) rather than math.isfinite(), which raises on ints beyond a float.
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not abs(value) <= sys.float_info.max:
-        raise SceneError(name, f"must be a finite number, got {value!r}")
-    if positive and not value > 0:
-        raise SceneError(name, f"must be > 0, got {value!r}")
-    return float(value)
-
-
-def _integer(value: Any, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise SceneError(name, f"must be an integer, got {value!r}")
-    return value
-
-
-def _vector(value: Any, name: str, size: int) -> np.ndarray:
-    if not isinstance(value, (list, tuple)) or len(value) != size:
-        raise SceneError(name, f"must be a list of {size} numbers, got {value!r}")
-    return np.array([_number(v, f"{name}[{i}]") for i, v in enumerate(value)])
-
-
 def _points(value: Any, name: str) -> np.ndarray:
     if not isinstance(value, (list, tuple)):
         raise SceneError(name, "must be a list of [x, y] points")
     if len(value) < 3:
         raise SceneError(name, f"needs at least 3 vertices, got {len(value)}")
-    return np.array([_vector(p, f"{name}[{i}]", 2) for i, p in enumerate(value)])
+    return np.array([vector(p, f"{name}[{i}]", 2) for i, p in enumerate(value)])
 
 
 def _polygon(value: Any, name: str) -> shapely.Polygon:
@@ -178,19 +136,19 @@ def _obstacle(value: Any, name: str) -> shapely.Polygon:
         raise SceneError(name, "must be {polygon: [[x, y], ...]} or {box: {center, size, angle}}")
     if "polygon" in value:
         return _polygon(value["polygon"], f"{name}.polygon")
-    box = _keys(value["box"], f"{name}.box", ("center", "size"), ("angle",))
-    cx, cy = _vector(box["center"], f"{name}.box.center", 2)
-    w, h = _vector(box["size"], f"{name}.box.size", 2)
+    box = keys(value["box"], f"{name}.box", ("center", "size"), ("angle",))
+    cx, cy = vector(box["center"], f"{name}.box.center", 2)
+    w, h = vector(box["size"], f"{name}.box.size", 2)
     if not (w > 0 and h > 0):
         raise SceneError(f"{name}.box.size", f"must be positive, got {[w, h]}")
-    angle = math.radians(_number(box.get("angle", 0.0), f"{name}.box.angle"))
+    angle = math.radians(number(box.get("angle", 0.0), f"{name}.box.angle"))
     corners = np.array([[-w, -h], [w, -h], [w, h], [-w, h]]) / 2
     rot = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
     return shapely.Polygon(corners @ rot.T + [cx, cy])
 
 
 def _slider(value: Any) -> Slider:
-    spec = _keys(value, "slider", ("vertices",), ("cf",))
+    spec = keys(value, "slider", ("vertices",), ("cf",))
     vertices = _points(spec["vertices"], "slider.vertices")
     _simple_polygon(vertices, "slider.vertices")
     # A repeated vertex makes an edge of no length, with no normal to push along; shapely accepts it.
@@ -205,7 +163,7 @@ def _slider(value: Any) -> Slider:
         raise SceneError("slider.vertices", str(err)) from None
     if "cf" not in spec:
         return Slider(vertices)
-    cf = _vector(spec["cf"], "slider.cf", 2)  # outside the try: a SceneError is a ValueError too
+    cf = vector(spec["cf"], "slider.cf", 2)  # outside the try: a SceneError is a ValueError too
     try:
         return Slider(vertices, cf)
     except ValueError as err:
@@ -213,10 +171,10 @@ def _slider(value: Any) -> Slider:
 
 
 def _pusher(value: Any, slider: Slider) -> Pusher:
-    spec = _keys(value, "pusher", ("width", "depth", "mu"), ("edges",))
-    width = _number(spec["width"], "pusher.width", positive=True)
-    depth = _number(spec["depth"], "pusher.depth", positive=True)
-    mu = _number(spec["mu"], "pusher.mu", positive=True)
+    spec = keys(value, "pusher", ("width", "depth", "mu"), ("edges",))
+    width = number(spec["width"], "pusher.width", positive=True)
+    depth = number(spec["depth"], "pusher.depth", positive=True)
+    mu = number(spec["mu"], "pusher.mu", positive=True)
     if "edges" not in spec:
         return Pusher(width, depth, mu, slider.pushable_edges)
     listed = spec["edges"]
@@ -224,7 +182,7 @@ def _pusher(value: Any, slider: Slider) -> Pusher:
         raise SceneError("pusher.edges", "must be a non-empty list of edge indices")
     edges = []
     for i, e in enumerate(listed):
-        e = _integer(e, f"pusher.edges[{i}]")
+        e = integer(e, f"pusher.edges[{i}]")
         if not 0 <= e < slider.n:
             raise SceneError("pusher.edges", f"edge {e} does not exist (the part has edges 0..{slider.n - 1})")
         if not slider.is_pushable(e):
@@ -236,7 +194,7 @@ def _pusher(value: Any, slider: Slider) -> Pusher:
 
 
 def _pose(value: Any, name: str, slider: Slider, obstacles, workspace) -> np.ndarray:
-    x, y, theta = _vector(value, name, 3)
+    x, y, theta = vector(value, name, 3)
     pose = np.array([x, y, math.radians(theta)])
     body = slider_at(slider.polygon, pose)
     if not shapely.box(*workspace).contains(body):
@@ -249,7 +207,7 @@ def _pose(value: Any, name: str, slider: Slider, obstacles, workspace) -> np.nda
 
 def parse_scene(data: Any, default_name: str = "scene", path: str | None = None) -> Scene:
     """Validate a scene given as the parsed YAML mapping (see :func:`load_scene`)."""
-    spec = _keys(data, "scene", ("slider", "pusher", "workspace", "start", "goal"),
+    spec = keys(data, "scene", ("slider", "pusher", "workspace", "start", "goal"),
                  ("name", "obstacles", "tolerance", "planner"))
     name = _name(spec.get("name", default_name))
     slider = _slider(spec["slider"])
@@ -258,17 +216,17 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     if not isinstance(obstacles_spec, list):
         raise SceneError("obstacles", "must be a list")
     obstacles = tuple(_obstacle(o, f"obstacles[{k}]") for k, o in enumerate(obstacles_spec))
-    ws = _keys(spec["workspace"], "workspace", ("min", "max"))
-    lo, hi = _vector(ws["min"], "workspace.min", 2), _vector(ws["max"], "workspace.max", 2)
+    ws = keys(spec["workspace"], "workspace", ("min", "max"))
+    lo, hi = vector(ws["min"], "workspace.min", 2), vector(ws["max"], "workspace.max", 2)
     if not np.all(hi > lo):
         raise SceneError("workspace", f"is empty or inverted: max {hi.tolist()} must exceed min {lo.tolist()}")
     workspace = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
     start = _pose(spec["start"], "start", slider, obstacles, workspace)
     goal = _pose(spec["goal"], "goal", slider, obstacles, workspace)
-    tol = _keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
-    tol_pos = _number(tol.get("position", 0.01), "tolerance.position", positive=True)
-    tol_ang = math.radians(_number(tol.get("angle", 2.0), "tolerance.angle", positive=True))
-    opts = _keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed"))
+    tol = keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
+    tol_pos = number(tol.get("position", 0.01), "tolerance.position", positive=True)
+    tol_ang = math.radians(number(tol.get("angle", 2.0), "tolerance.angle", positive=True))
+    opts = keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed"))
     planner = PlannerOptions(
         name=_planner_name(opts.get("name", DEFAULT_PLANNER), "planner.name"),
         time_limit=check_time_limit(opts.get("time_limit", 10.0), "planner.time_limit"),
@@ -294,7 +252,7 @@ def _planner_name(value: Any, name: str) -> str:
 
 def check_seed(value: Any, name: str) -> int:
     """``value`` as a planner seed; else a :class:`SceneError` naming ``name`` (a field or a flag)."""
-    seed = _integer(value, name)
+    seed = integer(value, name)
     if not 1 <= seed <= MAX_SEED:
         raise SceneError(name, f"must be an integer in 1..{MAX_SEED}, got {seed}")
     return seed
@@ -302,7 +260,7 @@ def check_seed(value: Any, name: str) -> int:
 
 def check_time_limit(value: Any, name: str) -> float:
     """``value`` as a planning time limit in seconds; else a :class:`SceneError` naming ``name``."""
-    limit = _number(value, name, positive=True)
+    limit = number(value, name, positive=True)
     if limit > MAX_TIME_LIMIT:
         raise SceneError(name, f"must be at most {MAX_TIME_LIMIT:g} s, got {value!r}")
     return limit
