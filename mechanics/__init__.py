@@ -1,27 +1,67 @@
-"""Mechanics of stable pushing: pure numpy/shapely, no planner imports.
+"""Mechanics of pushing: pure numpy/scipy/shapely, no planner imports.
 
-Modules follow the papers: :mod:`.twist` (signed CORs and twists), :mod:`.se2` (poses and the
-exponential of a twist), :mod:`.slider` (the part), :mod:`.stable` (procedure STABLE),
-:mod:`.steering` (a control box mapped onto the stable pushes).
+Modules follow the papers. Lynch & Mason 1996: :mod:`.twist` (signed CORs and twists),
+:mod:`.se2` (poses and the exponential of a twist), :mod:`.slider` (the part), :mod:`.stable`
+(procedure STABLE), :mod:`.steering` (a control box mapped onto the stable pushes). Lynch 1992,
+the general multi-contact analysis: :mod:`.cones` (polyhedral cones of twists and wrenches),
+:mod:`.contacts` (contact configurations), :mod:`.kinematics` (Reuleaux's method, §2),
+:mod:`.wrenches` (contact forces, §3.1), :mod:`.support` (support friction, §3.2),
+:mod:`.force_status` (P/U/I, §3.3-3.4).
 """
 
+from .cones import Cone, cor_halfplanes
+from .contacts import ContactConfiguration
+from .force_status import Verdict, force_status, force_status_regions, ray_twist
+from .kinematics import (
+    contact_modes,
+    kinematic_cone,
+    kinematic_cones,
+    modes_of_motion,
+    relative_cone,
+    relative_mode,
+)
 from .se2 import exp_twist, log_pose, relative_pose, wrap_angle
 from .slider import Slider
 from .stable import DEFAULT_TIP_FACTOR, StableRegion, stable_region
 from .steering import StableSteering
+from .support import SupportCells, SupportLoads, SupportModel, effective_cf, support_friction, unit_loads
 from .twist import cor_to_twist, point_velocity, twist_to_cor
+from .wrenches import contact_wrench_cone, friction_cone_edges, moment_labels, point_wrench
 
 __all__ = [
+    "Cone",
+    "ContactConfiguration",
     "DEFAULT_TIP_FACTOR",
     "Slider",
     "StableRegion",
     "StableSteering",
+    "SupportCells",
+    "SupportLoads",
+    "SupportModel",
+    "Verdict",
+    "contact_modes",
+    "contact_wrench_cone",
+    "cor_halfplanes",
     "cor_to_twist",
+    "effective_cf",
     "exp_twist",
+    "force_status",
+    "force_status_regions",
+    "friction_cone_edges",
+    "kinematic_cone",
+    "kinematic_cones",
     "log_pose",
+    "modes_of_motion",
+    "moment_labels",
     "point_velocity",
+    "point_wrench",
+    "ray_twist",
+    "relative_cone",
+    "relative_mode",
     "relative_pose",
     "stable_region",
+    "support_friction",
     "twist_to_cor",
+    "unit_loads",
     "wrap_angle",
 ]

@@ -1,0 +1,220 @@
+"""Force status of slider motions: P, U or I (Lynch 1992, §3.3-3.4; MECHANICS.md §2.4, §3.6-3.7).
+
+For a contact mode with composite wrench cone ``W`` (rows ``a``: ``a . w >= 0`` on ``W``) and a
+slider twist, each admissible support distribution ``mu`` needs the load ``L(mu)`` from the
+pusher (:mod:`mechanics.support`). The motion is
+
+* **P** (force possible) if every ``L(mu)`` lies in ``W``: ``sup_mu (-a) . L(mu) <= 0`` for every row;
+* **I** (impossible) if none does: some ``y = sum beta_j a_j`` (``beta >= 0``, so ``y . w >= 0``
+  on ``W``) has ``sup_mu y . L(mu) < 0``, a hyperplane separating the loads from ``W``;
+* **U** (undetermined) otherwise.
+
+Each supremum is a linear programme over distributions, solved on sample points. A discrete
+solution alone could hide a distribution between the samples; the verdicts here are
+**guaranteed** instead. The LP's dual ``lam`` (multiplier of the centroid constraint) makes
+``sup_x y . g(x) + lam . (x - CF)`` an upper bound for every admissible distribution, and
+:meth:`SupportLoads.upper_bound` bounds that over covering cells with an explicit curvature
+margin. So P is reported only when every row's certified bound is ``<= 0`` and I only when the
+separating hyperplane's certified bound is ``< 0``. In the other direction a sample distribution
+is a real distribution: a discrete violation proves "not P", a discrete load in ``W`` proves "not
+I". When neither proof nor certificate settles a question the samples are refined; what is still
+open is reported as U (never wrongly P or I), and :attr:`Verdict.consistent` says which statuses
+remain possible.
+
+A translation needs no samples: every distribution gives the same load, through the CF, so it is
+P or I, never U (§3.4).
+
+**Ray search (§3.4).** Along a ray from the CF the COR moves from the CF (a pure rotation about
+it) to infinity (a translation), and the paper's status follows one of four patterns: always I,
+U then I, always P, U then P. The twist ``(1 - tau) V_0 + tau V_inf`` sweeps the ray as ``tau``
+goes from 0 to 1 (a positive combination, §2.2), and bisection on ``tau`` finds the transition.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike
+
+from .cones import Cone
+from .support import SupportModel, unit_loads
+from .twist import cor_to_twist
+
+__all__ = ["Verdict", "force_status", "force_status_regions", "ray_twist"]
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Force status of one motion: ``status`` (``'P'``, ``'U'`` or ``'I'``) and ``consistent``,
+    the statuses the computation could not rule out (``'P'``, ``'U'``, ``'I'``, ``'UP'`` or
+    ``'UI'``). ``status`` is ``P`` or ``I`` only when proven; ``level`` is the refinement used."""
+
+    status: str
+    consistent: str
+    level: int
+
+    @property
+    def exact(self) -> bool:
+        """Whether the status is settled (for U: shown by a possible and an impossible sample load)."""
+        return self.consistent == self.status
+
+
+def _verdict(consistent: set[str], level: int) -> Verdict:
+    status = next(iter(consistent)) if len(consistent) == 1 else "U"
+    return Verdict(status, "".join(s for s in "PUI" if s in consistent), level)
+
+
+def _status_at(twist: np.ndarray, cone: Cone, support: SupportModel, level: int) -> set[str]:
+    """The statuses not ruled out with the samples of ``level``."""
+    loads = support.loads(twist, level)
+    tol = 1e-9 * (1.0 + float(np.linalg.norm(support.cf)) + support.radius)
+    # P: every row's support value must be certified <= 0; one sample violation refutes it.
+    refuted, certified = False, True
+    for a in cone.rows:
+        value, lam = loads.sample_support(-a)
+        if value > tol:
+            refuted = True
+            break
+        certified = certified and loads.upper_bound(-a, lam) <= 0
+    if certified and not refuted:
+        return {"P"}
+    beta, lam, value = loads.minimax(cone.rows)
+    if value < -tol and loads.is_negative(beta @ cone.rows, lam, tol):
+        return {"I"}
+    consistent = {"P", "U", "I"}
+    if refuted or value < -tol:  # the samples show a load outside W
+        consistent.discard("P")
+    if value >= -tol:  # a sample distribution's load is in W
+        consistent.discard("I")
+    return consistent
+
+
+def force_status(twist: ArrayLike, cone: Cone, support: SupportModel, refinements: int = 1) -> Verdict:
+    """Force status of the slider ``twist`` for a mode with composite wrench ``cone``.
+
+    ``refinements`` extra sample levels are tried while the verdict is open.
+
+    Examples
+    --------
+    A 2 x 1 block pushed on its whole bottom face, both ends sticking, mu = 0.5. Pushing straight
+    ahead is P (its load, through the CF, is inside the cone); sideways is I. Turning about
+    ``(-3, 0.5)``, far to the left, is P (MECHANICS.md §6.2, fixture A); turning about the CF is
+    U (a ring of support needs a pure moment, a point support at the CF needs nothing at all).
+
+    >>> from mechanics import ContactConfiguration, Slider, contact_wrench_cone, cor_to_twist
+    >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+    >>> cone = contact_wrench_cone(ContactConfiguration.slider_edge(block, 0, 0.5), "ss")
+    >>> support = SupportModel.of_slider(block, "footprint")
+    >>> [force_status(v, cone, support).status for v in ([0, 1, 0], [1, 0, 0])]
+    ['P', 'I']
+    >>> force_status(cor_to_twist([-3, 0.5], 1), cone, support)
+    Verdict(status='P', consistent='P', level=0)
+    >>> force_status(cor_to_twist([0, 0.5], 1), cone, support).status
+    'U'
+    """
+    v = np.asarray(twist, dtype=float)
+    if len(cone.rows) == 0:  # the contact forces span the wrench space
+        return Verdict("P", "P", 0)
+    if v[2] == 0:
+        load = unit_loads(v, support.cf)
+        return Verdict(*("PP" if cone.contains(load) else "II"), 0)
+    if cone.dimension == 0:  # no contact force, and any motion needs one
+        return Verdict("I", "I", 0)
+    consistent = {"P", "U", "I"}
+    for level in range(refinements + 1):
+        consistent &= _status_at(v, cone, support, level)
+        if len(consistent) == 1:
+            break
+    return _verdict(consistent, level)
+
+
+def ray_twist(cf: ArrayLike, angle: float, tau: ArrayLike, sense: int, scale: float) -> np.ndarray:
+    """Twist whose COR lies on the ray from ``cf`` at ``angle``, at distance ``scale tau/(1-tau)``.
+
+    ``tau = 0`` turns about the CF, ``tau = 1`` translates (the COR at infinity, with ``sense``
+    giving the side: a CCW COR far along ``e`` moves the part along ``e`` turned by -90 deg).
+
+    >>> ray_twist([0, 0], 0.0, [0.0, 0.5, 1.0], 1, 1.0).tolist()  # CORs (0, 0), (1, 0), infinity
+    [[0.0, 0.0, 1.0], [0.0, -0.5, 0.5], [0.0, -1.0, 0.0]]
+    """
+    e = np.array([np.cos(angle), np.sin(angle)])
+    tau = np.asarray(tau, dtype=float)[..., None]
+    at_cf = cor_to_twist(np.asarray(cf, dtype=float), sense) / scale
+    at_infinity = sense * np.array([e[1], -e[0], 0.0])
+    return (1 - tau) * at_cf + tau * at_infinity + 0.0
+
+
+def _ray(cone: Cone, support: SupportModel, angle: float, sense: int, steps: int, refinements: int) -> tuple[str, str, float]:
+    """``(inner, outer, distance)``: status near the CF, status towards infinity, and the
+    distance of the transition from the CF (0 if the status does not change)."""
+    def status(tau: float) -> str:
+        twist = ray_twist(support.cf, angle, tau, sense, support.radius)
+        return force_status(twist, cone, support, refinements).status
+
+    inner, outer = status(0.0), status(1.0)
+    if inner == outer:
+        return inner, outer, 0.0
+    lo, hi = 0.0, 1.0
+    for _ in range(steps):
+        mid = (lo + hi) / 2
+        lo, hi = (lo, mid) if status(mid) == outer else (mid, hi)
+    tau = (lo + hi) / 2
+    return inner, outer, support.radius * tau / (1 - tau)
+
+
+def force_status_regions(
+    cone: Cone,
+    support: SupportModel,
+    window: ArrayLike | None = None,
+    rays: int = 24,
+    steps: int = 10,
+    refinements: int = 1,
+) -> dict[int, dict[str, shapely.Geometry]]:
+    """P, U and I regions of rotation centres per sense, ``{sense: {status: geometry}}``, by ray bisection.
+
+    ``rays`` rays from the CF per sense, ``steps`` bisection steps each; a ray's statuses fill
+    the half-sectors on either side of it, and neighbouring rays with the same pattern are joined
+    by straight edges (adjoining segments merge into regions, §3.4). The default window is a
+    square of half-side ``4 r`` about the CF.
+
+    Examples
+    --------
+    A single sliding contact (one line of force, up along ``x = 0.5``) on the unit disk: nothing
+    is P, the CW CORs are all I (the load's moment about the CF has the sense of rotation), and
+    the U region is the COR locus of that line of force, on the far side of the CF.
+
+    >>> from mechanics import ContactConfiguration, contact_wrench_cone
+    >>> line = contact_wrench_cone(ContactConfiguration([[0.5, -1]], [[0, 1]], 0.0), "s")
+    >>> regions = force_status_regions(line, SupportModel.disk([0, 0], 1.0), rays=8, steps=6)
+    >>> regions[1]["P"].is_empty, regions[-1]["U"].is_empty, regions[-1]["P"].is_empty
+    (True, True, True)
+    >>> regions[1]["U"].bounds[0] < -1 < regions[1]["U"].bounds[2] <= 0.5
+    True
+    """
+    cf = support.cf
+    if window is None:
+        window = (*(cf - 4 * support.radius), *(cf + 4 * support.radius))
+    box = shapely.box(*window)
+    corners = np.array(box.exterior.coords)
+    far = 2 * float(np.max(np.linalg.norm(corners - cf, axis=1)))
+    angles = 2 * np.pi * np.arange(rays) / rays
+    out = {}
+    for sense in (1, -1):
+        found = [_ray(cone, support, a, sense, steps, refinements) for a in angles]
+        pieces: dict[str, list[shapely.Polygon]] = {"P": [], "U": [], "I": []}
+        for j, (inner, outer, dist) in enumerate(found):
+            for k in ((j - 1) % rays, (j + 1) % rays):
+                # The half-sector between ray j and the bisector towards its neighbour k.
+                mid = angles[j] + np.angle(np.exp(1j * (angles[k] - angles[j]))) / 2
+                same = found[k][:2] == (inner, outer)
+                at_mid = min((dist + found[k][2]) / 2 if same else dist, far)
+                e_j, e_m = (np.array([np.cos(a), np.sin(a)]) for a in (angles[j], mid))
+                d = min(dist, far)
+                if d > 0 or at_mid > 0:
+                    pieces[inner].append(shapely.Polygon([cf, cf + d * e_j, cf + at_mid * e_m]))
+                pieces[outer].append(shapely.Polygon([cf + d * e_j, cf + far * e_j, cf + far * e_m, cf + at_mid * e_m]))
+        out[sense] = {s: shapely.union_all([p for p in pieces[s] if p.is_valid] or [shapely.Polygon()]).intersection(box)
+                      for s in "PUI"}
+    return out
