@@ -6,10 +6,15 @@ Modules follow the papers. Lynch & Mason 1996: :mod:`.twist` (signed CORs and tw
 the general multi-contact analysis: :mod:`.cones` (polyhedral cones of twists and wrenches),
 :mod:`.contacts` (contact configurations), :mod:`.kinematics` (Reuleaux's method, §2),
 :mod:`.wrenches` (contact forces, §3.1), :mod:`.support` (support friction, §3.2),
-:mod:`.force_status` (P/U/I, §3.3-3.4).
+:mod:`.force_status` (P/U/I, §3.3-3.4), :mod:`.possible_motions` (the combined analysis, §4),
+:mod:`.stable_pushing` (guaranteed-stable pushes and one-step goals, §4-5.1),
+:mod:`.contact_synthesis` (which edges realise a motion, §5.2), :mod:`.figures` (the paper's
+figures redrawn). :mod:`.quasistatic` is an independent simulator that checks pushes without any
+of the stable-region code.
 """
 
 from .cones import Cone, cor_halfplanes
+from .contact_synthesis import EdgeRegions, edge_regions, stable_edges
 from .contacts import ContactConfiguration
 from .force_status import Verdict, force_status, force_status_regions, ray_twist
 from .kinematics import (
@@ -20,9 +25,11 @@ from .kinematics import (
     relative_cone,
     relative_mode,
 )
+from .possible_motions import ModeMotions, mode_possible, possible_motions
 from .se2 import exp_twist, log_pose, relative_pose, wrap_angle
 from .slider import Slider
 from .stable import DEFAULT_TIP_FACTOR, StableRegion, stable_region
+from .stable_pushing import GOALS, classify_goal
 from .steering import StableSteering
 from .support import SupportCells, SupportLoads, SupportModel, effective_cf, support_friction, unit_loads
 from .twist import cor_to_twist, point_velocity, twist_to_cor
@@ -32,6 +39,9 @@ __all__ = [
     "Cone",
     "ContactConfiguration",
     "DEFAULT_TIP_FACTOR",
+    "EdgeRegions",
+    "GOALS",
+    "ModeMotions",
     "Slider",
     "StableRegion",
     "StableSteering",
@@ -39,10 +49,12 @@ __all__ = [
     "SupportLoads",
     "SupportModel",
     "Verdict",
+    "classify_goal",
     "contact_modes",
     "contact_wrench_cone",
     "cor_halfplanes",
     "cor_to_twist",
+    "edge_regions",
     "effective_cf",
     "exp_twist",
     "force_status",
@@ -51,14 +63,17 @@ __all__ = [
     "kinematic_cone",
     "kinematic_cones",
     "log_pose",
+    "mode_possible",
     "modes_of_motion",
     "moment_labels",
     "point_velocity",
     "point_wrench",
+    "possible_motions",
     "ray_twist",
     "relative_cone",
     "relative_mode",
     "relative_pose",
+    "stable_edges",
     "stable_region",
     "support_friction",
     "twist_to_cor",

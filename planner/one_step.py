@@ -3,24 +3,26 @@
 The displacement from start to goal is one body twist, ``COR_total`` (turning by the smaller
 angle). If that twist lies in an edge's stable region and the motion is collision-free, pushing
 about ``COR_total`` reaches the goal exactly. The planner's goal region is built on it
-(:mod:`planner.preimage`).
+(:mod:`planner.preimage`). Each allowed edge's goal is also labelled as the paper's fig. 12 does
+(:func:`mechanics.classify_goal`): ``goal1`` guaranteed, ``goal2`` possible, ``goal3`` impossible,
+collisions aside.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import exp_twist, log_pose, wrap_angle
+from mechanics import GOALS, SupportModel, classify_goal, exp_twist, log_pose, wrap_angle
 
 from .plan_file import Segment
 from .pushes import EdgePush, clearance_margin, edge_pushes
 from .scene import Scene
 from .validity import CollisionModel
 
-__all__ = ["OneStep", "one_step", "connect"]
+__all__ = ["OneStep", "connect", "goal_verdicts", "one_step"]
 
 
 def connect(start: ArrayLike, goal: ArrayLike, push: EdgePush, model: CollisionModel, margin: float) -> Segment | str:
@@ -42,11 +44,13 @@ def connect(start: ArrayLike, goal: ArrayLike, push: EdgePush, model: CollisionM
 
 @dataclass(frozen=True)
 class OneStep:
-    """Answer of :func:`one_step`: the push (``segment``) if reachable, else the ``reason``."""
+    """Answer of :func:`one_step`: the push (``segment``) if reachable, else the ``reason``;
+    ``verdicts`` labels ``COR_total`` per allowed edge ``'goal1'``, ``'goal2'`` or ``'goal3'``."""
 
     reachable: bool
     segment: Segment | None
     reason: str
+    verdicts: dict[int, str] = field(default_factory=dict)
 
     @property
     def edge(self) -> int | None:
@@ -67,10 +71,20 @@ def one_step(scene: Scene, start: ArrayLike | None = None, goal: ArrayLike | Non
     goal = scene.goal if goal is None else np.asarray(goal, dtype=float)
     pushes = edge_pushes(scene)
     model = CollisionModel(scene, [p.edge for p in pushes])
+    verdicts = goal_verdicts(scene, start, goal)
     reasons = []
     for push in pushes:
         result = connect(start, goal, push, model, clearance_margin(scene))
         if isinstance(result, Segment):
-            return OneStep(True, result, "")
+            return OneStep(True, result, "", verdicts)
         reasons.append(f"edge {push.edge}: {result}")
-    return OneStep(False, None, "; ".join(reasons))
+    return OneStep(False, None, "; ".join(reasons), verdicts)
+
+
+def goal_verdicts(scene: Scene, start: ArrayLike, goal: ArrayLike) -> dict[int, str]:
+    """The paper's label of ``COR_total`` for each allowed edge (Lynch 1992, §5.1 and fig. 12)."""
+    total = log_pose(start, goal)
+    if not np.any(total):  # no motion: no COR to classify
+        return {}
+    p, support = scene.pusher, SupportModel.of_slider(scene.slider)
+    return {e: GOALS[classify_goal(scene.slider, e, p.mu, total, support, p.width)] for e in p.edges}
