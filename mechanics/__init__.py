@@ -2,12 +2,13 @@
 
 Modules follow the papers. Lynch & Mason 1996: :mod:`.twist` (signed CORs and twists),
 :mod:`.se2` (poses and the exponential of a twist), :mod:`.slider` (the part), :mod:`.stable`
-(procedure STABLE), :mod:`.steering` (a control box mapped onto the stable pushes). Lynch 1992,
+(procedure STABLE), :mod:`.push_plane` (the chart of an edge's pushes), :mod:`.steering` (a control box mapped onto the stable pushes). Lynch 1992,
 the general multi-contact analysis: :mod:`.cones` (polyhedral cones of twists and wrenches),
 :mod:`.contacts` (contact configurations), :mod:`.kinematics` (Reuleaux's method, §2),
 :mod:`.wrenches` (contact forces, §3.1), :mod:`.support` (support friction, §3.2),
 :mod:`.force_status` (P/U/I, §3.3-3.4), :mod:`.possible_motions` (the combined analysis, §4),
 :mod:`.stable_pushing` (guaranteed-stable pushes and one-step goals, §4-5.1),
+:mod:`.exact_region` (the exact stable pushes of an edge, containing STABLE's),
 :mod:`.contact_synthesis` (which edges realise a motion, §5.2), :mod:`.figures` (the paper's
 figures redrawn). :mod:`.quasistatic` is an independent simulator that checks pushes without any
 of the stable-region code.
@@ -16,6 +17,7 @@ of the stable-region code.
 from .cones import Cone, cor_halfplanes
 from .contact_synthesis import EdgeRegions, edge_regions, stable_edges
 from .contacts import ContactConfiguration
+from .exact_region import ExactRegion, exact_region
 from .force_status import Verdict, force_status, force_status_regions, ray_twist
 from .kinematics import (
     contact_modes,
@@ -42,6 +44,7 @@ __all__ = [
     "EdgeRegions",
     "GOALS",
     "ModeMotions",
+    "ExactRegion",
     "Slider",
     "StableRegion",
     "StableSteering",
@@ -56,6 +59,7 @@ __all__ = [
     "cor_to_twist",
     "edge_regions",
     "effective_cf",
+    "exact_region",
     "exp_twist",
     "force_status",
     "force_status_regions",

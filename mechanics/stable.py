@@ -15,11 +15,13 @@ point of the part and ``p_L``, ``p_R`` its distances to the end points.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
+from .push_plane import PushPlane
 from .slider import Slider
 from .twist import cor_to_twist
 
@@ -110,6 +112,24 @@ class StableRegion:
         parts = [cor_to_twist(self.cor_vertices(1), 1), np.array(trans), cor_to_twist(self.cor_vertices(-1), -1)]
         return np.vstack([p.reshape(-1, 3) for p in parts])
 
+    @cached_property
+    def plane(self) -> PushPlane:
+        """The chart of this edge's pushes (:mod:`.push_plane`)."""
+        return PushPlane(self.normal, self.contact, self.scale)
+
+    def section(self) -> tuple[shapely.Geometry, np.ndarray]:
+        """The region in the push plane and a centre it is star-shaped about.
+
+        STABLE's region is convex: the hull of the extremal twists, with its centroid.
+
+        >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+        >>> polygon, centre = stable_region(block, 0, 0.5, tip_factor=1.0).section()
+        >>> np.round(polygon.bounds, 6).tolist(), (np.round(centre, 12) + 0.0).tolist()
+        ([-0.5, -0.559017, 0.5, 0.559017], [0.0, 0.0])
+        """
+        hull = shapely.MultiPoint(self.plane.points(self.extremal_twists())).convex_hull
+        return hull, np.asarray(hull.centroid.coords[0])
+
     def cor_polygons(self, window: ArrayLike | None = None) -> dict[int, shapely.Polygon]:
         """COR regions per sense clipped to ``window = (xmin, ymin, xmax, ymax)`` (for drawing).
 
@@ -144,8 +164,12 @@ def stable_region(
     mu: float,
     width: float | None = None,
     tip_factor: float = DEFAULT_TIP_FACTOR,
+    method: str = "stable",
 ) -> StableRegion:
     """Procedure STABLE for a flat pusher of ``width`` centred on ``edge`` with friction ``mu``.
+
+    With ``method="exact"``, the exact region of :func:`mechanics.exact_region.exact_region` (an
+    :class:`~mechanics.exact_region.ExactRegion` with the same interface, containing this one).
 
     Parameters
     ----------
@@ -159,6 +183,8 @@ def stable_region(
         edge. Default: the whole edge.
     tip_factor : float
         Moves the tip line of step 2 from ``r^2/p`` to ``tip_factor * r^2/p`` (>= 1 is safer).
+    method : {"stable", "exact"}
+        Procedure STABLE (closed form) or the exact region (traced by certified force status).
 
     Examples
     --------
@@ -182,6 +208,12 @@ def stable_region(
     >>> stable_region(off_centre, 0, 0.5, width=0.5).is_empty
     True
     """
+    if method == "exact":
+        from .exact_region import exact_region  # it builds on this module's region
+
+        return exact_region(slider, edge, mu, width)
+    if method != "stable":
+        raise ValueError(f"method must be 'stable' or 'exact', got {method!r}")
     if not mu > 0:
         raise ValueError(f"mu must be > 0, got {mu}")
     if not slider.is_pushable(edge):

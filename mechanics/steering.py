@@ -5,11 +5,10 @@ push, the box is mapped onto the stable cone of :func:`mechanics.stable_region`,
 onto, so no stable push is out of reach (Lynch & Mason 1996, Prop. 3: the convex hull of the
 extremal pushes is what a planner can follow).
 
-Construction. Every stable twist moves the contact's midpoint ``m`` into the part (its COR lies
-beyond the part's extent along the edge, or it is a translation within the friction cone), so the
-cone's cross-section by ``a(V) = (v + omega k x m) . n = 1`` is a convex polygon, the hull of the
-extremal twists. ``u1`` picks a point ``B`` on its boundary by arc length, ``u2`` the point
-``C + u2 (B - C)`` on the segment from the centroid ``C``: a continuous map onto the polygon.
+Construction. The region's cross-section in the push plane (:mod:`.push_plane`) is a polygon
+that is star-shaped about a centre ``C`` (convex for procedure STABLE, the hull of the extremal
+twists). ``u1`` picks a point ``B`` on its boundary by arc length, ``u2`` the point
+``C + u2 (B - C)`` on the segment from the centre: a continuous map onto the polygon.
 """
 
 from __future__ import annotations
@@ -47,28 +46,18 @@ class StableSteering:
         if region.is_empty:
             raise ValueError(f"edge {region.edge} has no stable pushes")
         self.region = region
-        n, m = region.normal, region.contact.mean(axis=0)
-        t = np.array([n[1], -n[0]])
-        # Rows: normal and tangential velocity of m, and omega scaled to a speed. Invertible.
-        self._to_plane = np.array([
-            [n[0], n[1], m[0] * n[1] - m[1] * n[0]],
-            [t[0], t[1], m[0] * t[1] - m[1] * t[0]],
-            [0.0, 0.0, region.scale],
-        ])
-        self._from_plane = np.linalg.inv(self._to_plane)
-        y = region.extremal_twists() @ self._to_plane.T
-        hull = shapely.MultiPoint(y[:, 1:] / y[:, :1]).convex_hull
-        self._centre = np.asarray(hull.centroid.coords[0])
-        self._boundary = hull.exterior if isinstance(hull, shapely.Polygon) else hull
+        polygon, centre = region.section()
+        self._plane = region.plane
+        self._centre = np.asarray(centre, dtype=float)
+        # A region of one translation is a point; of translations only, a segment.
+        self._boundary = {"Polygon": getattr(polygon, "exterior", None), "LineString": polygon}.get(polygon.geom_type)
 
     def twist(self, u: ArrayLike) -> np.ndarray:
         """Stable twist(s) for control(s) ``u`` of shape ``(..., 2)`` in the unit box."""
         u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
-        if isinstance(self._boundary, shapely.Point):
+        if self._boundary is None:
             b = np.broadcast_to(self._centre, u.shape).copy()
         else:
             pts = shapely.line_interpolate_point(self._boundary, u[..., 0], normalized=True)
             b = shapely.get_coordinates(pts).reshape(u.shape)
-        p = self._centre + u[..., 1:2] * (b - self._centre)
-        y = np.concatenate([np.ones_like(p[..., :1]), p], axis=-1)
-        return y @ self._from_plane.T
+        return self._plane.twists(self._centre + u[..., 1:2] * (b - self._centre))

@@ -1,0 +1,249 @@
+"""The exact guaranteed-stable pushes of an edge (Lynch 1992, §4-5; MECHANICS.md §2.5b).
+
+A flat pusher on an edge pushes stably when the slider stays stuck to it whatever the support
+pressure: sticking ``ss`` is force possible (**P**) for every distribution on the part's footprint
+with its centre at the CF (:func:`~.force_status.force_status`, certified), and, by Lynch & Mason's
+Theorem 4, a rotation's centre lies beyond the part along the edge so that no other mode can
+occur. Procedure STABLE (:mod:`.stable`) is a closed-form inner bound of this set; here the set
+itself is traced, so it contains STABLE's and is as large as the guarantee allows.
+
+Construction, in the push plane (:mod:`.push_plane`), where the set is a bounded region:
+
+1. STABLE's section ``S`` (convex) and its centroid ``C``. STABLE finds every stable translation
+   (Lynch & Mason 1996, §3.3.1), so the translation range is STABLE's, and an empty STABLE means
+   no stable push at all (Proposition 6).
+2. ``rays`` rays from ``C``; along each, the last certified-P point by bisection between ``S``'s
+   boundary and the edge of Theorem 4's strip (or a distance far beyond any stable push).
+3. The vertices are pulled back towards ``S`` by ``margin`` of their reach beyond it, and every
+   vertex and ``checks`` points on every edge between neighbouring rays are certified P; an edge
+   with a failure has both its vertices pulled halfway back to ``S``, until all pass.
+4. The region is that star-shaped polygon united with ``S``.
+
+What is guaranteed: every twist on the boundary samples checked in step 3 is certified P (a
+discretised distribution cannot produce a false P, :mod:`.force_status`); between samples the
+boundary is trusted at the ray resolution with the inward margin, and the interior is trusted to be
+star-shaped about ``C`` (the bisection assumes one P-to-not-P crossing per ray). The tests check
+both against a much finer grid and an independent linear programme over explicit distributions.
+
+Examples
+--------
+MECHANICS.md §6.2 fixture A (2 x 1 block pushed on its whole bottom face, mu = 0.5): CCW about
+(-3, 1.2) and (-1.5, 0.5) are stable, though STABLE misses both; the mirror CW turn is not.
+
+>>> from mechanics import Slider, cor_to_twist, stable_region
+>>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+>>> exact = exact_region(block, 0, 0.5, rays=24)
+>>> twists = cor_to_twist([[-3, 1.2], [-1.5, 0.5], [-3, 0.5]], [1, 1, -1])
+>>> exact.contains(twists).tolist(), stable_region(block, 0, 0.5).contains(twists).tolist()
+([True, True, False], [False, False, False])
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike
+
+from .contacts import ContactConfiguration
+from .force_status import force_status
+from .push_plane import PushPlane
+from .slider import Slider
+from .stable import StableRegion, stable_region
+from .support import SupportModel
+from .twist import twist_to_cor
+from .wrenches import contact_wrench_cone
+
+__all__ = ["ExactRegion", "exact_region"]
+
+#: How far beyond STABLE's section a ray is searched, in units of that section's size: far past any
+#: stable push (sideways pushes are force impossible), so the cap never binds in practice.
+_REACH = 8.0
+
+
+@dataclass(frozen=True, eq=False)
+class ExactRegion:
+    """The exact stable pushes of one edge, with the interface of :class:`~.stable.StableRegion`.
+
+    ``polygon`` is the region's section in the push plane (:attr:`plane`), star-shaped about
+    ``centre``; ``stable`` is procedure STABLE's region for the same edge (contained in this one).
+    """
+
+    stable: StableRegion
+    polygon: shapely.Polygon
+    centre: np.ndarray
+
+    edge = property(lambda self: self.stable.edge)
+    contact = property(lambda self: self.stable.contact)
+    normal = property(lambda self: self.stable.normal)
+    mu = property(lambda self: self.stable.mu)
+    cf = property(lambda self: self.stable.cf)
+    scale = property(lambda self: self.stable.scale)
+    plane = property(lambda self: self.stable.plane)
+    #: Every stable translation is one of STABLE's (Lynch & Mason 1996, §3.3.1).
+    translation_range = property(lambda self: self.stable.translation_range)
+    is_empty = property(lambda self: self.stable.is_empty)
+
+    @cached_property
+    def _tolerance(self) -> float:
+        return 1e-9 * (1.0 + float(np.max(np.abs(self.polygon.bounds)))) if not self.is_empty else 0.0
+
+    def contains(self, twist: ArrayLike, tol: float = 1e-9) -> np.ndarray:
+        """Whether each slider-frame twist (shape ``(..., 3)``, any positive scale) is stable.
+
+        ``tol`` is a tolerance in the push plane's units (speeds per unit normal speed).
+        """
+        v = np.asarray(twist, dtype=float)
+        if self.is_empty:
+            return np.zeros(v.shape[:-1], dtype=bool)
+        p = self.plane.points(v)
+        ok = np.all(np.isfinite(p), axis=-1)
+        inside = shapely.dwithin(self.polygon, shapely.points(np.where(ok[..., None], p, 0.0)), tol)
+        return ok & inside
+
+    def section(self) -> tuple[shapely.Polygon, np.ndarray]:
+        """The region in the push plane and the centre it is star-shaped about."""
+        return self.polygon, self.centre
+
+    def extremal_twists(self) -> np.ndarray:
+        """The corners of the region's convex hull, as twists with ``|omega| = 1`` (rotations) or
+        unit speed (translations); the controls of the 1996 planner."""
+        if self.is_empty:
+            return np.zeros((0, 3))
+        corners = shapely.get_coordinates(self.polygon.convex_hull)  # a point or segment if degenerate
+        v = self.plane.twists(np.unique(corners, axis=0))
+        size = np.where(np.abs(v[:, 2]) > 1e-12, np.abs(v[:, 2]), np.linalg.norm(v[:, :2], axis=1))
+        return v / size[:, None]
+
+    def cor_polygons(self, window: ArrayLike | None = None) -> dict[int, shapely.Polygon]:
+        """COR regions per sense clipped to ``window = (xmin, ymin, xmax, ymax)`` (for drawing).
+
+        Straight lines of the push plane are straight lines of CORs (the map is projective), so
+        each sense's half of the section maps vertex by vertex; the band next to ``w = 0``, whose
+        CORs lie beyond the window, is left out. The default window is a square of half-side
+        ``4 r`` about the CF.
+        """
+        if window is None:
+            window = (*(self.cf - 4 * self.scale), *(self.cf + 4 * self.scale))
+        box = shapely.box(*window)
+        if self.is_empty:
+            return {1: shapely.Polygon(), -1: shapely.Polygon()}
+        corners = np.asarray(box.exterior.coords)
+        # A COR at plane height w sits |scale / w| from m along the edge: beyond the window when
+        # |w| < delta.
+        delta = self.scale / (2.0 * float(np.max(np.linalg.norm(corners - self.plane.midpoint, axis=1))))
+        big = 1e3 * (1.0 + float(np.max(np.abs(self.polygon.bounds))))
+        out = {}
+        for sense in (1, -1):
+            half = self.polygon.intersection(shapely.box(-big, delta, big, big) if sense > 0
+                                             else shapely.box(-big, -big, big, -delta))
+            pieces = []
+            for part in getattr(half, "geoms", [half]):
+                if isinstance(part, shapely.Polygon) and part.area > 0:
+                    cors, _ = twist_to_cor(self.plane.twists(np.asarray(part.exterior.coords)))
+                    pieces.append(shapely.Polygon(cors).buffer(0).intersection(box))
+            out[sense] = shapely.union_all(pieces) if pieces else shapely.Polygon()
+        return out
+
+
+def exact_region(
+    slider: Slider,
+    edge: int,
+    mu: float,
+    width: float | None = None,
+    rays: int = 48,
+    steps: int = 12,
+    margin: float = 0.02,
+    checks: int = 4,
+) -> ExactRegion:
+    """The exact guaranteed-stable pushes of ``edge`` (module docstring).
+
+    Parameters
+    ----------
+    slider, edge, mu, width
+        As for :func:`~.stable.stable_region`.
+    rays : int
+        Rays of the search from STABLE's centroid (at least 8).
+    steps : int
+        Bisection steps per ray.
+    margin : float
+        Fraction of each vertex's reach beyond STABLE's region given up as a safety margin.
+    checks : int
+        Points certified on each boundary edge between neighbouring rays, besides the vertices.
+
+    Examples
+    --------
+    An empty STABLE region means no stable push (Proposition 6):
+
+    >>> off_centre = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]], cf=[0.9, 0.5])
+    >>> exact_region(off_centre, 0, 0.5, width=0.5).is_empty
+    True
+    """
+    stable = stable_region(slider, edge, mu, width)
+    if stable.is_empty:
+        return ExactRegion(stable, shapely.Polygon(), np.zeros(2))
+    if rays < 8:
+        raise ValueError(f"rays must be at least 8, got {rays}")
+    inner, centre = stable.section()
+    if not (isinstance(inner, shapely.Polygon) and inner.area > 0):  # translations only: nothing to trace
+        return ExactRegion(stable, inner, centre)
+    plane = stable.plane
+    cone = contact_wrench_cone(ContactConfiguration.slider_edge(slider, edge, mu, width), "s" * 2)
+    support = SupportModel.of_slider(slider, "footprint")
+    w_lo, w_hi = plane.theorem4_strip(slider.vertices)
+
+    def stable_at(points: np.ndarray) -> np.ndarray:
+        """Certified P, strictly inside Theorem 4's strip, or inside STABLE's region."""
+        points = np.atleast_2d(points)
+        known = stable.contains(plane.twists(points))
+        out = []
+        for p, k in zip(points, known):
+            out.append(bool(k) or (w_lo < p[1] < w_hi
+                                   and force_status(plane.twists(p), cone, support).status == "P"))
+        return np.array(out)
+
+    angles = 2 * np.pi * np.arange(rays) / rays
+    directions = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    size = max(float(np.ptp(np.asarray(inner.bounds).reshape(2, 2), axis=0).max()), 1e-9)
+    base = np.empty(rays)
+    reach = np.empty(rays)
+    for k, e in enumerate(directions):
+        ray = shapely.LineString([centre, centre + 2 * _REACH * size * e])
+        base[k] = inner.intersection(ray).length  # STABLE's boundary along the ray
+        cap = _REACH * size
+        if e[1] > 0:
+            cap = min(cap, (w_hi - centre[1]) / e[1])
+        elif e[1] < 0:
+            cap = min(cap, (w_lo - centre[1]) / e[1])
+        lo, hi = base[k], cap * (1 - 1e-9)
+        if stable_at(centre + hi * e)[0]:
+            lo = hi
+        else:
+            for _ in range(steps):
+                mid = (lo + hi) / 2
+                lo, hi = (mid, hi) if stable_at(centre + mid * e)[0] else (lo, mid)
+        reach[k] = base[k] + (1 - margin) * (lo - base[k])
+    # Certify vertices and edges; pull back the ends of any edge with a failure.
+    fractions = np.arange(checks + 1) / (checks + 1)
+    pending = set(range(rays))
+    while pending:
+        failed = set()
+        for k in sorted(pending):
+            j = (k + 1) % rays
+            a, b = centre + reach[k] * directions[k], centre + reach[j] * directions[j]
+            samples = a + fractions[:, None] * (b - a)
+            if not np.all(stable_at(samples)):
+                failed |= {k, j}
+        for k in failed:
+            reach[k] = base[k] + 0.5 * (reach[k] - base[k])
+            if reach[k] - base[k] < 1e-6 * size:
+                reach[k] = base[k]
+        # Edges touching a moved vertex are checked again (an edge between two STABLE points
+        # lies in STABLE's convex region and cannot fail).
+        pending = {i for k in failed for i in ((k - 1) % rays, k)}
+        pending = {k for k in pending if reach[k] > base[k] or reach[(k + 1) % rays] > base[(k + 1) % rays]}
+    traced = shapely.Polygon(centre + reach[:, None] * directions)
+    polygon = shapely.union_all([traced.buffer(0), inner.buffer(0)])
+    return ExactRegion(stable, polygon, np.asarray(centre, dtype=float))

@@ -1,0 +1,171 @@
+"""The exact stable region of an edge (mechanics.exact_region) against independent reasoning.
+
+Sources of truth, none of them the code under test:
+* the membership table of MECHANICS.md §6.2 (its "exact V_F" column, computed by the note's own
+  LP oracle), and the note's statement that STABLE finds every stable translation;
+* ``oracle.LPOracle``: the exact V_F test of MECHANICS.md §2.4, linear programmes over explicit
+  support distributions on a grid of the part (no ``mechanics`` code), plus Theorem 4's
+  condition re-derived here (the COR lies beyond the part along the edge);
+* containment of procedure STABLE's region, monotonicity in mu and mirror symmetry.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+
+import oracle as O
+from mechanics import Slider, StableSteering, cor_to_twist, exact_region, stable_region
+
+RECT = [[-1, 0], [1, 0], [1, 1], [-1, 1]]
+D_VERTS = [(-2, 0), (-0.5, 0), (1, 0), (2, 0), (2, 1), (-2, 1)]
+RAYS = 24  # a coarse trace keeps the suite fast; the guarantee does not depend on it
+
+# Parts for soundness and size: MECHANICS.md fixtures A, B, D, an L-shaped part and a random convex one.
+PARTS = {
+    "A": dict(vertices=np.array(RECT, float), cf=np.array([0.0, 0.5]), edge=0, mu=0.5, width=None),
+    "B": dict(vertices=np.array(RECT, float), cf=np.array([0.4, 0.3]), edge=0, mu=0.5, width=None),
+    "D": dict(vertices=np.array(D_VERTS, float), cf=np.array([0.6, 0.5]), edge=1, mu=0.8, width=None),
+    "L": {**O.random_geometry(np.random.default_rng(11), "L"), "mu": 0.7, "width": None},
+    "convex": {**O.random_geometry(np.random.default_rng(5), "convex"), "width": None},
+}
+
+
+def regions(g, rays=RAYS):
+    slider = Slider(g["vertices"], cf=g["cf"])
+    return (exact_region(slider, g["edge"], g["mu"], width=g["width"], rays=rays),
+            stable_region(slider, g["edge"], g["mu"], width=g["width"]))
+
+
+CACHE: dict[str, tuple] = {}
+
+
+def part(name):
+    if name not in CACHE:
+        CACHE[name] = regions(PARTS[name])
+    return CACHE[name]
+
+
+# MECHANICS.md §6.2, rows whose COR lies beyond the part along the edge (Theorem 4).
+TABLE = [
+    ("A", (-3, 0.5), 1, True), ("A", (-3, 1.2), 1, True), ("A", (-1.5, 0.5), 1, True),
+    ("A", (-3, 0.5), -1, False), ("A", (10, 0.5), -1, True),
+    ("B", (-5, 0.3), 1, True), ("B", (-3.5, 0.3), 1, True), ("B", (2.05, 0.5), -1, True), ("B", (6, -1), -1, True),
+    ("D", (-12, 6), 1, True), ("D", (-12, 3), 1, True), ("D", (5.5, 3), -1, True),
+]
+
+
+@pytest.mark.parametrize("name, cor, sense, exact", TABLE)
+def test_membership_table(name, cor, sense, exact):
+    region, _ = part(name)
+    assert bool(region.contains(cor_to_twist(cor, sense))) == exact
+
+
+def theorem4_ok(twists, g):
+    """CCW CORs left of the whole part along t, CW right of it (translations pass)."""
+    f = O.edge_frame(g["vertices"], g["edge"], g["width"])
+    along = g["vertices"] @ f["t"]
+    v = np.asarray(twists, float)
+    rot = np.abs(v[:, 2]) > 1e-12
+    c = np.column_stack([-v[rot, 1], v[rot, 0]]) / v[rot, 2:]
+    ct = c @ f["t"]
+    ok = np.where(v[rot, 2] > 0, ct <= along.min() + 1e-9, ct >= along.max() - 1e-9)
+    return bool(ok.all())
+
+
+@pytest.mark.parametrize("name", list(PARTS))
+def test_exact_region_is_sound(name):
+    """Its boundary (traced vertices and points between them, finer than the trace) and a grid of
+    CORs inside it all pass the independent LP over distributions, and Theorem 4."""
+    g = PARTS[name]
+    region, stable = part(name)
+    assert not region.is_empty
+    polygon, _ = region.section()
+    ring = polygon.exterior
+    boundary = shapely.get_coordinates(shapely.line_interpolate_point(ring, np.linspace(0, 1, 97)[:-1], normalized=True))
+    inside = shapely.get_coordinates(shapely.points(np.random.default_rng(0).uniform(
+        polygon.bounds[:2], polygon.bounds[2:], size=(600, 2))))
+    inside = inside[shapely.contains_xy(polygon, inside[:, 0], inside[:, 1])][:60]
+    twists = region.plane.twists(np.vstack([boundary, inside]))
+    assert region.contains(twists).all()
+    assert theorem4_ok(twists, g)
+    ref = O.Reference(g["vertices"], g["cf"], g["edge"], g["mu"], g["width"])
+    lp = O.LPOracle(ref, O.support_samples(g["vertices"], 12))
+    worst = max(lp.max_violation(v) for v in twists)
+    assert worst <= 1e-9, worst
+
+
+@pytest.mark.parametrize("name", ["A", "B", "L"])
+def test_exact_region_is_tight(name):
+    """Just beyond its boundary (10 % further from the centre) twists fail the LP or Theorem 4 on
+    most rays: the region is close to as large as the guarantee allows."""
+    g = PARTS[name]
+    region, _ = part(name)
+    polygon, centre = region.section()
+    ring = np.asarray(polygon.exterior.coords)[:-1]
+    outside = centre + 1.1 * (ring[:: max(1, len(ring) // 12)] - centre)
+    twists = region.plane.twists(outside)
+    ref = O.Reference(g["vertices"], g["cf"], g["edge"], g["mu"], g["width"])
+    lp = O.LPOracle(ref, O.support_samples(g["vertices"], 12))
+    fails = [lp.max_violation(v) > 1e-9 or not theorem4_ok(v[None], g) for v in twists]
+    assert np.mean(fails) >= 0.6, fails
+
+
+@pytest.mark.parametrize("name", list(PARTS))
+def test_contains_stable_and_is_larger(name):
+    """STABLE's pushes (sampled through its steering map) are all exact-stable, the translations
+    are STABLE's, and the exact COR regions are larger within a window about the part."""
+    region, stable = part(name)
+    u = np.random.default_rng(1).random((3000, 2))
+    assert region.contains(StableSteering(stable).twist(u)).all()
+    assert region.translation_range == stable.translation_range
+    window = (*(stable.cf - 6 * stable.scale), *(stable.cf + 6 * stable.scale))
+    ex, st = region.cor_polygons(window), stable.cor_polygons(window)
+    for sense in (1, -1):
+        assert ex[sense].buffer(1e-6 * stable.scale).contains(st[sense])
+    exact_area = sum(ex[s].area for s in (1, -1))
+    stable_area = sum(st[s].area for s in (1, -1))
+    assert exact_area > 1.05 * stable_area
+    print(f"{name}: COR area within +-6r, exact {exact_area:.3g}, STABLE {stable_area:.3g}, "
+          f"ratio STABLE/exact {stable_area / exact_area:.2f}")
+
+
+def test_steering_covers_the_exact_region():
+    """Every control maps to a stable push, and the images reach every part of the region."""
+    region, _ = part("A")
+    steer = StableSteering(region)
+    twists = steer.twist(np.random.default_rng(2).random((4000, 2)))
+    assert region.contains(twists).all()
+    points = region.plane.points(twists)
+    polygon, _ = region.section()
+    hull = shapely.MultiPoint(points).convex_hull
+    assert hull.area >= 0.95 * polygon.convex_hull.area
+
+
+def test_monotone_in_mu():
+    g = PARTS["A"]
+    low, _ = regions({**g, "mu": 0.4})
+    high, _ = regions({**g, "mu": 0.8})
+    polygon, _ = low.section()
+    assert high.section()[0].buffer(0.02 * np.sqrt(polygon.area)).contains(polygon)
+    assert high.section()[0].area > polygon.area
+
+
+def test_mirror_symmetry():
+    """Fixture A is symmetric about the normal through the contact's midpoint: CCW and CW regions
+    are mirror images (the push plane's point reflection (s, w) -> (-s, -w))."""
+    region, _ = part("A")
+    polygon, _ = region.section()
+    mirrored = shapely.affinity.scale(polygon, -1, -1, origin=(0, 0))
+    assert polygon.symmetric_difference(mirrored).area <= 0.03 * polygon.area
+
+
+def test_no_stable_push_without_a_force_through_the_cf():
+    """Fixture E (MECHANICS.md §6.2): the contact's cone holds no pure force, so nothing is stable
+    (Proposition 6), whatever the method."""
+    slider = Slider([(-1, 0), (0.5, 0), (1, 0), (1, 1), (-1, 1)], cf=[0.8, 0.5])
+    region = exact_region(slider, 0, 0.5, rays=RAYS)
+    assert region.is_empty
+    assert not region.contains([[0.0, 1.0, 0.0], cor_to_twist([-3, 0.5], 1)]).any()
+    assert region.extremal_twists().shape == (0, 3)
