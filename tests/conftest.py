@@ -2,6 +2,8 @@ import atexit
 import os
 import sys
 
+import pytest
+
 
 def _silence_nanobind_leak_report() -> None:
     # OMPL objects alive at exit (e.g. in tracebacks kept by pytest) make nanobind print a leak
@@ -12,3 +14,17 @@ def _silence_nanobind_leak_report() -> None:
 
 
 atexit.register(_silence_nanobind_leak_report)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def region_cache(request):
+    """Exact regions are cached on disk (planner.regions): keep the tests' copy in pytest's cache
+    folder, not the user's, for this process and the ``plan`` commands it starts."""
+    folder = request.config.cache.mkdir("stablepush-regions")
+    old = os.environ.get("STABLEPUSH_CACHE")
+    os.environ["STABLEPUSH_CACHE"] = str(folder)
+    yield folder
+    if old is None:
+        os.environ.pop("STABLEPUSH_CACHE")
+    else:
+        os.environ["STABLEPUSH_CACHE"] = old

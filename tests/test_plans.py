@@ -1,8 +1,9 @@
 """Every shipped scene: `plan` solves it with seed 1, and the plan JSON replays correctly.
 
 The replay shares nothing with the planner: poses by the matrix exponential, collisions by
-shapely on densely sampled poses, stability by the test-only STABLE reference (tests/oracle.py),
-scene geometry read straight from the YAML.
+shapely on densely sampled poses, stability by the test-only linear programme over support
+distributions on the part and Theorem 4's condition (tests/oracle.py; the plans use the exact
+regions by default, larger than STABLE's), scene geometry read straight from the YAML.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import pytest
 import shapely
 import yaml
 
-from oracle import Reference
+from oracle import LPOracle, Reference, support_samples
 from replay import advance, angle_diff, max_point_speed, place, pusher_body
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -95,11 +96,16 @@ def test_plan_replays(planned):
         np.testing.assert_allclose(seg["start"][:2], pose[:2], atol=1e-9)
         assert angle_diff(seg["start"][2], pose[2]) < 1e-9
         edge = seg["edge"]
-        # Stability: the twist is in STABLE's region of this edge and contact (re-derived).
-        ref = Reference(verts, cf, edge, pusher["mu"], width=pusher["width"], tip_factor=1.02)
+        # Stability: sticking for every support distribution on the part (re-derived LP), and a
+        # turn's centre beyond the part along the edge (Theorem 4).
+        ref = Reference(verts, cf, edge, pusher["mu"], width=pusher["width"])
         np.testing.assert_allclose(sorted(map(tuple, seg["contact"])), sorted(map(tuple, [ref.eL, ref.eR])), atol=1e-12)
-        slack, band = ref.twist_margin(seg["twist"])
-        assert slack[0] >= -band[0], f"push {seg} is not stable"
+        v = np.asarray(seg["twist"])
+        assert LPOracle(ref, support_samples(verts, 12)).max_violation(v) <= 1e-9, f"push {seg} is not stable"
+        if v[2] != 0:
+            along = verts @ ref.t
+            c_t = np.array([-v[1], v[0]]) / v[2] @ ref.t
+            assert (c_t <= along.min()) if v[2] > 0 else (c_t >= along.max()), f"push {seg} may pivot"
         # Motion: the end is start * exp(twist * duration); sample it densely against obstacles.
         body = [verts, pusher_body(verts, edge, pusher["width"], pusher["depth"])]
         speed = max(max_point_speed(b, seg["twist"]) for b in body)

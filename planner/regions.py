@@ -1,0 +1,80 @@
+"""Each edge's stable region for planning, computed once per part.
+
+Procedure STABLE is a closed form; the exact region (:mod:`mechanics.exact_region`) costs about a
+second or two of certified linear programmes per edge. It depends only on the part, the edge, the
+friction and the pusher's width, so it is kept in memory for the process and on disk across runs:
+a JSON file per region under ``$STABLEPUSH_CACHE`` (default ``$XDG_CACHE_HOME/stablepush`` or
+``~/.cache/stablepush``), named by a hash of everything it depends on, written atomically. A cache
+that cannot be read or written is ignored: the region is then computed again, never guessed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from mechanics import ExactRegion, Slider, StableRegion, exact_region, stable_region
+
+from .plan_file import write_atomic
+
+__all__ = ["cache_folder", "edge_region"]
+
+#: Bump when the exact region's construction changes, so old cache files are not used.
+_VERSION = 1
+
+_memory: dict[str, ExactRegion] = {}
+
+
+def cache_folder() -> Path:
+    """Where exact regions are kept between runs."""
+    if os.environ.get("STABLEPUSH_CACHE"):
+        return Path(os.environ["STABLEPUSH_CACHE"])
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "stablepush"
+
+
+def _key(slider: Slider, edge: int, mu: float, width: float | None) -> str:
+    spec = {"version": _VERSION, "vertices": slider.vertices.tolist(), "cf": slider.cf.tolist(),
+            "edge": int(edge), "mu": float(mu), "width": None if width is None else float(width)}
+    return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
+
+
+def _read(path: Path, stable: StableRegion) -> ExactRegion | None:
+    try:
+        data = json.loads(path.read_text())
+        polygon = shapely.Polygon(np.asarray(data["polygon"], dtype=float))
+        centre = np.asarray(data["centre"], dtype=float)
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if not polygon.is_valid or polygon.area <= 0 or centre.shape != (2,):
+        return None
+    return ExactRegion(stable, polygon, centre)
+
+
+def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None,
+                method: str = "exact") -> StableRegion | ExactRegion:
+    """The ``method`` (``'stable'`` or ``'exact'``) stable region of ``edge``, cached as above."""
+    stable = stable_region(slider, edge, mu, width)
+    if method == "stable" or stable.is_empty:
+        return stable
+    key = _key(slider, edge, mu, width)
+    if key in _memory:
+        return _memory[key]
+    path = cache_folder() / f"exact-{key}.json"
+    region = _read(path, stable)
+    if region is None:
+        region = exact_region(slider, edge, mu, width)
+        polygon, centre = region.section()
+        if isinstance(polygon, shapely.Polygon):  # a degenerate region is cheap: not stored
+            try:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                write_atomic(path, json.dumps({"polygon": np.asarray(polygon.exterior.coords).tolist(),
+                                               "centre": centre.tolist()}))
+            except OSError:
+                pass  # a read-only home: compute again next time
+    _memory[key] = region
+    return region
