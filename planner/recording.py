@@ -26,6 +26,14 @@ segments. Frames are ``FRAMES_PER_RADIUS`` per slider radius of point travel, at
   a square of half-side 4 slider radii about the CF and carried with the slider (no strip where
   a region is empty).
 
+With a :class:`~planner.verify.Verification` (``plan --verify``), also:
+
+* ``/world/ghost`` -- the slider's outline as simulated under each push's worst support
+  distribution (the run deviating most from the plan), from the push's planned start, at up to
+  ``GHOST_SAMPLES`` frames per push (the viewer holds it in between); it hides under
+  ``/world/slider`` wherever the push sticks;
+* ``/log/verify`` -- ``TextLog``, the verification's summary line (``WARN`` when it failed).
+
 Styles (colours, line widths in UI points) are logged statically on the animated entities. The
 default blueprint shows ``/world`` in a 2-D view bounded by the workspace, above the text log.
 """
@@ -46,8 +54,9 @@ from .bodies import pusher_polygon
 from .plan_file import Plan, atomic_path
 from .pushes import edge_pushes
 from .scene import Scene
+from .verify import Verification
 
-__all__ = ["FRAMES_PER_RADIUS", "MAX_FRAMES", "PATH_POINTS", "write_recording"]
+__all__ = ["FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS", "write_recording"]
 
 #: Animation frames while a body point travels one slider radius (fewer if that exceeds MAX_FRAMES).
 FRAMES_PER_RADIUS = 20
@@ -55,11 +64,13 @@ FRAMES_PER_RADIUS = 20
 MAX_FRAMES = 600
 #: About the most points of the CF path drawn in one frame (it is redrawn every frame).
 PATH_POINTS = 100
+#: Most frames per push at which the simulated ghost is drawn (each costs a simulation).
+GHOST_SAMPLES = 10
 
 _THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0.5, 1.0, 2.0, 4.0]))
 _GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
 _SLIDER, _GOAL, _CF = [40, 110, 220], [40, 170, 70], [90, 160, 255]
-_CCW, _CW, _COR = [20, 170, 150], [230, 130, 20], [210, 40, 190]
+_CCW, _CW, _COR, _GHOST = [20, 170, 150], [230, 130, 20], [210, 40, 190], [140, 60, 230]
 
 
 def _closed(points: ArrayLike) -> np.ndarray:
@@ -150,7 +161,26 @@ def _outline(region: shapely.Geometry) -> np.ndarray | None:
     return np.asarray(region.exterior.coords) if isinstance(region, shapely.Polygon) and region.area > 0 else None
 
 
-def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
+def _log_ghost(rec: rr.RecordingStream, verification: Verification, index: np.ndarray, times: np.ndarray) -> None:
+    """``/world/ghost`` at up to ``GHOST_SAMPLES`` of each push's frames, and ``/log/verify``."""
+    frames, poses = [], []
+    for k in range(len(verification.pushes)):
+        mine = np.flatnonzero(index == k)  # the last segment's frames include the final one
+        mine = mine[np.unique(np.linspace(0, len(mine) - 1, min(GHOST_SAMPLES, len(mine))).round().astype(int))]
+        frames.append(mine)
+        poses.append(verification.poses(k, times[mine] - times[mine[0]]))
+    frames = np.concatenate(frames)
+    outline = _closed(verification.scene.slider.vertices)
+    rec.send_columns("world/ghost", indexes=[rr.TimeColumn("step", sequence=frames),
+                                             rr.TimeColumn("time", duration=times[frames])],
+                     columns=rr.LineStrips2D.columns(strips=_place(outline, np.concatenate(poses))))
+    rec.log("world/ghost", rr.LineStrips2D.from_fields(colors=_GHOST, radii=_LINE), static=True)
+    rec.log("log/verify", rr.TextLog(verification.summary(), level="INFO" if verification.passed else "WARN"),
+            static=True)
+
+
+def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
+    """The animated entities; returns the frames' segment indices and times."""
     index, times, poses = _frames(plan, scene.slider.radius / FRAMES_PER_RADIUS)
     steps = [rr.TimeColumn("step", sequence=np.arange(len(times))), rr.TimeColumn("time", duration=times)]
     slider, width, depth = scene.slider, scene.pusher.width, scene.pusher.depth
@@ -187,9 +217,10 @@ def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
                                   ("world/stable/cw", _CW, _LINE)):
         rec.log(entity, rr.LineStrips2D.from_fields(colors=color, radii=radius), static=True)
     rec.log("world/cor", rr.Points2D.from_fields(colors=_COR, radii=_DOT), static=True)
+    return index, times
 
 
-def write_recording(path: str | Path, scene: Scene, plan: Plan) -> None:
+def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Verification | None = None) -> None:
     """Write a rerun recording of ``plan`` for ``scene`` to ``path`` (layout: module docstring).
 
     The file is written atomically: a temporary file in the same folder is completed (footer
@@ -204,6 +235,8 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan) -> None:
         The scene that was planned.
     plan : Plan
         The planner's result, solved or not (an unsolved plan gives the static scene only).
+    verification : Verification, optional
+        :func:`planner.verify` of ``plan``: adds the simulated ghost and the verdict.
 
     Raises
     ------
@@ -223,6 +256,8 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan) -> None:
         try:
             _log_static(rec, scene, plan)
             if plan.segments:
-                _log_motion(rec, scene, plan)
+                index, times = _log_motion(rec, scene, plan)
+                if verification is not None:
+                    _log_ghost(rec, verification, index, times)
         finally:
             rec.disconnect()  # flushes and writes the footer
