@@ -153,9 +153,10 @@ class Verification:
     def poses(self, push: int, times: ArrayLike, run: int | None = None) -> np.ndarray:
         """Poses ``(m, 3)`` of a run (default: the worst) of push ``push`` at push times ``times``.
 
-        Each is the end of the same simulation cut short at that time with the full push's step,
-        so the poses lie on the verified run; where the run stopped early they stay put. Costs a
-        simulation per time (one step each while the part sticks).
+        Each is the end of the same simulation cut short at that time, in steps no longer than the
+        full push's, so the poses follow the verified run (exactly at its end, and wherever the
+        part sticks); where the run stopped early they stay put. Costs a simulation per time (one
+        step while the part sticks).
         """
         check = self.pushes[push]
         s, run = check.segment, check.worst if run is None else run
