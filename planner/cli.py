@@ -17,11 +17,12 @@ import atexit
 import os
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from .plan_file import Plan, load_plan, write_atomic
-from .scene import (DEFAULT_PLANNER, MAX_SEED, MAX_TIME_LIMIT, PLANNERS, Scene, SceneError, check_seed,
-                    check_time_limit, load_scene)
+from .scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS, Scene, SceneError,
+                    check_seed, check_time_limit, load_scene)
 from .search import plan
 from .verify import Verification, verify
 
@@ -44,6 +45,8 @@ def _parser() -> argparse.ArgumentParser:
                    help=f"planning time limit in seconds (at most {MAX_TIME_LIMIT:g})")
     p.add_argument("--seed", type=int, metavar="N",
                    help=f"random seed (1..{MAX_SEED}); the same seed gives the same plan")
+    p.add_argument("--regions", choices=REGIONS,
+                   help=f"stable pushes: procedure STABLE or the exact region (default: the scene's, else {DEFAULT_REGIONS})")
     p.add_argument("--out", metavar="DIR", help="output folder (default: logs/<name>-<timestamp>/)")
     p.add_argument("--verify", type=int, metavar="N",
                    help="re-simulate the plan under N support distributions; exit 3 if a push slips")
@@ -72,6 +75,8 @@ def _run(args: argparse.Namespace) -> int:
     if args.plan is not None and args.verify is None:
         raise SceneError("--plan", "needs --verify N: a plan file is only read to be verified")
     scene = load_scene(args.scene)
+    if args.regions:  # the search, the one-step check and the recording all read it from the scene
+        scene = replace(scene, planner=replace(scene.planner, regions=args.regions))
     name = args.planner or scene.planner.name
     limit = limit or scene.planner.time_limit
     seed = seed or scene.planner.seed

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -61,3 +64,13 @@ def test_stable_regions_plan_only_with_stable_pushes():
         assert region.contains(seg.twist)
     with pytest.raises(SceneError, match="regions"):
         plan(scene, seed=1, regions="approximate")
+
+
+def test_regions_flag_overrides_the_scene(tmp_path):
+    run = subprocess.run([str(Path(sys.executable).parent / "plan"), "scenes/nonconvex.yaml", "--regions", "stable",
+                          "--seed", "1", "--out", str(tmp_path)], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 0, run.stderr
+    scene = load_scene(ROOT / "scenes" / "nonconvex.yaml")
+    segments = json.loads((tmp_path / "nonconvex.json").read_text())["segments"]
+    region = stable_region(scene.slider, segments[0]["edge"], scene.pusher.mu, scene.pusher.width)
+    assert all(region.contains(s["twist"]) for s in segments)
