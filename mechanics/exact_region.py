@@ -16,8 +16,17 @@ Construction, in the push plane (:mod:`.push_plane`), where the set is a bounded
    boundary and the edge of Theorem 4's strip (or a distance far beyond any stable push).
 3. The vertices are pulled back towards ``S`` by ``margin`` of their reach beyond it, and every
    vertex and ``checks`` points on every edge between neighbouring rays are certified P; an edge
-   with a failure has both its vertices pulled halfway back to ``S``, until all pass.
+   with a failure gets a new ray in its middle (the region can be far from convex), and one that
+   still fails at the finest spacing has both its vertices pulled halfway back to ``S``, until
+   all pass.
 4. The region is that star-shaped polygon united with ``S``.
+
+**Robustness (Lynch 1992, §6).** A friction coefficient known only within an interval gives the
+region of its lowest value (sticking there implies sticking above it). A CF known only within a
+disk is a linear constraint on the distribution's centre (:class:`~.support.SupportModel`
+``cf_radius``): the certified verdicts then hold for every CF in the disk. STABLE's region, drawn
+for the nominal CF, is then not trusted: the trace starts from its centroid and certifies
+everything.
 
 What is guaranteed: every twist on the boundary samples checked in step 3 is certified P (a
 discretised distribution cannot produce a false P, :mod:`.force_status`); between samples the
@@ -68,12 +77,15 @@ class ExactRegion:
     """The exact stable pushes of one edge, with the interface of :class:`~.stable.StableRegion`.
 
     ``polygon`` is the region's section in the push plane (:attr:`plane`), star-shaped about
-    ``centre``; ``stable`` is procedure STABLE's region for the same edge (contained in this one).
+    ``centre``; ``stable`` is procedure STABLE's region for the same edge (at the lowest friction
+    and the nominal CF; contained in this one when the CF is known); ``cf_radius`` the radius of
+    the CF's uncertainty disk the region allows for.
     """
 
     stable: StableRegion
-    polygon: shapely.Polygon
+    polygon: shapely.Geometry
     centre: np.ndarray
+    cf_radius: float = 0.0
 
     edge = property(lambda self: self.stable.edge)
     contact = property(lambda self: self.stable.contact)
@@ -82,13 +94,22 @@ class ExactRegion:
     cf = property(lambda self: self.stable.cf)
     scale = property(lambda self: self.stable.scale)
     plane = property(lambda self: self.stable.plane)
-    #: Every stable translation is one of STABLE's (Lynch & Mason 1996, §3.3.1).
-    translation_range = property(lambda self: self.stable.translation_range)
-    is_empty = property(lambda self: self.stable.is_empty)
+    is_empty = property(lambda self: self.polygon.is_empty)
 
     @cached_property
-    def _tolerance(self) -> float:
-        return 1e-9 * (1.0 + float(np.max(np.abs(self.polygon.bounds)))) if not self.is_empty else 0.0
+    def translation_range(self) -> tuple[float, float] | None:
+        """Angles from the normal (positive tilted towards ``-t``) of the stable translations.
+
+        With a known CF they are STABLE's (it finds every stable translation, Lynch & Mason 1996,
+        §3.3.1); with an uncertain one, the region's chord along ``w = 0``.
+        """
+        if self.cf_radius == 0 or self.is_empty:
+            return self.stable.translation_range if not self.is_empty else None
+        chord = self.polygon.intersection(shapely.LineString([(-1e9, 0.0), (1e9, 0.0)]))
+        if chord.is_empty:
+            return None
+        s_lo, _, s_hi, _ = chord.bounds
+        return float(np.arctan(-s_hi)), float(np.arctan(-s_lo))  # s = -tan(angle)
 
     def contains(self, twist: ArrayLike, tol: float = 1e-9) -> np.ndarray:
         """Whether each slider-frame twist (shape ``(..., 3)``, any positive scale) is stable.
@@ -151,8 +172,9 @@ class ExactRegion:
 def exact_region(
     slider: Slider,
     edge: int,
-    mu: float,
+    mu: float | tuple[float, float],
     width: float | None = None,
+    cf_radius: float = 0.0,
     rays: int = 48,
     steps: int = 12,
     margin: float = 0.02,
@@ -162,14 +184,23 @@ def exact_region(
 
     Parameters
     ----------
-    slider, edge, mu, width
+    slider, edge, width
         As for :func:`~.stable.stable_region`.
+    mu : float or (float, float)
+        Pusher-slider friction, or an interval holding it (Lynch 1992, §6). Sticking is force
+        possible for every value once it is at the lowest, whose friction cone lies inside the
+        others', so an interval's region is exactly its lowest value's.
+    cf_radius : float
+        Radius of a disk about the slider's CF holding the true CF (§6); the region is then stable
+        for every CF in it (:class:`~.support.SupportModel`). STABLE is no longer an inner bound, so
+        every point of the trace is certified, from STABLE's centroid out.
     rays : int
-        Rays of the search from STABLE's centroid (at least 8).
+        Rays of the search (at least 8).
     steps : int
         Bisection steps per ray.
     margin : float
-        Fraction of each vertex's reach beyond STABLE's region given up as a safety margin.
+        Fraction of each vertex's reach (beyond STABLE's region, or from the centre) given up as a
+        safety margin.
     checks : int
         Points certified on each boundary edge between neighbouring rays, besides the vertices.
 
@@ -180,70 +211,104 @@ def exact_region(
     >>> off_centre = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]], cf=[0.9, 0.5])
     >>> exact_region(off_centre, 0, 0.5, width=0.5).is_empty
     True
+
+    Friction known only within [0.4, 0.6] gives the region of 0.4; a CF known within 5 cm shrinks it:
+
+    >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+    >>> loose = exact_region(block, 0, (0.4, 0.6), rays=16)
+    >>> loose.polygon.equals(exact_region(block, 0, 0.4, rays=16).polygon)
+    True
+    >>> bool(exact_region(block, 0, 0.5, cf_radius=0.05, rays=16).polygon.area < exact_region(block, 0, 0.5, rays=16).polygon.area)
+    True
     """
-    stable = stable_region(slider, edge, mu, width)
+    mu_lo, mu_hi = (float(mu), float(mu)) if np.isscalar(mu) else (float(min(mu)), float(max(mu)))
+    if not 0 < mu_lo <= mu_hi:
+        raise ValueError(f"mu must be > 0 (an interval: low <= high), got {mu}")
+    if not cf_radius >= 0:
+        raise ValueError(f"cf_radius must be >= 0, got {cf_radius}")
+    stable = stable_region(slider, edge, mu_lo, width)
     if stable.is_empty:
-        return ExactRegion(stable, shapely.Polygon(), np.zeros(2))
+        return ExactRegion(stable, shapely.Polygon(), np.zeros(2), cf_radius)
     if rays < 8:
         raise ValueError(f"rays must be at least 8, got {rays}")
     inner, centre = stable.section()
     if not (isinstance(inner, shapely.Polygon) and inner.area > 0):  # translations only: nothing to trace
-        return ExactRegion(stable, inner, centre)
+        return ExactRegion(stable, inner, centre, cf_radius)
     plane = stable.plane
-    cone = contact_wrench_cone(ContactConfiguration.slider_edge(slider, edge, mu, width), "s" * 2)
-    support = SupportModel.of_slider(slider, "footprint")
+    cone = contact_wrench_cone(ContactConfiguration.slider_edge(slider, edge, mu_lo, width), "s" * 2)
+    support = SupportModel.of_slider(slider, "footprint", cf_radius=cf_radius)
     w_lo, w_hi = plane.theorem4_strip(slider.vertices)
+    trusted = cf_radius == 0  # STABLE's region is proven only for a known CF
 
     def stable_at(points: np.ndarray) -> np.ndarray:
-        """Certified P, strictly inside Theorem 4's strip, or inside STABLE's region."""
+        """Certified P, strictly inside Theorem 4's strip, or (if trusted) inside STABLE's region."""
         points = np.atleast_2d(points)
-        known = stable.contains(plane.twists(points))
+        known = stable.contains(plane.twists(points)) if trusted else np.zeros(len(points), dtype=bool)
         out = []
         for p, k in zip(points, known):
             out.append(bool(k) or (w_lo < p[1] < w_hi
                                    and force_status(plane.twists(p), cone, support).status == "P"))
         return np.array(out)
 
-    angles = 2 * np.pi * np.arange(rays) / rays
-    directions = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    if not trusted and not stable_at(centre)[0]:
+        return ExactRegion(stable, shapely.Polygon(), np.zeros(2), cf_radius)
     size = max(float(np.ptp(np.asarray(inner.bounds).reshape(2, 2), axis=0).max()), 1e-9)
-    base = np.empty(rays)
-    reach = np.empty(rays)
-    for k, e in enumerate(directions):
-        ray = shapely.LineString([centre, centre + 2 * _REACH * size * e])
-        base[k] = inner.intersection(ray).length  # STABLE's boundary along the ray
+
+    def along(angle: float) -> np.ndarray:
+        # Exact zeros on the axes: a ray along w = 0 must stay on the translations, not turn
+        # about centres 1e16 away.
+        return np.where(np.abs(e := np.array([np.cos(angle), np.sin(angle)])) < 1e-12, 0.0, e)
+
+    def trace(angle: float) -> list[float]:
+        """``[base, reach]`` of the ray at ``angle``: where STABLE's region ends (or 0) and the
+        last certified point found by bisection, less the margin."""
+        e = along(angle)
+        base = inner.intersection(shapely.LineString([centre, centre + 2 * _REACH * size * e])).length if trusted else 0.0
         cap = _REACH * size
-        if e[1] > 0:
-            cap = min(cap, (w_hi - centre[1]) / e[1])
-        elif e[1] < 0:
-            cap = min(cap, (w_lo - centre[1]) / e[1])
-        lo, hi = base[k], cap * (1 - 1e-9)
+        if e[1] != 0:
+            cap = min(cap, ((w_hi if e[1] > 0 else w_lo) - centre[1]) / e[1])
+        lo, hi = base, cap * (1 - 1e-9)
         if stable_at(centre + hi * e)[0]:
             lo = hi
         else:
             for _ in range(steps):
                 mid = (lo + hi) / 2
                 lo, hi = (mid, hi) if stable_at(centre + mid * e)[0] else (lo, mid)
-        reach[k] = base[k] + (1 - margin) * (lo - base[k])
-    # Certify vertices and edges; pull back the ends of any edge with a failure.
+        return [base, base + (1 - margin) * (lo - base)]
+
+    found = {a: trace(a) for a in 2 * np.pi * np.arange(rays) / rays}
+    # Certify every vertex and ``checks`` points of every edge. A failing edge gets a ray of its
+    # own in the middle (down to 1/16 of the initial spacing), then, if still failing, has its
+    # ends pulled halfway back to their base.
+    finest = 2 * np.pi / rays / 16
     fractions = np.arange(checks + 1) / (checks + 1)
-    pending = set(range(rays))
+    pending = set(found)
     while pending:
-        failed = set()
-        for k in sorted(pending):
-            j = (k + 1) % rays
-            a, b = centre + reach[k] * directions[k], centre + reach[j] * directions[j]
-            samples = a + fractions[:, None] * (b - a)
-            if not np.all(stable_at(samples)):
-                failed |= {k, j}
-        for k in failed:
-            reach[k] = base[k] + 0.5 * (reach[k] - base[k])
-            if reach[k] - base[k] < 1e-6 * size:
-                reach[k] = base[k]
-        # Edges touching a moved vertex are checked again (an edge between two STABLE points
-        # lies in STABLE's convex region and cannot fail).
-        pending = {i for k in failed for i in ((k - 1) % rays, k)}
-        pending = {k for k in pending if reach[k] > base[k] or reach[(k + 1) % rays] > base[(k + 1) % rays]}
-    traced = shapely.Polygon(centre + reach[:, None] * directions)
-    polygon = shapely.union_all([traced.buffer(0), inner.buffer(0)])
-    return ExactRegion(stable, polygon, np.asarray(centre, dtype=float))
+        keys = sorted(found)
+        following = dict(zip(keys, keys[1:] + keys[:1]))
+        preceding = {b: a for a, b in following.items()}
+        grown = set()
+        for a in sorted(pending & set(keys)):
+            b = following[a]
+            ends = [centre + found[k][1] * along(k) for k in (a, b)]
+            if np.all(stable_at(ends[0] + fractions[:, None] * (ends[1] - ends[0]))):
+                continue
+            gap = (b - a) % (2 * np.pi)
+            if gap > finest:
+                mid = (a + gap / 2) % (2 * np.pi)
+                found[mid] = trace(mid)
+                grown |= {a, mid}
+                continue
+            for k in (a, b):
+                base, reach = found[k]
+                found[k][1] = base if reach - base < 1e-6 * size else base + 0.5 * (reach - base)
+            grown |= {preceding[a], a, b}
+        # An edge between two base points lies in STABLE's convex region (or is the certified
+        # centre) and cannot fail.
+        keys = sorted(found)
+        following = dict(zip(keys, keys[1:] + keys[:1]))
+        pending = {a for a in grown if found[a][1] > found[a][0] or found[following[a]][1] > found[following[a]][0]}
+    keys = sorted(found)
+    traced = shapely.Polygon([centre + found[k][1] * along(k) for k in keys]).buffer(0)
+    polygon = shapely.union_all([traced, inner.buffer(0)]) if trusted else traced
+    return ExactRegion(stable, polygon, np.asarray(centre, dtype=float), cf_radius)

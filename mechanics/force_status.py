@@ -22,7 +22,8 @@ open is reported as U (never wrongly P or I), and :attr:`Verdict.consistent` say
 remain possible.
 
 A translation needs no samples: every distribution gives the same load, through the CF, so it is
-P or I, never U (§3.4).
+P or I, never U (§3.4). (With an uncertain CF the loads of a translation form a segment, which can
+be U.)
 
 **Ray search (§3.4).** Along a ray from the CF the COR moves from the CF (a pure rotation about
 it) to infinity (a translation), and the paper's status follows one of four patterns: always I,
@@ -91,6 +92,26 @@ def _status_at(twist: np.ndarray, cone: Cone, support: SupportModel, level: int)
     return consistent
 
 
+def _translation_status(v: np.ndarray, cone: Cone, support: SupportModel) -> Verdict:
+    """A translation's load is the unit force along it through the CF, whatever the distribution;
+    with the CF anywhere in a disk of radius ``rho`` its moment spans ``m0 +- rho``: a segment of
+    loads, P when all of it lies in the cone, I when none does (each row cuts the segment once)."""
+    load = unit_loads(v, support.cf)
+    if support.cf_radius == 0:
+        return Verdict(*("PP" if cone.contains(load) else "II"), 0)
+    ends = load + np.array([[0.0, 0.0, -support.cf_radius], [0.0, 0.0, support.cf_radius]])
+    if cone.contains(ends).all():
+        return Verdict("P", "P", 0)
+    lo, hi = 0.0, 1.0  # points (1 - s) ends[0] + s ends[1] of the segment in the cone
+    for a0, a1 in (cone.rows @ ends.T).tolist():
+        if a0 < 0 and a1 < 0:
+            return Verdict("I", "I", 0)
+        if a0 < 0 <= a1 or a1 < 0 <= a0:
+            cross = a0 / (a0 - a1)
+            lo, hi = (max(lo, cross), hi) if a0 < 0 else (lo, min(hi, cross))
+    return Verdict(*("UU" if lo <= hi else "II"), 0)  # an equality is a pair of opposite rows
+
+
 def force_status(twist: ArrayLike, cone: Cone, support: SupportModel, refinements: int = 1) -> Verdict:
     """Force status of the slider ``twist`` for a mode with composite wrench ``cone``.
 
@@ -118,8 +139,7 @@ def force_status(twist: ArrayLike, cone: Cone, support: SupportModel, refinement
     if len(cone.rows) == 0:  # the contact forces span the wrench space
         return Verdict("P", "P", 0)
     if v[2] == 0:
-        load = unit_loads(v, support.cf)
-        return Verdict(*("PP" if cone.contains(load) else "II"), 0)
+        return _translation_status(v, cone, support)
     if cone.dimension == 0:  # no contact force, and any motion needs one
         return Verdict("I", "I", 0)
     consistent = {"P", "U", "I"}

@@ -28,6 +28,13 @@ the LP's dual). :meth:`SupportLoads.upper_bound` bounds that supremum rigorously
 (second-order: the Hessian of ``y . g`` is bounded below away from the COR), so a discrete LP's
 dual solution gives a guaranteed bound on the continuum (see :mod:`mechanics.force_status`).
 
+**An uncertain CF** (Lynch 1992, §6): with ``cf_radius = rho > 0`` the distribution's centre may
+be anywhere in the disk of radius ``rho`` about the nominal CF. A distribution centred at ``c``
+then has ``y . L = integral of psi d mu - lam . (c - CF)``, so the bound above grows by exactly
+``rho |lam|``: the centroid constraint's uncertainty is one more linear term, and a P verdict
+holds for every CF in the disk. Sample distributions keep their centre in a 32-gon inscribed
+in the disk, so they stay admissible.
+
 A support point exactly at the COR does not slide: its static friction may point anywhere (with
 at most the sliding magnitude), the limit of pressure concentrated near the COR. The samples
 therefore include the COR with a fan of friction directions when the COR lies in ``S``.
@@ -53,6 +60,8 @@ __all__ = ["SupportCells", "SupportLoads", "SupportModel", "effective_cf", "supp
 
 #: Friction directions tried at a support point on the COR (the LP mixes them).
 COR_DIRECTIONS = 32
+#: Corners of the polygon inscribed in the CF's uncertainty disk that sample centres may reach.
+CF_DIRECTIONS = 32
 
 
 def unit_loads(twist: ArrayLike, points: ArrayLike) -> np.ndarray:
@@ -185,7 +194,8 @@ class SupportModel:
     Build with :meth:`disk`, :meth:`footprint` or :meth:`of_slider`. ``kind`` is ``'disk'`` or
     ``'footprint'``, ``radius`` the CF's distance to the farthest support point, ``polygon`` the
     footprint (``None`` for the disk). ``resolution`` is the number of grid cells across the radius
-    at refinement level 0; level ``k`` has ``2**k`` times more.
+    at refinement level 0; level ``k`` has ``2**k`` times more. ``cf_radius`` is the radius of the
+    CF's uncertainty disk (module docstring; 0: the CF is known).
 
     Examples
     --------
@@ -197,7 +207,11 @@ class SupportModel:
     [True, False]
     """
 
-    def __init__(self, kind: str, cf: ArrayLike, radius: float, polygon: shapely.Polygon | None, resolution: int):
+    def __init__(self, kind: str, cf: ArrayLike, radius: float, polygon: shapely.Polygon | None, resolution: int,
+                 cf_radius: float = 0.0):
+        if not cf_radius >= 0:
+            raise ValueError(f"cf_radius must be >= 0, got {cf_radius}")
+        self.cf_radius = float(cf_radius)
         self.kind = kind
         self.cf = np.asarray(cf, dtype=float)
         self.radius = float(radius)
@@ -206,33 +220,35 @@ class SupportModel:
         self._cells: dict[int, SupportCells] = {}
 
     def __repr__(self) -> str:
-        return f"SupportModel({self.kind!r}, cf={self.cf.tolist()}, radius={self.radius:g})"
+        extra = f", cf_radius={self.cf_radius:g}" if self.cf_radius else ""
+        return f"SupportModel({self.kind!r}, cf={self.cf.tolist()}, radius={self.radius:g}{extra})"
 
     @classmethod
-    def disk(cls, cf: ArrayLike, radius: float, resolution: int = 6) -> SupportModel:
+    def disk(cls, cf: ArrayLike, radius: float, resolution: int = 6, cf_radius: float = 0.0) -> SupportModel:
         """Any distribution in the disk of ``radius`` about ``cf``, centred at ``cf``."""
         if not radius > 0:
             raise ValueError(f"radius must be > 0, got {radius}")
         c = np.asarray(cf, dtype=float)
-        return cls("disk", c, radius, None, resolution)
+        return cls("disk", c, radius, None, resolution, cf_radius)
 
     @classmethod
-    def footprint(cls, vertices: ArrayLike, cf: ArrayLike, resolution: int = 6) -> SupportModel:
+    def footprint(cls, vertices: ArrayLike, cf: ArrayLike, resolution: int = 6, cf_radius: float = 0.0) -> SupportModel:
         """Any distribution on the polygon ``vertices``, centred at ``cf`` (inside it)."""
         polygon = shapely.Polygon(np.asarray(vertices, dtype=float))
         c = np.asarray(cf, dtype=float)
         if not (polygon.is_valid and polygon.contains(shapely.Point(c))):
             raise ValueError("the footprint must be a valid polygon with the CF inside")
         radius = float(np.max(np.linalg.norm(np.asarray(polygon.exterior.coords) - c, axis=1)))
-        return cls("footprint", c, radius, polygon, resolution)
+        return cls("footprint", c, radius, polygon, resolution, cf_radius)
 
     @classmethod
-    def of_slider(cls, slider: Slider, kind: str = "footprint", resolution: int = 6) -> SupportModel:
+    def of_slider(cls, slider: Slider, kind: str = "footprint", resolution: int = 6,
+                  cf_radius: float = 0.0) -> SupportModel:
         """The ``disk`` (radius :attr:`Slider.radius`) or ``footprint`` model of a slider."""
         if kind == "disk":
-            return cls.disk(slider.cf, slider.radius, resolution)
+            return cls.disk(slider.cf, slider.radius, resolution, cf_radius)
         if kind == "footprint":
-            return cls.footprint(slider.vertices, slider.cf, resolution)
+            return cls.footprint(slider.vertices, slider.cf, resolution, cf_radius)
         raise ValueError(f"support model must be 'disk' or 'footprint', got {kind!r}")
 
     def covers(self, points: ArrayLike) -> np.ndarray:
@@ -309,6 +325,9 @@ class SupportLoads:
         h, x = self.wrenches @ y, self.points - self.cf
         if self._cor_in_region:  # the best friction direction at the COR, exactly
             h, x = np.r_[h, np.linalg.norm(self._arm(y))], np.vstack([x, self.cor - self.cf])
+        if self.model.cf_radius > 0:  # the centre may move: one LP (module docstring)
+            _, lam, value = self.minimax(y[None])
+            return value, lam
         try:
             hull = ConvexHull(np.c_[x, h])
         except QhullError:  # flat (e.g. a translation: y . g is affine): the LP copes
@@ -331,17 +350,24 @@ class SupportLoads:
         k, n = len(rows), len(self.points)
         # Rows of points that do not move carry no "t" when the moving weight is normalised.
         t_column = np.where(self._moving | (not self._at_cf), -1.0, 0.0)
-        a_ub = np.c_[self.wrenches @ rows.T, self.points - self.cf, t_column]
+        a_ub = np.c_[self.wrenches @ rows.T, self.points - self.cf, t_column, np.zeros(n)]
+        rho = self.model.cf_radius
+        if rho > 0:
+            # u >= -e_j . lam for the inscribed polygon's corners e_j: the LP's dual lets the
+            # centre move to any point of that polygon, and the objective pays rho u for it.
+            angle = 2 * np.pi * np.arange(CF_DIRECTIONS) / CF_DIRECTIONS
+            e = np.stack([np.cos(angle), np.sin(angle)], axis=1)
+            a_ub = np.r_[a_ub, np.c_[np.zeros((CF_DIRECTIONS, k)), -e, np.zeros(CF_DIRECTIONS), -np.ones(CF_DIRECTIONS)]]
         res = linprog(
-            np.r_[np.zeros(k + 2), 1.0], A_ub=a_ub, b_ub=np.zeros(n),
-            A_eq=np.r_[np.ones(k), 0.0, 0.0, 0.0][None], b_eq=[1.0],
-            bounds=[(0, None)] * k + [(None, None)] * 3, method="highs",
+            np.r_[np.zeros(k + 2), 1.0, rho], A_ub=a_ub, b_ub=np.zeros(len(a_ub)),
+            A_eq=np.r_[np.ones(k), 0.0, 0.0, 0.0, 0.0][None], b_eq=[1.0],
+            bounds=[(0, None)] * k + [(None, None)] * 3 + [(0, None)], method="highs",
         )
         if res.status == 2 and self._at_cf:
             return np.full(k, np.nan), np.zeros(2), np.inf
         if res.status != 0:
             raise RuntimeError(f"support LP failed: {res.message}")
-        return res.x[:k], res.x[k:k + 2], float(res.x[-1])
+        return res.x[:k], res.x[k:k + 2], float(res.x[k + 2] + rho * res.x[-1])
 
     @cached_property
     def _cell_geometry(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -402,10 +428,12 @@ class SupportLoads:
         Weak duality: ``y . L(mu) = integral of psi d mu`` for any multiplier ``lam``, with
         ``psi(x) = y . g(x) + lam . (x - CF)``, so the supremum of ``psi`` over the region bounds
         it; that supremum is bounded cell by cell (second order away from the COR, first order
-        near it, where the static friction of a point at the COR may point anywhere).
+        near it, where the static friction of a point at the COR may point anywhere). An uncertain
+        CF adds ``cf_radius |lam|``.
         """
-        bounds, *_ = self._cell_bounds(np.asarray(y, dtype=float), np.asarray(lam, dtype=float))
-        return float(bounds.max())
+        lam = np.asarray(lam, dtype=float)
+        bounds, *_ = self._cell_bounds(np.asarray(y, dtype=float), lam)
+        return float(bounds.max()) + self.model.cf_radius * float(np.linalg.norm(lam))
 
     def is_negative(self, y: ArrayLike, lam: ArrayLike, tol: float = 0.0) -> bool:
         """Whether ``y . L < 0`` is guaranteed for every admissible distribution.
@@ -414,6 +442,9 @@ class SupportLoads:
         ``<= tol`` and ``psi`` falls away from it (then a distribution with any moving weight has
         ``y . L < 0``; one wholly at the COR is not a motion).
         """
-        bounds, touching, envelope, slope = self._cell_bounds(np.asarray(y, dtype=float), np.asarray(lam, dtype=float))
+        lam = np.asarray(lam, dtype=float)
+        bounds, touching, envelope, slope = self._cell_bounds(np.asarray(y, dtype=float), lam)
+        if self.model.cf_radius > 0:  # no exemption at the COR: the centre term is positive
+            return bool(np.all(bounds + self.model.cf_radius * float(np.linalg.norm(lam)) < 0))
         at_cor_ok = envelope <= tol and slope < 0
         return bool(np.all((bounds < 0) | (touching & at_cor_ok)))

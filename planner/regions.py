@@ -25,7 +25,7 @@ from .plan_file import write_atomic
 __all__ = ["cache_folder", "edge_region"]
 
 #: Bump when the exact region's construction changes, so old cache files are not used.
-_VERSION = 1
+_VERSION = 2
 
 _memory: dict[str, ExactRegion] = {}
 

@@ -17,10 +17,11 @@ atexit.register(_silence_nanobind_leak_report)
 
 
 @pytest.fixture(scope="session", autouse=True)
-def region_cache(request):
+def region_cache(request, tmp_path_factory):
     """Exact regions are cached on disk (planner.regions): keep the tests' copy in pytest's cache
     folder, not the user's, for this process and the ``plan`` commands it starts."""
-    folder = request.config.cache.mkdir("stablepush-regions")
+    cache = getattr(request.config, "cache", None)  # None with -p no:cacheprovider
+    folder = cache.mkdir("stablepush-regions") if cache else tmp_path_factory.mktemp("stablepush-regions")
     old = os.environ.get("STABLEPUSH_CACHE")
     os.environ["STABLEPUSH_CACHE"] = str(folder)
     yield folder

@@ -169,3 +169,83 @@ def test_no_stable_push_without_a_force_through_the_cf():
     assert region.is_empty
     assert not region.contains([[0.0, 1.0, 0.0], cor_to_twist([-3, 0.5], 1)]).any()
     assert region.extremal_twists().shape == (0, 3)
+
+
+# -- robustness (Lynch 1992, §6) -------------------------------------------------------------------
+
+def test_friction_interval_gives_its_lowest_value():
+    """A wider friction cone holds the narrower one, so sticking at the lowest mu implies sticking
+    above it: the interval's region is the lowest value's, inside the highest value's."""
+    g = PARTS["A"]
+    slider = Slider(g["vertices"], cf=g["cf"])
+    interval = exact_region(slider, 0, (0.4, 0.8), rays=RAYS)
+    low = exact_region(slider, 0, 0.4, rays=RAYS)
+    high = exact_region(slider, 0, 0.8, rays=RAYS)
+    assert interval.polygon.equals(low.polygon)
+    assert high.polygon.buffer(0.02).contains(interval.polygon)
+    with pytest.raises(ValueError, match="mu"):
+        exact_region(slider, 0, (0.0, 0.5))
+
+
+def disk_cfs(cf, rho, count=8):
+    angle = 2 * np.pi * np.arange(count) / count
+    return [np.asarray(cf, float)] + [cf + rho * np.array([np.cos(a), np.sin(a)]) for a in angle]
+
+
+@pytest.mark.parametrize("name, rho", [("A", 0.1), ("B", 0.05)])
+def test_uncertain_cf_region_is_sound_for_every_cf_in_the_disk(name, rho):
+    """Boundary and interior twists of the robust region pass the independent LP with the support
+    centred at the nominal CF and at points on the uncertainty disk's rim."""
+    g = PARTS[name]
+    region = exact_region(Slider(g["vertices"], cf=g["cf"]), g["edge"], g["mu"], cf_radius=rho, rays=RAYS)
+    polygon, centre = region.section()
+    assert polygon.area > 0
+    ring = polygon.exterior
+    points = shapely.get_coordinates(shapely.line_interpolate_point(ring, np.linspace(0, 1, 41)[:-1], normalized=True))
+    twists = region.plane.twists(np.vstack([points, centre + 0.5 * (points[::4] - centre)]))
+    assert region.contains(twists).all() and theorem4_ok(twists, g)
+    samples = O.support_samples(g["vertices"], 12)
+    for cf in disk_cfs(g["cf"], rho):
+        lp = O.LPOracle(O.Reference(g["vertices"], cf, g["edge"], g["mu"], g["width"]), samples)
+        worst = max(lp.max_violation(v) for v in twists)
+        assert worst <= 1e-9, (cf, worst)
+
+
+def test_uncertain_cf_shrinks_the_region_and_needs_to():
+    """More uncertainty, a smaller region, nested; the limit of no uncertainty is the known-CF
+    region; and pushes of the known-CF region left out fail for some CF in the disk."""
+    g = PARTS["A"]
+    slider = Slider(g["vertices"], cf=g["cf"])
+    known, _ = part("A")
+    tiny = exact_region(slider, 0, 0.5, cf_radius=1e-4, rays=RAYS)
+    small = exact_region(slider, 0, 0.5, cf_radius=0.05, rays=RAYS)
+    large = exact_region(slider, 0, 0.5, cf_radius=0.15, rays=RAYS)
+    areas = [r.polygon.area for r in (known, tiny, small, large)]
+    assert areas[1] >= 0.93 * areas[0] and areas[0] > areas[2] > areas[3]
+    for outer, inner in ((known, small), (small, large)):
+        assert outer.polygon.buffer(0.02).contains(inner.polygon)
+    # The known-CF region's corners that the rho = 0.15 region drops: most fail at some CF.
+    corners = np.asarray(known.polygon.exterior.coords)[:-1]
+    dropped = corners[~shapely.contains_xy(large.polygon.buffer(0.02), corners[:, 0], corners[:, 1])][::2]
+    assert len(dropped) >= 4
+    samples = O.support_samples(g["vertices"], 12)
+    oracles = [O.LPOracle(O.Reference(g["vertices"], cf, 0, 0.5), samples) for cf in disk_cfs(g["cf"], 0.15)]
+    fails = [max(lp.max_violation(v) for lp in oracles) > 1e-9 for v in known.plane.twists(dropped)]
+    assert np.mean(fails) >= 0.5, fails
+
+
+def test_uncertain_cf_translations_match_the_hand_derived_range():
+    """A 2 x 1 block pushed by a 0.5-wide face, mu = 1, CF (0, 0.5) known within rho = 0.1. The
+    line of the push through any CF c of the disk must cross the face: with tau = tan(angle) and
+    h = 0.5 the CF's height, 0.5 |tau| + rho sqrt(1 + tau^2) <= 0.25, so tau <= 0.2917 (16.26 deg)
+    instead of 0.5 (26.57 deg) for a known CF; friction (|tau| <= 1) does not bind."""
+    from scipy.optimize import brentq
+
+    slider = Slider(RECT, cf=[0.0, 0.5])
+    region = exact_region(slider, 0, 1.0, width=0.5, cf_radius=0.1, rays=RAYS)
+    tau = brentq(lambda x: 0.5 * x + 0.1 * np.sqrt(1 + x * x) - 0.25, 0.0, 0.5)
+    lo, hi = region.translation_range
+    assert np.tan(hi) <= tau + 1e-9 and np.tan(hi) >= 0.95 * tau
+    assert np.tan(-lo) <= tau + 1e-9 and np.tan(-lo) >= 0.95 * tau
+    known = exact_region(slider, 0, 1.0, width=0.5, rays=RAYS)
+    np.testing.assert_allclose(np.tan(known.translation_range), [-0.5, 0.5])
