@@ -26,6 +26,19 @@ segments. Frames are ``FRAMES_PER_RADIUS`` per slider radius of point travel, at
   a square of half-side 4 slider radii about the CF and carried with the slider (no strip where
   a region is empty).
 
+The pushed edge's mechanics (Lynch 1992's figures 11 and 14 for this part), static, in the
+slider frame, for a plan with segments:
+
+* ``/analysis/part`` -- the slider's outline at the origin of its frame, and ``/analysis/contact``
+  the pushed contact segment;
+* ``/analysis/stable/{ccw,cw}`` -- procedure STABLE's COR regions; ``/analysis/exact/{ccw,cw}``
+  the exact regions (contain STABLE's; :mod:`mechanics.exact_region`);
+* ``/analysis/sticking/{ccw,cw}/{P,U,I}`` -- the force status of sticking (both ends) for every
+  COR of each sense (:func:`mechanics.force_status_regions`, ``ANALYSIS_RAYS`` rays);
+* ``/analysis/cor`` -- ``Points2D``, the centres of rotation of the plan's pushes inside the window.
+
+All COR regions are clipped to a square of half-side 4 slider radii about the CF.
+
 With a :class:`~planner.verify.Verification` (``plan --verify``), also:
 
 * ``/world/ghost`` -- the slider's outline as simulated under each push's worst support
@@ -35,7 +48,8 @@ With a :class:`~planner.verify.Verification` (``plan --verify``), also:
 * ``/log/verify`` -- ``TextLog``, the verification's summary line (``WARN`` when it failed).
 
 Styles (colours, line widths in UI points) are logged statically on the animated entities. The
-default blueprint shows ``/world`` in a 2-D view bounded by the workspace, above the text log.
+default blueprint shows ``/world`` in a 2-D view bounded by the workspace beside ``/analysis``,
+above the text log.
 """
 
 from __future__ import annotations
@@ -48,7 +62,8 @@ import rerun.blueprint as rrb
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import exp_twist, twist_to_cor
+from mechanics import (ContactConfiguration, SupportModel, contact_wrench_cone, exp_twist, force_status_regions,
+                       stable_region, twist_to_cor)
 
 from .bodies import pusher_polygon
 from .plan_file import Plan, atomic_path
@@ -56,7 +71,7 @@ from .pushes import edge_pushes
 from .scene import Scene
 from .verify import Verification
 
-__all__ = ["FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS", "write_recording"]
+__all__ = ["ANALYSIS_RAYS", "FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS", "write_recording"]
 
 #: Animation frames while a body point travels one slider radius (fewer if that exceeds MAX_FRAMES).
 FRAMES_PER_RADIUS = 20
@@ -66,11 +81,14 @@ MAX_FRAMES = 600
 PATH_POINTS = 100
 #: Most frames per push at which the simulated ghost is drawn (each costs a simulation).
 GHOST_SAMPLES = 10
+#: Rays per sense of the sticking force-status map in ``/analysis`` (about a second's work).
+ANALYSIS_RAYS = 16
 
 _THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0.5, 1.0, 2.0, 4.0]))
 _GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
 _SLIDER, _GOAL, _CF = [40, 110, 220], [40, 170, 70], [90, 160, 255]
 _CCW, _CW, _COR, _GHOST = [20, 170, 150], [230, 130, 20], [210, 40, 190], [140, 60, 230]
+_STATUS = {"P": [40, 170, 70], "U": [230, 190, 40], "I": [200, 50, 50]}
 
 
 def _closed(points: ArrayLike) -> np.ndarray:
@@ -161,6 +179,38 @@ def _outline(region: shapely.Geometry) -> np.ndarray | None:
     return np.asarray(region.exterior.coords) if isinstance(region, shapely.Polygon) and region.area > 0 else None
 
 
+def _rings(geometry: shapely.Geometry) -> list[np.ndarray]:
+    """Closed outer rings of every polygon of ``geometry`` with area."""
+    parts = getattr(geometry, "geoms", [geometry])
+    return [np.asarray(g.exterior.coords) for g in parts if isinstance(g, shapely.Polygon) and g.area > 0]
+
+
+def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
+    """``/analysis``: the pushed edge's regions in the slider frame (module docstring)."""
+    slider, p = scene.slider, scene.pusher
+    edge = plan.segments[0].edge
+    window = (*(slider.cf - 4 * slider.radius), *(slider.cf + 4 * slider.radius))
+    exact = next(push.region for push in edge_pushes(scene) if push.edge == edge)
+    regions = {"stable": stable_region(slider, edge, p.mu, p.width).cor_polygons(window),
+               "exact": exact.cor_polygons(window)}
+    config = ContactConfiguration.slider_edge(slider, edge, p.mu, p.width)
+    status = force_status_regions(contact_wrench_cone(config, "ss"), SupportModel.of_slider(slider), window,
+                                  rays=ANALYSIS_RAYS, steps=6, refinements=0)
+    rec.log("analysis/part", rr.LineStrips2D([_closed(slider.vertices)], colors=_SLIDER, radii=_BOLD), static=True)
+    rec.log("analysis/contact", rr.LineStrips2D([config.points], colors=_DARK, radii=_BOLD), static=True)
+    for name, width in (("stable", _BOLD), ("exact", _LINE)):
+        for side, colour in (("ccw", _CCW), ("cw", _CW)):
+            rings = _rings(regions[name][1 if side == "ccw" else -1])
+            rec.log(f"analysis/{name}/{side}", rr.LineStrips2D(rings, colors=colour, radii=width), static=True)
+    for side, sense in (("ccw", 1), ("cw", -1)):
+        for label, colour in _STATUS.items():
+            rings = _rings(status[sense][label])
+            rec.log(f"analysis/sticking/{side}/{label}", rr.LineStrips2D(rings, colors=colour, radii=_THIN), static=True)
+    cors = [c for c, sense in map(twist_to_cor, (s.twist for s in plan.segments)) if sense != 0]
+    inside = [c for c in cors if shapely.box(*window).contains(shapely.Point(c))]  # far ones would zoom the view out
+    rec.log("analysis/cor", rr.Points2D(inside or np.zeros((0, 2)), colors=_COR, radii=_DOT), static=True)
+
+
 def _log_ghost(rec: rr.RecordingStream, verification: Verification, index: np.ndarray, times: np.ndarray) -> None:
     """``/world/ghost`` at up to ``GHOST_SAMPLES`` of each push's frames, and ``/log/verify``."""
     frames, poses = [], []
@@ -245,8 +295,11 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
     """
     xmin, ymin, xmax, ymax = scene.workspace
     blueprint = rrb.Blueprint(rrb.Vertical(
-        rrb.Spatial2DView(origin="/world", name=scene.name,
-                          visual_bounds=rrb.VisualBounds2D(x_range=[xmin, xmax], y_range=[ymin, ymax])),
+        rrb.Horizontal(
+            rrb.Spatial2DView(origin="/world", name=scene.name,
+                              visual_bounds=rrb.VisualBounds2D(x_range=[xmin, xmax], y_range=[ymin, ymax])),
+            rrb.Spatial2DView(origin="/analysis", name="pushed edge (slider frame)"),
+            column_shares=[3, 2]),
         rrb.TextLogView(origin="/log", name="summary"),
         row_shares=[6, 1]))
     with atomic_path(path) as tmp:
@@ -257,6 +310,7 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
             _log_static(rec, scene, plan)
             if plan.segments:
                 index, times = _log_motion(rec, scene, plan)
+                _log_analysis(rec, scene, plan)
                 if verification is not None:
                     _log_ghost(rec, verification, index, times)
         finally:

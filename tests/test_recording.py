@@ -35,6 +35,9 @@ TURN = math.radians(30.0)
 
 STATIC = {"/log", "/world/workspace", "/world/obstacles", "/world/start", "/world/goal", "/world/tree"}
 ANIMATED = {"/world/slider", "/world/pusher", "/world/cf_path", "/world/cor", "/world/stable/ccw", "/world/stable/cw"}
+ANALYSIS = {"/analysis/part", "/analysis/contact", "/analysis/cor", "/analysis/stable/ccw", "/analysis/stable/cw",
+            "/analysis/exact/ccw", "/analysis/exact/cw"} | {
+            f"/analysis/sticking/{side}/{s}" for side in ("ccw", "cw") for s in "PUI"}
 
 
 def write_scene(folder: Path, name: str, goal: list[float], start: list[float] = (0.0, 0.0, 0.0)) -> planner.Scene:
@@ -130,7 +133,7 @@ def turn(tmp_path_factory):
 def test_the_file_is_complete_and_has_every_entity(straight):
     _, plan, path = straight
     verify(path)
-    assert entities(path) == STATIC | ANIMATED
+    assert entities(path) == STATIC | ANIMATED | ANALYSIS
     assert RrdReader(str(path)).recordings()[0].recording_id == f"straight-{plan.planner}-seed1"
 
 
@@ -279,3 +282,33 @@ def test_a_failed_write_keeps_the_old_file_and_leaves_no_temporary(straight, tmp
     assert renamed == [path.read_bytes()]
     verify(path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["straight.rrd"]
+
+
+def strips(path: Path, entity: str) -> list[np.ndarray]:
+    (_, value), = rrd_rows(path, entity, "LineStrips2D:strips")
+    return [np.asarray(v, dtype=float) for v in value]
+
+
+def test_the_analysis_shows_the_pushed_edge_in_the_slider_frame(turn):
+    """The part at the origin of its frame, the pushed face (edge 3, x = -0.04, the central 5 cm),
+    STABLE's COR regions inside the exact ones, and the plan's turn about COR inside the exact CCW
+    region and the CCW sticking P region, and in the CW I region (turning the other way about it
+    would pull the part off the pusher)."""
+    scene, plan, path = turn
+    np.testing.assert_allclose(strips(path, "/analysis/part")[0], closed(SLIDER))
+    (contact,) = strips(path, "/analysis/contact")
+    np.testing.assert_allclose(sorted(map(tuple, contact)), [(-0.04, -0.025), (-0.04, 0.025)], atol=1e-12)
+    for side in ("ccw", "cw"):
+        exact = shapely.union_all([shapely.Polygon(r) for r in strips(path, f"/analysis/exact/{side}")])
+        stable = shapely.union_all([shapely.Polygon(r) for r in strips(path, f"/analysis/stable/{side}")])
+        assert stable.area > 0 and exact.buffer(1e-9).contains(stable) and exact.area > 1.05 * stable.area
+    (_, points), = rrd_rows(path, "/analysis/cor", "Points2D:positions")
+    np.testing.assert_allclose(points, [COR], atol=1e-9)
+    centre = shapely.Point(COR)
+    def region(entity):
+        return shapely.union_all([shapely.Polygon(r) for r in strips(path, entity)])
+
+    assert region("/analysis/exact/ccw").contains(centre) and not region("/analysis/exact/cw").contains(centre)
+    assert region("/analysis/sticking/ccw/P").contains(centre)
+    assert not region("/analysis/sticking/ccw/I").contains(centre)
+    assert region("/analysis/sticking/cw/I").contains(centre)
