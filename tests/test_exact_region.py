@@ -263,3 +263,30 @@ def test_invariant_under_rigid_motion_and_scaling(angle, shift, scale):
     here = exact_region(Slider(g["vertices"], cf=g["cf"]), 0, 0.5, rays=16).polygon
     there = exact_region(Slider(move(g["vertices"]), cf=move(g["cf"])), 0, 0.5, rays=16).polygon
     assert here.symmetric_difference(there).area <= (0.1 if angle else 0.01) * here.area
+
+
+def test_the_simulator_sticks_on_the_exact_regions_corners():
+    """The most aggressive exact pushes (the corners of the region's hull, which STABLE rejects)
+    stick under grid, random and extreme two- and three-point distributions in the independent
+    quasi-static simulator (mechanics.quasistatic knows nothing of stable regions), and pushes 10 %
+    beyond the region's boundary slip or separate under some of them."""
+    from mechanics.quasistatic import Contact, dipod_supports, grid_support, random_support, solve_step, tripod_supports
+
+    g = PARTS["A"]
+    region, stable = part("A")
+    corners = region.extremal_twists()
+    beyond = corners[~stable.contains(corners)]
+    assert len(beyond) >= 6
+    block = shapely.Polygon(g["vertices"])
+    rng = np.random.default_rng(3)
+    supports = ([grid_support(block, 60, cf=g["cf"])] + [random_support(block, 40, rng, cf=g["cf"]) for _ in range(4)]
+                + dipod_supports(block, g["cf"], 16) + tripod_supports(block, g["cf"], 16, rng))
+    line = [Contact([-1.0, 0.0], [0.0, 1.0], 0.5), Contact([1.0, 0.0], [0.0, 1.0], 0.5)]
+    for twist in beyond:
+        for support in supports:
+            assert solve_step(support, line, twist).sticks, (twist, support)
+    polygon, centre = region.section()
+    ring = np.asarray(polygon.exterior.coords)[:-1:3]
+    outside = region.plane.twists(centre + 1.1 * (ring - centre))
+    slips = [not all(solve_step(support, line, twist).sticks for support in supports) for twist in outside]
+    assert np.mean(slips) >= 0.75, slips
