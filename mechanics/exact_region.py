@@ -212,7 +212,7 @@ def exact_region(
     >>> exact_region(off_centre, 0, 0.5, width=0.5).is_empty
     True
 
-    Friction known only within [0.4, 0.6] gives the region of 0.4; a CF known within 5 cm shrinks it:
+    Friction known only within [0.4, 0.6] gives the region of 0.4; a CF known only within 0.05 shrinks it:
 
     >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
     >>> loose = exact_region(block, 0, (0.4, 0.6), rays=16)
@@ -233,7 +233,8 @@ def exact_region(
         raise ValueError(f"rays must be at least 8, got {rays}")
     inner, centre = stable.section()
     if not (isinstance(inner, shapely.Polygon) and inner.area > 0):  # translations only: nothing to trace
-        return ExactRegion(stable, inner, centre, cf_radius)
+        # ...and with an uncertain CF not even those are proven: give none.
+        return ExactRegion(stable, inner if cf_radius == 0 else shapely.Polygon(), centre, cf_radius)
     plane = stable.plane
     cone = contact_wrench_cone(ContactConfiguration.slider_edge(slider, edge, mu_lo, width), "s" * 2)
     support = SupportModel.of_slider(slider, "footprint", cf_radius=cf_radius)
