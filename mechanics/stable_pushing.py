@@ -48,7 +48,8 @@ def classify_goal(
     """``'guaranteed'``, ``'possible'`` or ``'impossible'``: pushing ``edge`` about ``twist``.
 
     ``twist`` is the pusher's (slider-frame) twist, e.g. ``COR_total``; ``support`` defaults to the
-    slider's footprint, ``width`` (the pusher's face) to the whole edge.
+    slider's footprint (with a ``cf_radius``, the answer holds for every CF in that disk),
+    ``width`` (the pusher's face) to the whole edge.
 
     Examples
     --------
@@ -62,10 +63,11 @@ def classify_goal(
     ['guaranteed', 'possible', 'impossible']
     """
     v = np.asarray(twist, dtype=float)
-    if mu > 0 and stable_region(slider, edge, mu, width).contains(v):
+    support = SupportModel.of_slider(slider) if support is None else support
+    # STABLE proves stability for the known CF only.
+    if mu > 0 and support.cf_radius == 0 and stable_region(slider, edge, mu, width).contains(v):
         return "guaranteed"
     config = ContactConfiguration.slider_edge(slider, edge, mu, width)
-    support = SupportModel.of_slider(slider) if support is None else support
     sticking = "s" * len(config)
     status = force_status(v, contact_wrench_cone(config, sticking), support).status
     if status == "I":

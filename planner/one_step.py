@@ -86,5 +86,5 @@ def goal_verdicts(scene: Scene, start: ArrayLike, goal: ArrayLike) -> dict[int, 
     total = log_pose(start, goal)
     if not np.any(total):  # no motion: no COR to classify
         return {}
-    p, support = scene.pusher, SupportModel.of_slider(scene.slider)
+    p, support = scene.pusher, SupportModel.of_slider(scene.slider, cf_radius=scene.cf_uncertainty)
     return {e: GOALS[classify_goal(scene.slider, e, p.mu, total, support, p.width)] for e in p.edges}

@@ -60,12 +60,16 @@ def edge_pushes(scene: Scene) -> list[EdgePush]:
     Raises
     ------
     SceneError
-        If no allowed edge has any (the friction cone of the contact cannot push through the CF).
+        If no allowed edge has any (the friction cone of the contact cannot push through the CF), or
+        if procedure STABLE is asked for with an uncertain CF.
     """
     p = scene.pusher
+    if scene.cf_uncertainty > 0 and scene.planner.regions == "stable":
+        raise SceneError("planner.regions", "procedure STABLE assumes a known CF; slider.cf_uncertainty needs "
+                                            "the exact regions")
     out = []
     for e in p.edges:
-        region = edge_region(scene.slider, e, p.mu, p.width, scene.planner.regions)
+        region = edge_region(scene.slider, e, p.mu, p.width, scene.planner.regions, scene.cf_uncertainty)
         if not region.is_empty:
             out.append(EdgePush(e, region, StableSteering(region), body_outline(scene.slider, e, p.width, p.depth)))
     if not out:

@@ -37,13 +37,14 @@ def cache_folder() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "stablepush"
 
 
-def _key(slider: Slider, edge: int, mu: float, width: float | None) -> str:
+def _key(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float) -> str:
     spec = {"version": _VERSION, "vertices": slider.vertices.tolist(), "cf": slider.cf.tolist(),
-            "edge": int(edge), "mu": float(mu), "width": None if width is None else float(width)}
+            "edge": int(edge), "mu": float(mu), "width": None if width is None else float(width),
+            "cf_radius": float(cf_radius)}
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
 
 
-def _read(path: Path, stable: StableRegion) -> ExactRegion | None:
+def _read(path: Path, stable: StableRegion, cf_radius: float) -> ExactRegion | None:
     try:
         data = json.loads(path.read_text())
         polygon = shapely.Polygon(np.asarray(data["polygon"], dtype=float))
@@ -52,24 +53,27 @@ def _read(path: Path, stable: StableRegion) -> ExactRegion | None:
         return None
     if not polygon.is_valid or polygon.area <= 0 or centre.shape != (2,):
         return None
-    return ExactRegion(stable, polygon, centre)
+    return ExactRegion(stable, polygon, centre, cf_radius)
 
 
 def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None,
-                method: str = "exact") -> StableRegion | ExactRegion:
-    """The ``method`` (``'stable'`` or ``'exact'``) stable region of ``edge``, cached as above."""
+                method: str = "exact", cf_radius: float = 0.0) -> StableRegion | ExactRegion:
+    """The ``method`` (``'stable'`` or ``'exact'``) stable region of ``edge``, cached as above;
+    ``cf_radius`` (exact only) makes it hold for every CF within that distance of the slider's."""
     stable = stable_region(slider, edge, mu, width)
     if method == "stable" or stable.is_empty:
+        if cf_radius > 0 and not stable.is_empty:
+            raise ValueError("procedure STABLE assumes a known CF: an uncertain one needs the exact regions")
         return stable
-    key = _key(slider, edge, mu, width)
+    key = _key(slider, edge, mu, width, cf_radius)
     if key in _memory:
         return _memory[key]
     path = cache_folder() / f"exact-{key}.json"
-    region = _read(path, stable)
+    region = _read(path, stable, cf_radius)
     if region is None:
-        region = exact_region(slider, edge, mu, width)
+        region = exact_region(slider, edge, mu, width, cf_radius=cf_radius)
         polygon, centre = region.section()
-        if isinstance(polygon, shapely.Polygon):  # a degenerate region is cheap: not stored
+        if isinstance(polygon, shapely.Polygon) and polygon.area > 0:  # a degenerate one is cheap: not stored
             try:
                 path.parent.mkdir(parents=True, exist_ok=True)
                 write_atomic(path, json.dumps({"polygon": np.asarray(polygon.exterior.coords).tolist(),

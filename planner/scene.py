@@ -42,10 +42,15 @@ _MAX_NAME_BYTES = 200
 
 @dataclass(frozen=True)
 class Pusher:
+    """The flat pusher. ``mu`` is the friction the plan relies on: the scene's value, or the low
+    end of its interval ``[mu, mu_high]`` (sticking at the lowest friction implies sticking at
+    any higher one, :func:`mechanics.exact_region`)."""
+
     width: float
     depth: float
     mu: float
     edges: tuple[int, ...]  # the edges that may be pushed
+    mu_high: float | None = None  # top of the friction interval, if one was given
 
 
 @dataclass(frozen=True)
@@ -71,6 +76,7 @@ class Scene:
     tolerance_angle: float = math.radians(2.0)
     planner: PlannerOptions = field(default_factory=PlannerOptions)
     path: str | None = None  # the file it was read from
+    cf_uncertainty: float = 0.0  # radius of the disk about slider.cf holding the true CF (metres)
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -153,7 +159,7 @@ def _obstacle(value: Any, name: str) -> shapely.Polygon:
 
 
 def _slider(value: Any) -> Slider:
-    spec = keys(value, "slider", ("vertices",), ("cf",))
+    spec = keys(value, "slider", ("vertices",), ("cf", "cf_uncertainty"))
     vertices = _points(spec["vertices"], "slider.vertices")
     _simple_polygon(vertices, "slider.vertices")
     # A repeated vertex makes an edge of no length, with no normal to push along; shapely accepts it.
@@ -179,9 +185,9 @@ def _pusher(value: Any, slider: Slider) -> Pusher:
     spec = keys(value, "pusher", ("width", "depth", "mu"), ("edges",))
     width = number(spec["width"], "pusher.width", positive=True)
     depth = number(spec["depth"], "pusher.depth", positive=True)
-    mu = number(spec["mu"], "pusher.mu", positive=True)
+    mu, mu_high = _friction(spec["mu"])
     if "edges" not in spec:
-        return Pusher(width, depth, mu, slider.pushable_edges)
+        return Pusher(width, depth, mu, slider.pushable_edges, mu_high)
     listed = spec["edges"]
     if not isinstance(listed, (list, tuple)) or not listed:
         raise SceneError("pusher.edges", "must be a non-empty list of edge indices")
@@ -195,7 +201,17 @@ def _pusher(value: Any, slider: Slider) -> Pusher:
         if e in edges:
             raise SceneError("pusher.edges", f"edge {e} is listed twice")
         edges.append(e)
-    return Pusher(width, depth, mu, tuple(edges))
+    return Pusher(width, depth, mu, tuple(edges), mu_high)
+
+
+def _friction(value: Any) -> tuple[float, float | None]:
+    """``pusher.mu``: a number > 0, or an interval ``[low, high]`` with ``0 < low <= high``."""
+    if not isinstance(value, (list, tuple)):
+        return number(value, "pusher.mu", positive=True), None
+    low, high = vector(value, "pusher.mu", 2)
+    if not 0 < low <= high:
+        raise SceneError("pusher.mu", f"an interval must be [low, high] with 0 < low <= high, got {list(value)}")
+    return float(low), float(high)
 
 
 def _pose(value: Any, name: str, slider: Slider, obstacles, workspace) -> np.ndarray:
@@ -216,6 +232,7 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
                  ("name", "obstacles", "tolerance", "planner"))
     name = _name(spec.get("name", default_name))
     slider = _slider(spec["slider"])
+    cf_uncertainty = _cf_uncertainty(spec["slider"], slider)
     pusher = _pusher(spec["pusher"], slider)
     obstacles_spec = [] if spec.get("obstacles") is None else spec["obstacles"]  # None: a bare "obstacles:"
     if not isinstance(obstacles_spec, list):
@@ -238,7 +255,18 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
         seed=check_seed(opts.get("seed", 1), "planner.seed"),
         regions=check_regions(opts.get("regions", DEFAULT_REGIONS), "planner.regions"),
     )
-    return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path)
+    return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path,
+                 cf_uncertainty)
+
+
+def _cf_uncertainty(spec: dict, slider: Slider) -> float:
+    """``slider.cf_uncertainty``: the radius (>= 0, less than the part's radius) of the disk about
+    the CF that holds the true CF."""
+    radius = number(spec.get("cf_uncertainty", 0.0), "slider.cf_uncertainty")
+    if not 0 <= radius < slider.radius:
+        raise SceneError("slider.cf_uncertainty", f"must be >= 0 and less than the part's radius "
+                                                  f"{slider.radius:.4g}, got {radius!r}")
+    return radius
 
 
 def _name(value: Any) -> str:

@@ -35,6 +35,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import shapely
 from numpy.typing import ArrayLike
 
 from mechanics import exp_twist, log_pose, wrap_angle
@@ -60,6 +61,8 @@ def distributions(scene: Scene, n: int, seed: int = 1) -> tuple[list[SupportDist
 
     One uniform grid, then about a third each of extreme dipods (at evenly spaced angles), extreme
     tripods and random distributions; the tripods and the random ones are drawn from ``seed``.
+    With ``slider.cf_uncertainty`` the centres move away from the CF: the dipods' and the tripods'
+    round the rim of the uncertainty disk, the random ones anywhere in it (the grid stays at the CF).
 
     >>> from planner import load_scene
     >>> supports, kinds = distributions(load_scene("scenes/battery.yaml"), 7)
@@ -70,13 +73,26 @@ def distributions(scene: Scene, n: int, seed: int = 1) -> tuple[list[SupportDist
     """
     if n < 1:
         raise ValueError(f"need at least one distribution, got {n}")
-    footprint, cf = scene.slider.polygon, scene.slider.cf
+    footprint, cf, rho = scene.slider.polygon, scene.slider.cf, scene.cf_uncertainty
     rng = np.random.default_rng(seed)
     extreme = (n - 1) // 3
-    supports = ([grid_support(footprint, GRID_POINTS, cf=cf)] + dipod_supports(footprint, cf, extreme)
-                + tripod_supports(footprint, cf, extreme, rng)
-                + [random_support(footprint, RANDOM_POINTS, rng, cf=cf) for _ in range(n - 1 - 2 * extreme)])
-    kinds = ["grid"] + ["dipod"] * extreme + ["tripod"] * extreme + ["random"] * (n - 1 - 2 * extreme)
+
+    def centre(angle: float, reach: float = 1.0) -> np.ndarray:
+        """A point of the uncertainty disk (the CF itself if that point is off the part)."""
+        c = cf + rho * reach * np.array([np.cos(angle), np.sin(angle)])
+        return c if footprint.contains(shapely.Point(c)) else cf
+
+    if rho == 0:
+        dipods, tripods = dipod_supports(footprint, cf, extreme), tripod_supports(footprint, cf, extreme, rng)
+    else:  # the k-th line angle through the k-th centre round the rim
+        dipods = [dipod_supports(footprint, centre(2 * np.pi * k / extreme), extreme)[k] for k in range(extreme)]
+        tripods = [tripod_supports(footprint, centre(rng.uniform(0, 2 * np.pi)), 1, rng)[0] for _ in range(extreme)]
+    randoms = n - 1 - 2 * extreme
+    supports = ([grid_support(footprint, GRID_POINTS, cf=cf)] + dipods + tripods
+                + [random_support(footprint, RANDOM_POINTS, rng,
+                                  cf=centre(rng.uniform(0, 2 * np.pi), np.sqrt(rng.uniform())) if rho else cf)
+                   for _ in range(randoms)])
+    kinds = ["grid"] + ["dipod"] * extreme + ["tripod"] * extreme + ["random"] * randoms
     return supports, kinds
 
 
