@@ -34,7 +34,8 @@ slider frame, for a plan with segments:
 * ``/analysis/stable/{ccw,cw}`` -- procedure STABLE's COR regions; ``/analysis/exact/{ccw,cw}``
   the exact regions (contain STABLE's; :mod:`mechanics.exact_region`);
 * ``/analysis/sticking/{ccw,cw}/{P,U,I}`` -- the force status of sticking (both ends) for every
-  COR of each sense (:func:`mechanics.force_status_regions`, ``ANALYSIS_RAYS`` rays);
+  COR of each sense (:func:`mechanics.force_status_regions`, ``ANALYSIS_RAYS`` rays), for every CF
+  of the scene's uncertainty disk;
 * ``/analysis/cor`` -- ``Points2D``, the centres of rotation of the plan's pushes inside the window.
 
 All COR regions are clipped to a square of half-side 4 slider radii about the CF.
@@ -194,7 +195,8 @@ def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
     regions = {"stable": stable_region(slider, edge, p.mu, p.width).cor_polygons(window),
                "exact": exact.cor_polygons(window)}
     config = ContactConfiguration.slider_edge(slider, edge, p.mu, p.width)
-    status = force_status_regions(contact_wrench_cone(config, "ss"), SupportModel.of_slider(slider), window,
+    support = SupportModel.of_slider(slider, cf_radius=scene.cf_uncertainty)  # as the plan's regions
+    status = force_status_regions(contact_wrench_cone(config, "ss"), support, window,
                                   rays=ANALYSIS_RAYS, steps=6, refinements=0)
     rec.log("analysis/part", rr.LineStrips2D([_closed(slider.vertices)], colors=_SLIDER, radii=_BOLD), static=True)
     rec.log("analysis/contact", rr.LineStrips2D([config.points], colors=_DARK, radii=_BOLD), static=True)
