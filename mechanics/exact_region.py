@@ -103,8 +103,10 @@ class ExactRegion:
         With a known CF they are STABLE's (it finds every stable translation, Lynch & Mason 1996,
         §3.3.1); with an uncertain one, the region's chord along ``w = 0``.
         """
-        if self.cf_radius == 0 or self.is_empty:
-            return self.stable.translation_range if not self.is_empty else None
+        if self.is_empty:
+            return None
+        if self.cf_radius == 0:
+            return self.stable.translation_range
         chord = self.polygon.intersection(shapely.LineString([(-1e9, 0.0), (1e9, 0.0)]))
         if chord.is_empty:
             return None
@@ -244,12 +246,10 @@ def exact_region(
     def stable_at(points: np.ndarray) -> np.ndarray:
         """Certified P, strictly inside Theorem 4's strip, or (if trusted) inside STABLE's region."""
         points = np.atleast_2d(points)
-        known = stable.contains(plane.twists(points)) if trusted else np.zeros(len(points), dtype=bool)
-        out = []
-        for p, k in zip(points, known):
-            out.append(bool(k) or (w_lo < p[1] < w_hi
-                                   and force_status(plane.twists(p), cone, support).status == "P"))
-        return np.array(out)
+        twists = plane.twists(points)
+        known = stable.contains(twists) if trusted else np.zeros(len(points), dtype=bool)
+        return np.array([bool(k) or (w_lo < p[1] < w_hi and force_status(v, cone, support).status == "P")
+                         for p, v, k in zip(points, twists, known)])
 
     if not trusted and not stable_at(centre)[0]:
         return ExactRegion(stable, shapely.Polygon(), np.zeros(2), cf_radius)
@@ -284,12 +284,17 @@ def exact_region(
     finest = 2 * np.pi / rays / 16
     fractions = np.arange(checks + 1) / (checks + 1)
     pending = set(found)
-    while pending:
+    while True:
         keys = sorted(found)
         following = dict(zip(keys, keys[1:] + keys[:1]))
         preceding = {b: a for a, b in following.items()}
+        # An edge between two base points lies in STABLE's convex region (or is the certified
+        # centre) and cannot fail.
+        pending = {a for a in pending if found[a][1] > found[a][0] or found[following[a]][1] > found[following[a]][0]}
+        if not pending:
+            break
         grown = set()
-        for a in sorted(pending & set(keys)):
+        for a in sorted(pending):
             b = following[a]
             ends = [centre + found[k][1] * along(k) for k in (a, b)]
             if np.all(stable_at(ends[0] + fractions[:, None] * (ends[1] - ends[0]))):
@@ -304,12 +309,7 @@ def exact_region(
                 base, reach = found[k]
                 found[k][1] = base if reach - base < 1e-6 * size else base + 0.5 * (reach - base)
             grown |= {preceding[a], a, b}
-        # An edge between two base points lies in STABLE's convex region (or is the certified
-        # centre) and cannot fail.
-        keys = sorted(found)
-        following = dict(zip(keys, keys[1:] + keys[:1]))
-        pending = {a for a in grown if found[a][1] > found[a][0] or found[following[a]][1] > found[following[a]][0]}
-    keys = sorted(found)
+        pending = grown
     traced = shapely.Polygon([centre + found[k][1] * along(k) for k in keys]).buffer(0)
     polygon = shapely.union_all([traced, inner.buffer(0)]) if trusted else traced
     return ExactRegion(stable, polygon, np.asarray(centre, dtype=float), cf_radius)

@@ -322,12 +322,12 @@ class SupportLoads:
         """``(value, lam)``: the largest ``y . L`` over sample distributions, and the LP's dual
         ``lam`` (value ``= max over samples of y . g + lam . (x - CF)``)."""
         y = np.asarray(y, dtype=float)
-        h, x = self.wrenches @ y, self.points - self.cf
-        if self._cor_in_region:  # the best friction direction at the COR, exactly
-            h, x = np.r_[h, np.linalg.norm(self._arm(y))], np.vstack([x, self.cor - self.cf])
         if self.model.cf_radius > 0:  # the centre may move: one LP (module docstring)
             _, lam, value = self.minimax(y[None])
             return value, lam
+        h, x = self.wrenches @ y, self.points - self.cf
+        if self._cor_in_region:  # the best friction direction at the COR, exactly
+            h, x = np.r_[h, np.linalg.norm(self._arm(y))], np.vstack([x, self.cor - self.cf])
         try:
             hull = ConvexHull(np.c_[x, h])
         except QhullError:  # flat (e.g. a translation: y . g is affine): the LP copes
