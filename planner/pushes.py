@@ -64,9 +64,6 @@ def edge_pushes(scene: Scene) -> list[EdgePush]:
         if procedure STABLE is asked for with an uncertain CF.
     """
     p = scene.pusher
-    if scene.cf_uncertainty > 0 and scene.planner.regions == "stable":
-        raise SceneError("planner.regions", "procedure STABLE assumes a known CF; slider.cf_uncertainty needs "
-                                            "the exact regions")
     out = []
     for e in p.edges:
         region = edge_region(scene.slider, e, p.mu, p.width, scene.planner.regions, scene.cf_uncertainty)

@@ -64,11 +64,12 @@ import shapely
 from numpy.typing import ArrayLike
 
 from mechanics import (ContactConfiguration, SupportModel, contact_wrench_cone, exp_twist, force_status_regions,
-                       stable_region, twist_to_cor)
+                       twist_to_cor)
 
 from .bodies import pusher_polygon
 from .plan_file import Plan, atomic_path
 from .pushes import edge_pushes
+from .regions import edge_region
 from .scene import Scene
 from .verify import Verification
 
@@ -191,9 +192,9 @@ def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
     slider, p = scene.slider, scene.pusher
     edge = plan.segments[0].edge
     window = (*(slider.cf - 4 * slider.radius), *(slider.cf + 4 * slider.radius))
-    exact = next(push.region for push in edge_pushes(scene) if push.edge == edge)
-    regions = {"stable": stable_region(slider, edge, p.mu, p.width).cor_polygons(window),
-               "exact": exact.cor_polygons(window)}
+    # The exact region whatever the plan used (cached): the view compares it with STABLE's.
+    regions = {"stable": edge_region(slider, edge, p.mu, p.width, "stable").cor_polygons(window),
+               "exact": edge_region(slider, edge, p.mu, p.width, "exact", scene.cf_uncertainty).cor_polygons(window)}
     config = ContactConfiguration.slider_edge(slider, edge, p.mu, p.width)
     support = SupportModel.of_slider(slider, cf_radius=scene.cf_uncertainty)  # as the plan's regions
     status = force_status_regions(contact_wrench_cone(config, "ss"), support, window,

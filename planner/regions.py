@@ -20,6 +20,7 @@ import shapely
 
 from mechanics import ExactRegion, Slider, StableRegion, exact_region, stable_region
 
+from .fields import SceneError
 from .plan_file import write_atomic
 
 __all__ = ["cache_folder", "edge_region"]
@@ -59,11 +60,18 @@ def _read(path: Path, stable: StableRegion, cf_radius: float) -> ExactRegion | N
 def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None,
                 method: str = "exact", cf_radius: float = 0.0) -> StableRegion | ExactRegion:
     """The ``method`` (``'stable'`` or ``'exact'``) stable region of ``edge``, cached as above;
-    ``cf_radius`` (exact only) makes it hold for every CF within that distance of the slider's."""
+    ``cf_radius`` (exact only) makes it hold for every CF within that distance of the slider's.
+
+    Raises
+    ------
+    SceneError
+        For ``method='stable'`` with ``cf_radius > 0``: procedure STABLE assumes a known CF.
+    """
+    if method == "stable" and cf_radius > 0:
+        raise SceneError("planner.regions", "procedure STABLE assumes a known CF; slider.cf_uncertainty needs "
+                                            "the exact regions")
     stable = stable_region(slider, edge, mu, width)
     if method == "stable" or stable.is_empty:
-        if cf_radius > 0 and not stable.is_empty:
-            raise ValueError("procedure STABLE assumes a known CF: an uncertain one needs the exact regions")
         return stable
     key = _key(slider, edge, mu, width, cf_radius)
     if key in _memory:

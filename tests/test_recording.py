@@ -312,3 +312,17 @@ def test_the_analysis_shows_the_pushed_edge_in_the_slider_frame(turn):
     assert region("/analysis/sticking/ccw/P").contains(centre)
     assert not region("/analysis/sticking/ccw/I").contains(centre)
     assert region("/analysis/sticking/cw/I").contains(centre)
+
+
+def test_the_analysis_shows_the_exact_region_even_when_planning_with_stable(turn, tmp_path):
+    from dataclasses import replace
+
+    scene, _, _ = turn
+    scene = replace(scene, planner=replace(scene.planner, regions="stable"))
+    plan = planner.plan(scene)
+    assert plan.solved
+    recording.write_recording(tmp_path / "stable.rrd", scene, plan)
+    for side in ("ccw", "cw"):
+        exact = shapely.union_all([shapely.Polygon(r) for r in strips(tmp_path / "stable.rrd", f"/analysis/exact/{side}")])
+        stable = shapely.union_all([shapely.Polygon(r) for r in strips(tmp_path / "stable.rrd", f"/analysis/stable/{side}")])
+        assert exact.area > 1.05 * stable.area
