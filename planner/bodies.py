@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import Slider
 
-__all__ = ["body_outline", "pusher_polygon", "convex_pieces", "slider_at", "transform_points"]
+__all__ = ["body_outline", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at", "transform_points"]
 
 
 def transform_points(points: ArrayLike, pose: ArrayLike) -> np.ndarray:
@@ -45,6 +45,17 @@ def pusher_polygon(slider: Slider, edge: int, width: float, depth: float) -> sha
     back = -slider.inward_normal(edge) * depth
     half = along * width / 2
     return shapely.Polygon([mid - half, mid + half, mid + half + back, mid - half + back])
+
+
+def pusher_frame_body(width: float, depth: float) -> np.ndarray:
+    """The pusher's rectangle in its own frame: origin at the middle of the pushing face, x along
+    the push direction, so the body is ``x in [-depth, 0]``, ``y in [-width/2, width/2]`` (CCW).
+
+    >>> pusher_frame_body(0.06, 0.02).tolist()
+    [[-0.02, -0.03], [0.0, -0.03], [0.0, 0.03], [-0.02, 0.03]]
+    """
+    w = width / 2
+    return np.array([[-depth, -w], [0.0, -w], [0.0, w], [-depth, w]])
 
 
 def convex_pieces(polygon: shapely.Polygon) -> list[np.ndarray]:

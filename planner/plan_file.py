@@ -1,8 +1,10 @@
 """Plans and their JSON file format ``stablepush.plan/1`` (read by other tools; see the README).
 
-A plan is a list of push segments. Each holds the edge pushed, the contact segment (slider
-frame), the body twist of the slider and the push's duration, so that ``end = start *
-exp(twist * duration)`` on SE(2). Angles are radians.
+A plan is a list of segments of two kinds. A push (:class:`Segment`) holds the edge pushed, the
+contact segment (slider frame), the body twist of the slider and the push's duration, so that
+``end = start * exp(twist * duration)`` on SE(2). A transit (:class:`Transit`) moves the pusher
+from one edge to another while the part stays still: the world poses of the pusher frame along
+the way (:mod:`planner.transit`). Angles are radians.
 """
 
 from __future__ import annotations
@@ -22,9 +24,11 @@ from mechanics import point_velocity
 
 from .fields import SceneError, integer, keys, number, vector
 
-__all__ = ["FORMAT", "Segment", "Plan", "atomic_path", "load_plan", "write_atomic"]
+__all__ = ["FORMAT", "TRANSIT_MODES", "Segment", "Transit", "Plan", "atomic_path", "load_plan", "write_atomic"]
 
 FORMAT = "stablepush.plan/1"
+#: How a transit moves the pusher: on the table, or lifted over it between two standoff poses.
+TRANSIT_MODES = ("plane", "lift")
 
 
 def _floats(values) -> list[float]:
@@ -34,6 +38,8 @@ def _floats(values) -> list[float]:
 @dataclass(frozen=True)
 class Segment:
     """One constant push."""
+
+    kind = "push"
 
     edge: int
     contact: np.ndarray  # (2, 2), slider frame
@@ -79,6 +85,87 @@ class Segment:
         return float(np.linalg.norm(point_velocity(self.twist, cf)) * self.duration)
 
 
+@dataclass(frozen=True)
+class Transit:
+    """The pusher's move from the contact on ``from_edge`` to the contact on ``to_edge``.
+
+    ``pusher_path`` holds world poses of the pusher frame (origin at the middle of the pushing
+    face, x along the push direction): the first is the contact pose on ``from_edge``, the last
+    the contact pose on ``to_edge``, both with the part at ``pose``, which does not move. In
+    ``'plane'`` mode the pusher moves between consecutive poses by linear interpolation of
+    ``(x, y, theta)`` (theta the shorter way); in ``'lift'`` mode there are four poses (contact,
+    retreat, approach, contact) and the middle piece is airborne. ``duration`` is the time at 1 m/s.
+
+    >>> t = Transit(0, 2, "lift", np.array([[0, 0, 0], [-0.1, 0, 0], [0.5, 0, np.pi], [0.4, 0, np.pi]]), 0.7,
+    ...             np.zeros(3))
+    >>> t.to_dict()["kind"], t.end.tolist(), t.twist.tolist()
+    ('transit', [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    """
+
+    kind = "transit"
+
+    from_edge: int
+    to_edge: int
+    mode: str
+    pusher_path: np.ndarray  # (m, 3) world poses of the pusher frame
+    duration: float
+    pose: np.ndarray  # the part's pose throughout (not in the file: the previous segment's end)
+
+    @property
+    def start(self) -> np.ndarray:
+        return self.pose
+
+    @property
+    def end(self) -> np.ndarray:
+        return self.pose
+
+    @property
+    def twist(self) -> np.ndarray:
+        """The part's body twist: zero, it stands still."""
+        return np.zeros(3)
+
+    @property
+    def edge(self) -> int:
+        """The edge the pusher is on once the transit is over."""
+        return self.to_edge
+
+    def cf_path_length(self, cf: np.ndarray) -> float:
+        return 0.0
+
+    def to_dict(self) -> dict:
+        return {
+            "kind": "transit",
+            "from_edge": int(self.from_edge),
+            "to_edge": int(self.to_edge),
+            "mode": self.mode,
+            "pusher_path": np.asarray(self.pusher_path, dtype=float).tolist(),
+            "duration": float(self.duration),
+        }
+
+    @classmethod
+    def from_dict(cls, data: Any, name: str, pose: np.ndarray) -> "Transit":
+        """Read a transit of a plan file with the part at ``pose``, checking every field."""
+        spec = keys(data, name, ("kind", "from_edge", "to_edge", "mode", "pusher_path", "duration"))
+        if spec["mode"] not in TRANSIT_MODES:
+            raise SceneError(f"{name}.mode", f"must be one of {', '.join(TRANSIT_MODES)}, got {spec['mode']!r}")
+        path = spec["pusher_path"]
+        if not isinstance(path, list) or len(path) < 2:
+            raise SceneError(f"{name}.pusher_path", "must be a list of at least two [x, y, theta] poses")
+        if spec["mode"] == "lift" and len(path) != 4:
+            raise SceneError(f"{name}.pusher_path", f"a lift has exactly 4 poses, got {len(path)}")
+        duration = number(spec["duration"], f"{name}.duration")
+        if duration < 0:
+            raise SceneError(f"{name}.duration", f"must be >= 0, got {duration}")
+        return cls(
+            from_edge=integer(spec["from_edge"], f"{name}.from_edge"),
+            to_edge=integer(spec["to_edge"], f"{name}.to_edge"),
+            mode=spec["mode"],
+            pusher_path=np.array([vector(p, f"{name}.pusher_path[{i}]", 3) for i, p in enumerate(path)]),
+            duration=duration,
+            pose=np.array(pose, dtype=float),
+        )
+
+
 @dataclass
 class Plan:
     """The result of :func:`planner.plan`."""
@@ -90,7 +177,7 @@ class Plan:
     planning_time_s: float
     start: np.ndarray
     goal: np.ndarray
-    segments: list[Segment] = field(default_factory=list)
+    segments: list[Segment | Transit] = field(default_factory=list)
     reason: str = ""  # why it is not solved
     tree: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)), repr=False)  # search tree, world xy
 
@@ -100,7 +187,12 @@ class Plan:
 
     @property
     def pushes(self) -> int:
-        return len(self.segments)
+        return sum(s.kind == "push" for s in self.segments)
+
+    @property
+    def switches(self) -> int:
+        """How many times the pusher changes edge (transits)."""
+        return sum(s.kind == "transit" for s in self.segments)
 
     def path_length(self, cf: np.ndarray) -> float:
         """Length of the path of the centre of friction ``cf`` (slider frame)."""
@@ -142,12 +234,27 @@ class Plan:
             planning_time_s=number(spec["planning_time_s"], "plan.planning_time_s"),
             start=vector(spec["start"], "plan.start", 3),
             goal=vector(spec["goal"], "plan.goal", 3),
-            segments=[Segment.from_dict(s, f"plan.segments[{i}]") for i, s in enumerate(spec["segments"])],
         )
+        plan.segments = _read_segments(spec["segments"], plan.start)
         final = vector(spec["final"], "plan.final", 3)
         if not np.allclose(final, plan.final, atol=1e-9):
             raise SceneError("plan.final", "is not the end of the last segment")
         return plan
+
+
+def _read_segments(items: list, start: np.ndarray) -> list[Segment | Transit]:
+    """Pushes and transits, each transit taking the part's pose from the segment before it."""
+    out: list[Segment | Transit] = []
+    for i, item in enumerate(items):
+        name = f"plan.segments[{i}]"
+        kind = item.get("kind") if isinstance(item, dict) else None
+        if kind == "transit":
+            out.append(Transit.from_dict(item, name, out[-1].end if out else start))
+        elif kind == "push" or not isinstance(item, dict):
+            out.append(Segment.from_dict(item, name))
+        else:
+            raise SceneError(f"{name}.kind", f"must be 'push' or 'transit', got {kind!r}")
+    return out
 
 
 def load_plan(path: str | Path) -> Plan:

@@ -21,7 +21,8 @@ from mechanics import Slider
 from .bodies import slider_at
 from .fields import SceneError, integer, keys, number, vector
 
-__all__ = ["DEFAULT_PLANNER", "DEFAULT_REGIONS", "REGIONS", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
+__all__ = ["DEFAULT_PLANNER", "DEFAULT_REGIONS", "DEFAULT_SWITCH_COST", "DEFAULT_TRANSIT", "REGIONS", "TRANSITS",
+           "check_switch_cost", "check_transit", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
            "check_regions", "check_seed", "check_time_limit", "load_scene", "parse_scene", "PLANNERS"]
 
 PLANNERS = ("rrt", "kpiece", "est")
@@ -29,6 +30,14 @@ PLANNERS = ("rrt", "kpiece", "est")
 REGIONS = ("stable", "exact")
 #: Both are sound (mechanics.exact_region); the exact region is the larger.
 DEFAULT_REGIONS = "exact"
+#: How the pusher may get from one edge to another: on the table, lifted over it (an arm; table
+#: moves are allowed too), or not at all (one edge per plan).
+TRANSITS = ("plane", "lift", "none")
+DEFAULT_TRANSIT = "plane"
+#: What a switch of edge costs, in metres of the centre of friction's path: a plan that switches
+#: must be shorter than one that does not by more than this for each switch (Lynch & Mason 1996,
+#: §4, cost per contact change).
+DEFAULT_SWITCH_COST = 0.25
 #: The planner used when neither the scene nor the caller names one (chosen by planner.bench).
 DEFAULT_PLANNER = "rrt"
 #: Seeds are OMPL's ``std::uint_fast32_t``: 32 bits is the most every platform takes.
@@ -51,6 +60,7 @@ class Pusher:
     mu: float
     edges: tuple[int, ...]  # the edges that may be pushed
     mu_high: float | None = None  # top of the friction interval, if one was given
+    transit: str = DEFAULT_TRANSIT  # how it moves between edges (TRANSITS)
 
 
 @dataclass(frozen=True)
@@ -59,6 +69,7 @@ class PlannerOptions:
     time_limit: float = 10.0
     seed: int = 1
     regions: str = DEFAULT_REGIONS
+    switch_cost: float = DEFAULT_SWITCH_COST
 
 
 @dataclass(frozen=True)
@@ -182,12 +193,13 @@ def _slider(value: Any) -> Slider:
 
 
 def _pusher(value: Any, slider: Slider) -> Pusher:
-    spec = keys(value, "pusher", ("width", "depth", "mu"), ("edges",))
+    spec = keys(value, "pusher", ("width", "depth", "mu"), ("edges", "transit"))
     width = number(spec["width"], "pusher.width", positive=True)
     depth = number(spec["depth"], "pusher.depth", positive=True)
     mu, mu_high = _friction(spec["mu"])
+    transit = check_transit(spec.get("transit", DEFAULT_TRANSIT), "pusher.transit")
     if "edges" not in spec:
-        return Pusher(width, depth, mu, slider.pushable_edges, mu_high)
+        return Pusher(width, depth, mu, slider.pushable_edges, mu_high, transit)
     listed = spec["edges"]
     if not isinstance(listed, (list, tuple)) or not listed:
         raise SceneError("pusher.edges", "must be a non-empty list of edge indices")
@@ -201,7 +213,7 @@ def _pusher(value: Any, slider: Slider) -> Pusher:
         if e in edges:
             raise SceneError("pusher.edges", f"edge {e} is listed twice")
         edges.append(e)
-    return Pusher(width, depth, mu, tuple(edges), mu_high)
+    return Pusher(width, depth, mu, tuple(edges), mu_high, transit)
 
 
 def _friction(value: Any) -> tuple[float, float | None]:
@@ -248,12 +260,13 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     tol = keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
     tol_pos = number(tol.get("position", 0.01), "tolerance.position", positive=True)
     tol_ang = math.radians(number(tol.get("angle", 2.0), "tolerance.angle", positive=True))
-    opts = keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed", "regions"))
+    opts = keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed", "regions", "switch_cost"))
     planner = PlannerOptions(
         name=_one_of(opts.get("name", DEFAULT_PLANNER), PLANNERS, "planner.name"),
         time_limit=check_time_limit(opts.get("time_limit", 10.0), "planner.time_limit"),
         seed=check_seed(opts.get("seed", 1), "planner.seed"),
         regions=check_regions(opts.get("regions", DEFAULT_REGIONS), "planner.regions"),
+        switch_cost=check_switch_cost(opts.get("switch_cost", DEFAULT_SWITCH_COST), "planner.switch_cost"),
     )
     return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path,
                  cf_uncertainty)
@@ -287,6 +300,27 @@ def _one_of(value: Any, choices: tuple[str, ...], name: str) -> str:
 def check_regions(value: Any, name: str) -> str:
     """``value`` as a region method (:data:`REGIONS`); else a :class:`SceneError` naming ``name``."""
     return _one_of(value, REGIONS, name)
+
+
+def check_transit(value: Any, name: str) -> str:
+    """``value`` as a transit mode (:data:`TRANSITS`); else a :class:`SceneError` naming ``name``."""
+    return _one_of(value, TRANSITS, name)
+
+
+def check_switch_cost(value: Any, name: str) -> float:
+    """``value`` as a switch cost in metres (>= 0); else a :class:`SceneError` naming ``name``.
+
+    >>> check_switch_cost(0, "planner.switch_cost")
+    0.0
+    >>> check_switch_cost(-0.1, "planner.switch_cost")
+    Traceback (most recent call last):
+    ...
+    planner.fields.SceneError: planner.switch_cost: must be >= 0, got -0.1
+    """
+    cost = number(value, name)
+    if cost < 0:
+        raise SceneError(name, f"must be >= 0, got {value!r}")
+    return cost
 
 
 def check_seed(value: Any, name: str) -> int:

@@ -2,16 +2,26 @@
 
 The OMPL objects are kept separate, as OMPL intends, and none of them knows about pushing:
 
-* state space: SE(2) (the slider pose) x the index of the pushed edge (constant along a plan);
-* control space: the unit box ``[0, 1]^2``; the propagator maps a control through the edge's
-  :class:`~mechanics.StableSteering`, so every control is a guaranteed-stable push, and applies it
-  exactly (SE(2) exponential, no integration);
+* state space: SE(2) (the slider pose) x the index of the pushed edge;
+* control space: the unit box ``[0, 1]^2``, or ``[0, 1]^3`` when the pusher may switch edges.
+  The propagator maps the first two components through the edge's
+  :class:`~mechanics.StableSteering`, so every push control is a guaranteed-stable push, and
+  applies it exactly (SE(2) exponential, no integration). With switching, a third component in
+  the top :data:`SWITCH_SHARE` of its range is instead a *switch* to the edge it selects: the pose
+  stays, the edge changes, and the state is valid only if :class:`~planner.transit.TransitPlanner`
+  finds a collision-free transit for the pusher (a car with reverse gear: the opposite edge drives
+  the part backwards);
 * validity: :class:`~planner.validity.CollisionModel` with its clearance rule;
 * goal: the pose tolerance, or one or two stable collision-free pushes away
   (:class:`~planner.preimage.GoalPreimage`).
 
-Every allowed edge gets a start state, so the trees of all edges grow at once and a plan uses
-the one edge whose tree reaches the goal first; no time is split between edges.
+Every allowed edge gets a start state, so the trees of all edges grow at once; no time is split
+between edges.
+
+Switches cost (Lynch & Mason 1996, §4: a cost per contact change): a plan's cost is the length of
+its centre of friction's path plus ``switch_cost`` per switch. When the first plan found switches,
+a search without switches gets as many iterations again (a count, not a time, so a seed still
+gives one plan), and its plan wins if it costs no more.
 """
 
 from __future__ import annotations
@@ -29,15 +39,18 @@ from ompl import util as ou
 from mechanics import exp_twist, wrap_angle
 
 from .one_step import connect
-from .plan_file import Plan, Segment
+from .plan_file import Plan, Segment, Transit
 from .preimage import GoalPreimage
 from .pushes import EdgePush, clearance_margin, edge_pushes, resolution
-from .scene import Scene, SceneError, check_regions
+from .scene import Scene, SceneError, check_regions, check_switch_cost, check_transit
+from .transit import TransitPlanner
 from .validity import CollisionModel
 
-__all__ = ["plan", "MAX_CONTROL_STEPS"]
+__all__ = ["plan", "MAX_CONTROL_STEPS", "SWITCH_SHARE"]
 #: Longest constant push the planners sample, in collision-check steps.
 MAX_CONTROL_STEPS = 30
+#: Share of sampled controls that switch edges, when switching is allowed.
+SWITCH_SHARE = 0.1
 
 _PLANNERS: dict[str, Callable] = {"rrt": oc.RRT, "kpiece": oc.KPIECE1, "est": oc.EST}
 
@@ -88,9 +101,11 @@ class _PushGoal(ob.GoalSampleableRegion):
         self.setThreshold(1e-9)  # OMPL accepts distances strictly below the threshold
 
     def distanceGoal(self, state) -> float:
-        p = state[0]
+        p, k = state[0], state[1].value
         pose = np.array([p.getX(), p.getY(), p.getYaw()])
-        if _within_tolerance(self.scene, pose) or self.preimage.connect(pose, state[1].value) is not None:
+        if k >= len(self.preimage.pushes):  # the marker of a blocked switch
+            return math.inf
+        if _within_tolerance(self.scene, pose) or self.preimage.connect(pose, k) is not None:
             return 0.0
         g = self.scene.goal
         return math.hypot(pose[0] - g[0], pose[1] - g[1]) + self.scene.slider.radius * abs(
@@ -108,21 +123,26 @@ class _PushGoal(ob.GoalSampleableRegion):
 
 
 def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
-         regions: str | None = None) -> Plan:
+         regions: str | None = None, transit: str | None = None, switch_cost: float | None = None) -> Plan:
     """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``.
 
-    Arguments left as ``None`` take the scene's ``planner`` options; ``regions`` is ``'stable'``
-    (procedure STABLE) or ``'exact'`` (the exact region, the default). With a given seed, a run that
-    solves within the time limit returns the same plan every time.
+    Arguments left as ``None`` take the scene's options: ``regions`` is ``'stable'`` (procedure
+    STABLE) or ``'exact'`` (the exact region, the default); ``transit`` is ``'plane'``, ``'lift'``
+    or ``'none'`` (``pusher.transit``); ``switch_cost`` is in metres (``planner.switch_cost``). With a
+    given seed, a run that solves within the time limit returns the same plan every time.
 
     Raises
     ------
     SceneError
-        If the planner name is unknown or no allowed edge can start pushing.
+        If an option is invalid or no allowed edge can start pushing.
     """
     opts = scene.planner
     if regions is not None:
-        scene = replace(scene, planner=replace(opts, regions=check_regions(regions, "regions")))
+        opts = replace(opts, regions=check_regions(regions, "regions"))
+    if switch_cost is not None:
+        opts = replace(opts, switch_cost=check_switch_cost(switch_cost, "switch_cost"))
+    pusher = scene.pusher if transit is None else replace(scene.pusher, transit=check_transit(transit, "transit"))
+    scene = replace(scene, planner=opts, pusher=pusher)
     seed = opts.seed if seed is None else seed
     time_limit = opts.time_limit if time_limit is None else time_limit
     name = opts.name if planner is None else planner
@@ -134,7 +154,7 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     step, margin = resolution(scene), clearance_margin(scene)
     result = Plan(scene.path, False, name, seed, 0.0, scene.start.copy(), scene.goal.copy())
 
-    def done(segments: list[Segment], reason: str = "", tree=None) -> Plan:
+    def done(segments: list, reason: str = "", tree=None) -> Plan:
         result.solved = not reason
         result.segments = segments
         result.reason = reason
@@ -149,32 +169,84 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     if _within_tolerance(scene, scene.start):
         return done([])
     preimage = GoalPreimage(scene.goal, pushes, model, margin, scene.slider.radius)
+    switching = scene.pusher.transit != "none" and len(pushes) > 1
+    transits = TransitPlanner(scene, [p.edge for p in pushes], model, margin) if switching else None
+    shortcut = _Shortcut(pushes, model, margin, transits)
     for k in starts:  # one or two pushes may do, as in the paper's one-step planning
         direct = preimage.connect(scene.start, k)
         if direct is not None:
-            return done(_shortcut(direct, pushes[k], model, margin))
-    _seed_ompl(seed)
-    space, si = _spaces(scene, pushes, model, step)
-    ss = oc.SimpleSetup(si)
-    for k in starts:
-        s = space.allocState()
-        s[0].setXY(float(scene.start[0]), float(scene.start[1]))
-        s[0].setYaw(float(wrap_angle(scene.start[2])))
-        s[1].value = k
-        ss.addStartState(s)
-    ss.setGoal(_PushGoal(si, scene, preimage))
-    ss.setPlanner(_PLANNERS[name](si))
-    ss.solve(float(time_limit))
-    tree = _tree(ss, si)
-    if not ss.haveExactSolutionPath():
-        return done([], f"no plan found within the time limit of {time_limit:g} s", tree)
-    segments = _segments(ss.getSolutionPath(), scene, pushes, model, margin, preimage)
+            return done(shortcut(direct))
+    deadline = clock + float(time_limit)
+    search = _Search(scene, pushes, model, preimage, name, seed, step)
+    segments, tree, iterations = search.run(starts, deadline, transits)
+    if segments is not None and any(s.kind == "transit" for s in segments):
+        plain, _, _ = search.run(starts, deadline, None, iterations)
+        if plain is not None and _cost(scene, plain) <= _cost(scene, segments):
+            segments = plain
     if segments is None:
-        return done([], "the final push failed its re-check after rounding", tree)
-    return done(segments, tree=tree)
+        reason = ("the final push failed its re-check after rounding" if tree is None
+                  else f"no plan found within the time limit of {time_limit:g} s")
+        return done([], reason, tree)
+    return done(shortcut(segments), tree=tree)
 
 
-def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: float):
+def _cost(scene: Scene, segments: list) -> float:
+    """Length of the centre of friction's path plus the switch cost per switch."""
+    return sum(s.cf_path_length(scene.slider.cf) for s in segments) + scene.planner.switch_cost * sum(
+        s.kind == "transit" for s in segments)
+
+
+class _Search:
+    """One OMPL control search from the start states to the goal preimage, re-seeded per run."""
+
+    def __init__(self, scene: Scene, pushes: list[EdgePush], model: CollisionModel, preimage: GoalPreimage,
+                 name: str, seed: int, step: float):
+        self.scene, self.pushes, self.model, self.preimage = scene, pushes, model, preimage
+        self.name, self.seed, self.step = name, seed, step
+
+    def run(self, starts: list[int], deadline: float, transits: TransitPlanner | None,
+            iterations: int | None = None) -> tuple[list | None, np.ndarray | None, int]:
+        """Segments of the plan found (None if none), the search tree (None if the plan failed
+        its re-check) and the iterations used; the search stops at ``deadline`` (perf_counter
+        time) or after ``iterations``."""
+        _seed_ompl(self.seed)
+        space, si = _spaces(self.scene, self.pushes, self.model, self.step, transits)
+        ss = oc.SimpleSetup(si)
+        for k in starts:
+            s = space.allocState()
+            s[0].setXY(float(self.scene.start[0]), float(self.scene.start[1]))
+            s[0].setYaw(float(wrap_angle(self.scene.start[2])))
+            s[1].value = k
+            ss.addStartState(s)
+        ss.setGoal(_PushGoal(si, self.scene, self.preimage))
+        ss.setPlanner(_PLANNERS[self.name](si))
+        count = [0]
+
+        def stop() -> bool:
+            count[0] += 1
+            return time.perf_counter() >= deadline or (iterations is not None and count[0] > iterations)
+
+        ss.solve(ob.PlannerTerminationCondition(stop))
+        tree = _tree(ss, si)
+        if not ss.haveExactSolutionPath():
+            return None, tree, count[0]
+        segments = _segments(ss.getSolutionPath(), self.scene, self.pushes, self.preimage, transits)
+        return segments, tree if segments is not None else None, count[0]
+
+
+def _switch_target(u: float, n: int) -> int | None:
+    """The edge index a third control component selects, or None if it is a push.
+
+    >>> [_switch_target(u, 4) for u in (0.0, 0.89, 0.9, 0.949, 0.96, 1.0)]
+    [None, None, 0, 1, 2, 3]
+    """
+    if u < 1.0 - SWITCH_SHARE:
+        return None
+    return min(n - 1, int((u - (1.0 - SWITCH_SHARE)) / SWITCH_SHARE * n))
+
+
+def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: float,
+            transits: TransitPlanner | None):
     se2 = ob.SE2StateSpace()
     bounds = ob.RealVectorBounds(2)
     xmin, ymin, xmax, ymax = scene.workspace
@@ -182,16 +254,17 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
     se2.setBounds(bounds)
     space = ob.CompoundStateSpace()
     space.addSubspace(se2, 1.0)
-    # OMPL needs a discrete range of positive extent; with one edge, index 1 exists but is invalid.
-    # The index weighs as much as crossing the workspace: nearest-neighbour planners (RRT) then
-    # extend each edge's tree towards samples of that edge, instead of only the first edge's tree
-    # (all start states share one pose, so ties would always go to edge 0).
+    # Index len(pushes) is never valid: it marks a switch with no transit. The index weighs as
+    # much as crossing the workspace: nearest-neighbour planners (RRT) then extend each edge's
+    # tree towards samples of that edge, instead of only the first edge's tree (all start states
+    # share one pose, so ties would always go to edge 0).
+    blocked = len(pushes)
     span = math.hypot(xmax - xmin, ymax - ymin)
-    space.addSubspace(ob.DiscreteStateSpace(0, max(1, len(pushes) - 1)), span)
+    space.addSubspace(ob.DiscreteStateSpace(0, blocked), span)
     space.lock()
     space.registerDefaultProjection(_PoseProjection(space, scene.slider.radius))
-    controls = oc.RealVectorControlSpace(space, 2)
-    unit = ob.RealVectorBounds(2)
+    controls = oc.RealVectorControlSpace(space, 2 if transits is None else 3)
+    unit = ob.RealVectorBounds(2 if transits is None else 3)
     unit.setLow(0.0), unit.setHigh(1.0)
     controls.setBounds(unit)
     si = oc.SpaceInformation(space, controls)
@@ -209,17 +282,27 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
 
     def propagate(start, control, duration, result) -> None:
         p, k = start[0], start[1].value
+        r = result[0]
+        target = None if transits is None else _switch_target(control[2], len(pushes))
+        if target is not None:
+            # A switch: the part stays; the pusher must find its way round (every step of the
+            # control after the first is a switch to the edge it is already on, i.e. nothing).
+            r.setXY(p.getX(), p.getY())
+            r.setYaw(p.getYaw())
+            free = target == k or transits.find((p.getX(), p.getY(), p.getYaw()), pushes[k].edge,
+                                                pushes[target].edge) is not None
+            result[1].value = target if free else blocked
+            return
         dx, dy, dth = step_of(k, control[0], control[1], duration)
         x, y, yaw = p.getX(), p.getY(), p.getYaw()
         c, s = math.cos(yaw), math.sin(yaw)
-        r = result[0]
         r.setXY(x + c * dx - s * dy, y + s * dx + c * dy)
         r.setYaw((yaw + dth + math.pi) % (2 * math.pi) - math.pi)
         result[1].value = k
 
     def is_valid(state) -> bool:
         p, k = state[0], state[1].value
-        return k < len(pushes) and si.satisfiesBounds(state) and model.clearance(
+        return k < blocked and si.satisfiesBounds(state) and model.clearance(
             (p.getX(), p.getY(), p.getYaw()), pushes[k].edge) > step / 2
 
     si.setStatePropagator(propagate)
@@ -230,24 +313,40 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
     return space, si
 
 
-def _segments(path, scene: Scene, pushes: list[EdgePush], model: CollisionModel, margin: float,
-              preimage: GoalPreimage) -> list[Segment] | None:
-    """Segments of an OMPL control path (copied out at once: its states live in C++), merged where
-    consecutive controls are equal, plus the final push onto the goal if the path stops short."""
+def _segments(path, scene: Scene, pushes: list[EdgePush], preimage: GoalPreimage,
+              transits: TransitPlanner | None) -> list | None:
+    """Segments of an OMPL control path (copied out at once: its states live in C++): pushes,
+    merged where consecutive controls are equal, and transits where the edge changes, plus the
+    final push onto the goal if the path stops short; None if a re-check after rounding fails."""
     states = [(s[0].getX(), s[0].getY(), s[0].getYaw(), s[1].value) for s in path.getStates()]
-    controls = [(u[0], u[1]) for u in path.getControls()]
+    width = 2 if transits is None else 3
+    controls = [tuple(u[i] for i in range(width)) for u in path.getControls()]
     durations = list(path.getControlDurations())
     k = states[0][3]
-    push = pushes[k]
-    merged: list[tuple[tuple, float]] = []
+    # (edge index, push control, duration) per push and (from, to) per switch, in order.
+    moves: list[tuple] = []
     for u, d in zip(controls, durations):
-        if merged and merged[-1][0] == u:
-            merged[-1] = (u, merged[-1][1] + d)
+        target = None if transits is None else _switch_target(u[2], len(pushes))
+        if target is not None:
+            if target != k:
+                moves.append((k, target))
+                k = target
+        elif moves and len(moves[-1]) == 3 and moves[-1][:2] == (k, u[:2]):
+            moves[-1] = (k, u[:2], moves[-1][2] + d)
         else:
-            merged.append((u, d))
-    segments = []
+            moves.append((k, u[:2], d))
+    segments: list = []
     pose = np.array(states[0][:3])
-    for u, d in merged:
+    for move in moves:
+        if len(move) == 2:
+            transit = transits.find(pose, pushes[move[0]].edge, pushes[move[1]].edge)
+            if transit is None:
+                return None
+            segments.append(transit)
+            k = move[1]
+            continue
+        k, u, d = move
+        push = pushes[k]
         twist = push.control_twist(u)
         end = exp_twist(pose, twist, d)
         end[2] = wrap_angle(end[2])
@@ -259,28 +358,54 @@ def _segments(path, scene: Scene, pushes: list[EdgePush], model: CollisionModel,
         if last is None:
             return None
         segments += last
-    return _shortcut(segments, push, model, margin)
+    return segments
 
 
-def _shortcut(segments: list[Segment], push: EdgePush, model: CollisionModel, margin: float) -> list[Segment]:
-    """Replace runs of pushes by one push wherever one stable collision-free push joins their
+class _Shortcut:
+    """Replace runs of segments by one push wherever one stable collision-free push joins their
     ends (the one-step test between plan waypoints); greedy, farthest waypoint first.
 
     Random controls make plans zig-zag; this keeps the guarantee (every replacement is checked
-    like any push) and usually removes most pushes.
+    like any push) and usually removes most pushes. A run may hold transits: it is replaced by a
+    push on the edge in use where it begins, followed by a transit to the edge its end was on if
+    the plan goes on from there (or, at the very start, by a push on that edge), so switches that
+    are not needed disappear.
     """
-    out, i = [], 0
-    while i < len(segments):
-        for j in range(len(segments) - 1, i, -1):
-            joined = connect(segments[i].start, segments[j].end, push, model, margin)
-            if isinstance(joined, Segment):
-                out.append(joined)
-                i = j + 1
-                break
-        else:
-            out.append(segments[i])
-            i += 1
-    return out
+
+    def __init__(self, pushes: list[EdgePush], model: CollisionModel, margin: float,
+                 transits: TransitPlanner | None):
+        self.by_edge = {p.edge: p for p in pushes}
+        self.model, self.margin, self.transits = model, margin, transits
+
+    def __call__(self, segments: list) -> list:
+        out, i = [], 0
+        while i < len(segments):
+            for j in range(len(segments) - 1, i, -1):
+                joined = self._join(segments, i, j, first=not out)
+                if joined is not None:
+                    out += joined
+                    i = j + 1
+                    break
+            else:
+                out.append(segments[i])
+                i += 1
+        return out
+
+    def _join(self, segments: list, i: int, j: int, first: bool) -> list | None:
+        a, b = segments[i], segments[j]
+        if a.kind != "push" or b.kind != "push":
+            return None
+        last = j == len(segments) - 1
+        for edge in (a.edge, b.edge) if first and a.edge != b.edge else (a.edge,):
+            joined = connect(a.start, b.end, self.by_edge[edge], self.model, self.margin)
+            if not isinstance(joined, Segment):
+                continue
+            if edge == b.edge or last:
+                return [joined]
+            transit = self.transits.find(b.end, edge, b.edge) if self.transits is not None else None
+            if transit is not None:
+                return [joined, transit]
+        return None
 
 
 def _tree(ss, si) -> np.ndarray:
