@@ -2,7 +2,8 @@
 
 Plans every scene with every planner for seeds ``1..runs`` and prints, per scene and planner, the
 success rate, the median and 90th-percentile planning time, and the median path length (of the
-centre of friction) and number of pushes of the solved runs. Runs go to worker processes, one per
+centre of friction), number of pushes and number of switches (edge changes) of the solved runs.
+``--transit`` overrides every scene's ``pusher.transit`` (``none``: one edge per plan). Runs go to worker processes, one per
 core, each building its own OMPL objects (they cannot be pickled; STACK.md §1.5).
 """
 
@@ -16,17 +17,18 @@ import sys
 
 import numpy as np
 
-from .scene import PLANNERS, load_scene
+from .scene import PLANNERS, TRANSITS, load_scene
 from .search import plan
 
 __all__ = ["main"]
 
 
-def _run(job: tuple[str, str, int, float]) -> tuple[str, str, bool, float, float, int]:
-    path, name, seed, limit = job
+def _run(job: tuple[str, str, int, float, str | None]) -> tuple[str, str, bool, float, float, int, int]:
+    path, name, seed, limit, transit = job
     scene = load_scene(path)
-    result = plan(scene, seed=seed, time_limit=limit, planner=name)
-    return path, name, result.solved, result.planning_time_s, result.path_length(scene.slider.cf), result.pushes
+    result = plan(scene, seed=seed, time_limit=limit, planner=name, transit=transit)
+    return (path, name, result.solved, result.planning_time_s, result.path_length(scene.slider.cf), result.pushes,
+            result.switches)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -35,22 +37,25 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--runs", type=int, default=20, help="seeds 1..RUNS per scene and planner")
     p.add_argument("--planners", nargs="+", choices=PLANNERS, default=list(PLANNERS))
     p.add_argument("--time-limit", type=float, default=10.0, metavar="S")
+    p.add_argument("--transit", choices=TRANSITS, help="override every scene's pusher.transit")
     p.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     args = p.parse_args(argv)
-    jobs = [(s, name, seed, args.time_limit) for s in args.scenes for name in args.planners
+    jobs = [(s, name, seed, args.time_limit, args.transit) for s in args.scenes for name in args.planners
             for seed in range(1, args.runs + 1)]
     with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
         results = pool.map(_run, jobs, chunksize=1)
-    print(f"{'scene':<22}{'planner':<8}{'success':>8}{'t_med[s]':>10}{'t_p90[s]':>10}{'len_med[m]':>11}{'pushes':>8}")
+    print(f"{'scene':<22}{'planner':<8}{'success':>8}{'t_med[s]':>10}{'t_p90[s]':>10}{'len_med[m]':>11}{'pushes':>8}"
+          f"{'switches':>9}")
     for s in args.scenes:
         for name in args.planners:
             rows = [r for r in results if r[0] == s and r[1] == name]
             solved = [r for r in rows if r[2]]
             times = [r[3] for r in rows]  # unsolved runs count with the time they used
             length = f"{statistics.median(r[4] for r in solved):.3f}" if solved else "-"
-            pushes = f"{statistics.median(r[5] for r in solved):g}" if solved else "-"
+            pushes, switches = (f"{statistics.median(r[i] for r in solved):g}" if solved else "-" for i in (5, 6))
             print(f"{os.path.basename(s):<22}{name:<8}{len(solved) / len(rows):>8.0%}"
-                  f"{statistics.median(times):>10.3f}{float(np.percentile(times, 90)):>10.3f}{length:>11}{pushes:>8}")
+                  f"{statistics.median(times):>10.3f}{float(np.percentile(times, 90)):>10.3f}{length:>11}{pushes:>8}"
+                  f"{switches:>9}")
     return 0
 
 

@@ -21,8 +21,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from .plan_file import Plan, load_plan, write_atomic
-from .scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS, Scene, SceneError,
-                    check_seed, check_time_limit, load_scene)
+from .scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS,
+                    TRANSITS, Scene, SceneError, check_seed, check_time_limit, load_scene)
 from .search import plan
 from .verify import Verification, verify
 
@@ -47,6 +47,9 @@ def _parser() -> argparse.ArgumentParser:
                    help=f"random seed (1..{MAX_SEED}); the same seed gives the same plan")
     p.add_argument("--regions", choices=REGIONS,
                    help=f"stable pushes: procedure STABLE or the exact region (default: the scene's, else {DEFAULT_REGIONS})")
+    p.add_argument("--transit", choices=TRANSITS,
+                   help=f"how the pusher may change edges: walk round the part, be lifted, or never "
+                        f"(default: the scene's pusher.transit, else {DEFAULT_TRANSIT})")
     p.add_argument("--out", metavar="DIR", help="output folder (default: logs/<name>-<timestamp>/)")
     p.add_argument("--verify", type=int, metavar="N",
                    help="re-simulate the plan under N support distributions; exit 3 if a push slips")
@@ -77,6 +80,8 @@ def _run(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     if args.regions:  # the search, the one-step check and the recording all read it from the scene
         scene = replace(scene, planner=replace(scene.planner, regions=args.regions))
+    if args.transit:  # and verify checks a plan's lifts against it
+        scene = replace(scene, pusher=replace(scene.pusher, transit=args.transit))
     name = args.planner or scene.planner.name
     limit = limit or scene.planner.time_limit
     seed = seed or scene.planner.seed
@@ -96,8 +101,8 @@ def _run(args: argparse.Namespace) -> int:
     if not result.solved and args.plan is None:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
         return 2
-    head = (f"loaded {args.plan}: {result.pushes} pushes{'' if result.solved else ' (not solved)'}" if args.plan
-            else f"solved: {result.pushes} pushes, path length {result.path_length(scene.slider.cf):.3f} m, "
+    head = (f"loaded {args.plan}: {result.contents()}{'' if result.solved else ' (not solved)'}" if args.plan
+            else f"solved: {result.contents()}, path length {result.path_length(scene.slider.cf):.3f} m, "
                  f"planning time {result.planning_time_s:.2f} s")
     print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd")
     if check is None:

@@ -194,6 +194,18 @@ class Plan:
         """How many times the pusher changes edge (transits)."""
         return sum(s.kind == "transit" for s in self.segments)
 
+    def contents(self, joiner: str = ", ") -> str:
+        """What the plan is made of, in words: ``'3 pushes'``, ``'1 push, 2 switches'``.
+
+        >>> Plan(None, True, "rrt", 1, 0.0, np.zeros(3), np.zeros(3)).contents()
+        '0 pushes'
+        """
+        def count(n: int, word: str, plural: str) -> str:
+            return f"{n} {word if n == 1 else plural}"
+
+        pushes = count(self.pushes, "push", "pushes")
+        return f"{pushes}{joiner}{count(self.switches, 'switch', 'switches')}" if self.switches else pushes
+
     def path_length(self, cf: np.ndarray) -> float:
         """Length of the path of the centre of friction ``cf`` (slider frame)."""
         return sum(s.cf_path_length(cf) for s in self.segments)

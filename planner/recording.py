@@ -10,24 +10,33 @@ Static (no timeline, always visible)
 * ``/world/obstacles`` -- one strip per obstacle, labelled ``obstacle <k>`` in scene order;
 * ``/world/start``, ``/world/goal`` -- the slider's outline at the start and goal poses (ghosts);
 * ``/world/tree`` -- one strip per search-tree edge (``Plan.tree``; empty after a one-step plan);
+* ``/world/transits`` -- the path of the pusher's face centre on each transit (edge switch),
+  labelled ``transit <k>`` in plan order: one strip for a walk round the part, three for a lift,
+  whose middle, airborne, strip is labelled ``transit <k> lifted`` and drawn thin and faint in
+  the lifted pusher's colour (no strip for a plan without switches);
 * ``/log`` -- ``TextLog``, one summary line (``WARN`` when not solved).
 
-Animated, one row per frame on the timelines ``time`` (push time in seconds: twists are scaled
-so that no body point moves faster than 1 m/s) and ``step`` (frame index), only for a plan with
+Animated, one row per frame on the timelines ``time`` (plan time in seconds, pushes and transits
+alike: no body point moves faster than 1 m/s) and ``step`` (frame index), only for a plan with
 segments. Frames are ``FRAMES_PER_RADIUS`` per slider radius of point travel, at most
 ``MAX_FRAMES`` in all:
 
-* ``/world/slider``, ``/world/pusher`` -- the slider's outline and the pusher's on the pushed edge;
+* ``/world/slider`` -- the slider's outline; it stands still during a transit;
+* ``/world/pusher`` -- the pusher's outline on the table: on the pushed edge during a push, and
+  along the transit's path (:func:`planner.transit.transit_poses`) during a transit; no strip while it is lifted;
+* ``/world/pusher_lifted`` -- the pusher's outline while it is in the air (the inside of a lift's
+  middle piece), thin, faint and labelled ``lifted``; no strip on every other frame;
 * ``/world/cf_path`` -- the path of the centre of friction so far (thinned to about
   ``PATH_POINTS`` points, always through the segments' ends);
 * ``/world/cor`` -- ``Points2D``, the current push's centre of rotation (no point for a
-  translation, whose COR is at infinity);
+  translation, whose COR is at infinity, nor during a transit);
 * ``/world/stable/ccw``, ``/world/stable/cw`` -- the pushed edge's stable COR regions, clipped to
   a square of half-side 4 slider radii about the CF and carried with the slider (no strip where
-  a region is empty).
+  a region is empty, nor during a transit: no edge is pushed then, and the regions of the edge
+  being left would suggest one is).
 
-The pushed edge's mechanics (Lynch 1992's figures 11 and 14 for this part), static, in the
-slider frame, for a plan with segments:
+The first pushed edge's mechanics (Lynch 1992's figures 11 and 14 for this part), static, in the
+slider frame, for a plan with a push:
 
 * ``/analysis/part`` -- the slider's outline at the origin of its frame, and ``/analysis/contact``
   the pushed contact segment;
@@ -36,7 +45,8 @@ slider frame, for a plan with segments:
 * ``/analysis/sticking/{ccw,cw}/{P,U,I}`` -- the force status of sticking (both ends) for every
   COR of each sense (:func:`mechanics.force_status_regions`, ``ANALYSIS_RAYS`` rays), for every CF
   of the scene's uncertainty disk;
-* ``/analysis/cor`` -- ``Points2D``, the centres of rotation of the plan's pushes inside the window.
+* ``/analysis/cor`` -- ``Points2D``, the centres of rotation of the plan's pushes on that edge
+  inside the window (pushes on other edges belong with other regions).
 
 All COR regions are clipped to a square of half-side 4 slider radii about the CF.
 
@@ -44,8 +54,8 @@ With a :class:`~planner.verify.Verification` (``plan --verify``), also:
 
 * ``/world/ghost`` -- the slider's outline as simulated under each push's worst support
   distribution (the run deviating most from the plan), from the push's planned start, at up to
-  ``GHOST_SAMPLES`` frames per push (the viewer holds it in between); it hides under
-  ``/world/slider`` wherever the push sticks;
+  ``GHOST_SAMPLES`` frames per push (the viewer holds it in between, through transits too); it
+  hides under ``/world/slider`` wherever the push sticks;
 * ``/log/verify`` -- ``TextLog``, the verification's summary line (``WARN`` when it failed).
 
 Styles (colours, line widths in UI points) are logged statically on the animated entities. The
@@ -56,6 +66,7 @@ above the text log.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import rerun as rr
@@ -63,14 +74,15 @@ import rerun.blueprint as rrb
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import (ContactConfiguration, SupportModel, contact_wrench_cone, exp_twist, force_status_regions,
-                       twist_to_cor)
+from mechanics import (ContactConfiguration, Slider, SupportModel, contact_wrench_cone, exp_twist,
+                       force_status_regions, twist_to_cor, wrap_angle)
 
-from .bodies import pusher_polygon
-from .plan_file import Plan, atomic_path
+from .bodies import pusher_frame_body
+from .plan_file import Plan, Segment, Transit, atomic_path
 from .pushes import edge_pushes
 from .regions import edge_region
 from .scene import Scene
+from .transit import contact_pose, transit_pieces, transit_poses
 from .verify import Verification
 
 __all__ = ["ANALYSIS_RAYS", "FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS", "write_recording"]
@@ -90,6 +102,7 @@ _THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0
 _GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
 _SLIDER, _GOAL, _CF = [40, 110, 220], [40, 170, 70], [90, 160, 255]
 _CCW, _CW, _COR, _GHOST = [20, 170, 150], [230, 130, 20], [210, 40, 190], [140, 60, 230]
+_LIFTED = [110, 110, 110, 110]  # a faint, see-through grey: the pusher off the table, seen from above
 _STATUS = {"P": [40, 170, 70], "U": [230, 190, 40], "I": [200, 50, 50]}
 
 
@@ -115,9 +128,11 @@ def _summary(scene: Scene, plan: Plan) -> str:
     head = f"{scene.name}: planner {plan.planner}, seed {plan.seed}"
     if not plan.solved:
         return f"{head}: not solved: {plan.reason}; {len(plan.tree)} tree edges"
-    push_time = sum(s.duration for s in plan.segments)
-    return (f"{head}: solved with {plan.pushes} push{'' if plan.pushes == 1 else 'es'}, "
-            f"CF path {plan.path_length(scene.slider.cf):.4f} m, push time {push_time:.4f} s; "
+    made = plan.contents(" and ")
+    timing = f"push time {sum(s.duration for s in plan.segments if s.kind == 'push'):.4f} s"
+    if plan.switches:
+        timing += f", transit time {sum(s.duration for s in plan.segments if s.kind == 'transit'):.4f} s"
+    return (f"{head}: solved with {made}, CF path {plan.path_length(scene.slider.cf):.4f} m, {timing}; "
             f"{len(plan.tree)} tree edges")
 
 
@@ -134,35 +149,72 @@ def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
     rec.log("world/goal", rr.LineStrips2D(ghosts[1:], colors=_GOAL, radii=_LINE, labels="goal"), static=True)
     rec.log("world/tree", rr.LineStrips2D(np.asarray(plan.tree, dtype=float).reshape(-1, 2, 2),
                                           colors=_GREY, radii=_THIN, draw_order=-1.0), static=True)
+    pieces = [(k, xy, up) for k, t in enumerate(s for s in plan.segments if s.kind == "transit")
+              for xy, up in transit_pieces(t)]
+    rec.log("world/transits", rr.LineStrips2D(
+        [xy for _, xy, _ in pieces], colors=[_LIFTED if up else _DARK for *_, up in pieces],
+        radii=[_THIN if up else _LINE for *_, up in pieces],
+        labels=[f"transit {k + 1}{' lifted' if up else ''}" for k, _, up in pieces]), static=True)
     rec.log("log", rr.TextLog(_summary(scene, plan), level="INFO" if plan.solved else "WARN"), static=True)
 
 
-def _frames(plan: Plan, step: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Segment index, push time and pose of each animation frame.
+class _Frames(NamedTuple):
+    """The animation, one item per frame."""
 
-    No body point moves more than ``step`` between frames (push time bounds point travel), unless
-    that would take more than ``MAX_FRAMES``: then frames are shared out in proportion to the
-    segments' durations. Every segment gets at least its first frame, and a last frame shows the
-    final pose, so there are at most ``max(MAX_FRAMES, pushes + 1)`` frames.
+    index: np.ndarray  # the segment shown
+    times: np.ndarray  # plan time, s
+    part: np.ndarray  # the part's pose
+    pusher: np.ndarray  # the pusher frame's world pose (planner.bodies.pusher_frame_body)
+    lifted: np.ndarray  # whether the pusher is in the air
+
+
+def _pusher_on(slider: Slider, edge: int) -> np.ndarray:
+    """The pusher frame's pose in the slider frame while it pushes ``edge``: face centred on the
+    edge's midpoint (:func:`planner.bodies.pusher_polygon`), facing the part."""
+    a, b = slider.edge(edge)
+    return contact_pose(np.zeros(3), (a + b) / 2, -slider.inward_normal(edge))
+
+
+def _sample(slider: Slider, body: np.ndarray, segment: Segment | Transit,
+            t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The part's and the pusher's poses and the pusher's being airborne, ``t`` into ``segment``."""
+    if segment.kind == "transit":
+        pusher, lifted = transit_poses(segment, body, t)
+        return np.tile(segment.pose, (len(t), 1)), pusher, lifted
+    part = exp_twist(segment.start, segment.twist, t)
+    local = _pusher_on(slider, segment.edge)
+    pusher = np.column_stack([_place(local[None, :2], part)[:, 0], part[:, 2] + local[2]])
+    return part, pusher, np.zeros(len(t), dtype=bool)
+
+
+def _frames(scene: Scene, plan: Plan, step: float) -> _Frames:
+    """Every animation frame.
+
+    No body point moves more than ``step`` between frames (pushes and transits alike, duration
+    bounds point travel), unless that would take more than ``MAX_FRAMES``: then frames are
+    shared out in proportion to the segments' durations. Every segment gets at least its first
+    frame, and a last frame shows the end of the last, so there are at most
+    ``max(MAX_FRAMES, segments + 1)`` frames.
     """
     segments = plan.segments
+    body = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
     durations = np.array([s.duration for s in segments])
     counts = np.maximum(np.ceil(durations / step), 1).astype(int)
     if counts.sum() > MAX_FRAMES - 1:
         budget = max(MAX_FRAMES - 1 - len(segments), 0)
         counts = 1 + (budget * durations / durations.sum()).astype(int)
-    index, times, poses = [], [], []
+    index, times, samples = [], [], []
     clock = 0.0
     for k, (s, n) in enumerate(zip(segments, counts)):
         t = np.arange(n) * (s.duration / n)
         index.append(np.full(n, k))
         times.append(clock + t)
-        poses.append(exp_twist(s.start, s.twist, t))
+        samples.append(_sample(scene.slider, body, s, t))
         clock += s.duration
     index.append([len(segments) - 1])
     times.append([clock])
-    poses.append([plan.final])
-    return np.concatenate(index), np.concatenate(times), np.concatenate(poses)
+    samples.append(_sample(scene.slider, body, segments[-1], np.array([segments[-1].duration])))
+    return _Frames(np.concatenate(index), np.concatenate(times), *map(np.concatenate, zip(*samples)))
 
 
 def _history(points: np.ndarray, index: np.ndarray) -> list[np.ndarray]:
@@ -188,9 +240,10 @@ def _rings(geometry: shapely.Geometry) -> list[np.ndarray]:
 
 
 def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
-    """``/analysis``: the pushed edge's regions in the slider frame (module docstring)."""
+    """``/analysis``: the first pushed edge's regions in the slider frame (module docstring)."""
     slider, p = scene.slider, scene.pusher
-    edge = plan.segments[0].edge
+    pushes = [s for s in plan.segments if s.kind == "push"]
+    edge = pushes[0].edge
     window = (*(slider.cf - 4 * slider.radius), *(slider.cf + 4 * slider.radius))
     # The exact region whatever the plan used (cached): the view compares it with STABLE's.
     regions = {"stable": edge_region(slider, edge, p.mu, p.width, "stable").cor_polygons(window),
@@ -209,19 +262,24 @@ def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
         for label, colour in _STATUS.items():
             rings = _rings(status[sense][label])
             rec.log(f"analysis/sticking/{side}/{label}", rr.LineStrips2D(rings, colors=colour, radii=_THIN), static=True)
-    cors = [c for c, sense in map(twist_to_cor, (s.twist for s in plan.segments)) if sense != 0]
+    cors = [c for c, sense in map(twist_to_cor, (s.twist for s in pushes if s.edge == edge)) if sense != 0]
     inside = [c for c in cors if shapely.box(*window).contains(shapely.Point(c))]  # far ones would zoom the view out
     rec.log("analysis/cor", rr.Points2D(inside or np.zeros((0, 2)), colors=_COR, radii=_DOT), static=True)
 
 
-def _log_ghost(rec: rr.RecordingStream, verification: Verification, index: np.ndarray, times: np.ndarray) -> None:
-    """``/world/ghost`` at up to ``GHOST_SAMPLES`` of each push's frames, and ``/log/verify``."""
+def _log_ghost(rec: rr.RecordingStream, plan: Plan, verification: Verification, index: np.ndarray,
+               times: np.ndarray) -> None:
+    """``/world/ghost`` at up to ``GHOST_SAMPLES`` of each push's frames, and ``/log/verify``.
+
+    The verification checks pushes only, in plan order: its ``i``-th is the plan's ``i``-th push,
+    whose frames are found by that push's segment index."""
     frames, poses = [], []
-    for k in range(len(verification.pushes)):
-        mine = np.flatnonzero(index == k)  # the last segment's frames include the final one
+    segment_of = [k for k, s in enumerate(plan.segments) if s.kind == "push"]
+    for i in range(len(verification.pushes)):
+        mine = np.flatnonzero(index == segment_of[i])  # the last segment's frames include the final one
         mine = mine[np.unique(np.linspace(0, len(mine) - 1, min(GHOST_SAMPLES, len(mine))).round().astype(int))]
         frames.append(mine)
-        poses.append(verification.poses(k, times[mine] - times[mine[0]]))
+        poses.append(verification.poses(i, times[mine] - times[mine[0]]))
     frames = np.concatenate(frames)
     outline = _closed(verification.scene.slider.vertices)
     rec.send_columns("world/ghost", indexes=[rr.TimeColumn("step", sequence=frames),
@@ -234,41 +292,44 @@ def _log_ghost(rec: rr.RecordingStream, verification: Verification, index: np.nd
 
 def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
     """The animated entities; returns the frames' segment indices and times."""
-    index, times, poses = _frames(plan, scene.slider.radius / FRAMES_PER_RADIUS)
+    frames = _frames(scene, plan, scene.slider.radius / FRAMES_PER_RADIUS)
+    index, times, poses = frames.index, frames.times, frames.part
     steps = [rr.TimeColumn("step", sequence=np.arange(len(times))), rr.TimeColumn("time", duration=times)]
-    slider, width, depth = scene.slider, scene.pusher.width, scene.pusher.depth
+    slider = scene.slider
     window = (*(slider.cf - 4 * slider.radius), *(slider.cf + 4 * slider.radius))
     regions = {push.edge: {sense: _outline(poly) for sense, poly in push.region.cor_polygons(window).items()}
                for push in edge_pushes(scene)}
-    # Per frame: the pusher's outline; the COR and the regions' outlines, none or one each.
-    pusher: list[np.ndarray] = []
+    # Per frame: the COR and the regions' outlines, none or one each.
     cor: list[np.ndarray] = []
     stable: dict[int, list[np.ndarray]] = {1: [], -1: []}
     for k, s in enumerate(plan.segments):
         at = poses[index == k]
-        pusher.append(_place(_closed(pusher_polygon(slider, s.edge, width, depth).exterior.coords[:-1]), at))
-        centre, sense = twist_to_cor(s.twist)
+        centre, sense = twist_to_cor(s.twist)  # a transit's twist is zero: no COR
         cor += list(_place(centre[None], at)) if sense != 0 else [np.zeros((0, 2))] * len(at)
-        for side, outline in regions[s.edge].items():
+        outlines = regions[s.edge] if s.kind == "push" else dict.fromkeys(stable)  # nothing is pushed
+        for side, outline in outlines.items():
             empty = [np.zeros((0, 0, 2))] * len(at)
             stable[side] += empty if outline is None else list(_place(outline, at)[:, None])
 
-    def send(entity: str, columns: rr.ComponentColumnList, rows: list[np.ndarray] | None = None) -> None:
-        """One row per frame; ``rows`` (the items of each frame) splits ``columns`` into them."""
-        rec.send_columns(entity, indexes=steps,
-                         columns=columns if rows is None else columns.partition([len(r) for r in rows]))
+    def send(entity: str, columns: rr.ComponentColumnList, lengths: ArrayLike | None = None) -> None:
+        """One row per frame; ``lengths`` (how many items each frame has) splits ``columns`` into them."""
+        rec.send_columns(entity, indexes=steps, columns=columns if lengths is None else columns.partition(lengths))
 
     send("world/slider", rr.LineStrips2D.columns(strips=_place(_closed(slider.vertices), poses)))
-    send("world/pusher", rr.LineStrips2D.columns(strips=np.concatenate(pusher)))
+    pusher = _place(_closed(pusher_frame_body(scene.pusher.width, scene.pusher.depth)), frames.pusher)
+    for entity, shown in (("world/pusher", ~frames.lifted), ("world/pusher_lifted", frames.lifted)):
+        send(entity, rr.LineStrips2D.columns(strips=pusher[shown]), shown.astype(int))
     send("world/cf_path", rr.LineStrips2D.columns(strips=_history(_place(slider.cf[None], poses)[:, 0], index)))
-    send("world/cor", rr.Points2D.columns(positions=np.concatenate(cor)), cor)
+    send("world/cor", rr.Points2D.columns(positions=np.concatenate(cor)), [len(c) for c in cor])
     for name, side in (("ccw", 1), ("cw", -1)):
         send(f"world/stable/{name}", rr.LineStrips2D.columns(strips=[o for row in stable[side] for o in row]),
-             stable[side])
+             [len(row) for row in stable[side]])
     for entity, color, radius in (("world/slider", _SLIDER, _BOLD), ("world/pusher", _DARK, _BOLD),
                                   ("world/cf_path", _CF, _LINE), ("world/stable/ccw", _CCW, _LINE),
                                   ("world/stable/cw", _CW, _LINE)):
         rec.log(entity, rr.LineStrips2D.from_fields(colors=color, radii=radius), static=True)
+    rec.log("world/pusher_lifted", rr.LineStrips2D.from_fields(colors=_LIFTED, radii=_THIN, labels=["lifted"]),
+            static=True)
     rec.log("world/cor", rr.Points2D.from_fields(colors=_COR, radii=_DOT), static=True)
     return index, times
 
@@ -313,8 +374,9 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
             _log_static(rec, scene, plan)
             if plan.segments:
                 index, times = _log_motion(rec, scene, plan)
-                _log_analysis(rec, scene, plan)
+                if plan.pushes:
+                    _log_analysis(rec, scene, plan)
                 if verification is not None:
-                    _log_ghost(rec, verification, index, times)
+                    _log_ghost(rec, plan, verification, index, times)
         finally:
             rec.disconnect()  # flushes and writes the footer

@@ -13,15 +13,16 @@ The OMPL objects are kept separate, as OMPL intends, and none of them knows abou
   the part backwards);
 * validity: :class:`~planner.validity.CollisionModel` with its clearance rule;
 * goal: the pose tolerance, or one or two stable collision-free pushes away
-  (:class:`~planner.preimage.GoalPreimage`).
+  (:class:`~planner.preimage.GoalPreimage`), on the state's edge or, with switching, on another
+  edge the pusher can reach from there.
 
 Every allowed edge gets a start state, so the trees of all edges grow at once; no time is split
 between edges.
 
 Switches cost (Lynch & Mason 1996, §4: a cost per contact change): a plan's cost is the length of
 its centre of friction's path plus ``switch_cost`` per switch. When the first plan found switches,
-a search without switches gets as many iterations again (a count, not a time, so a seed still
-gives one plan), and its plan wins if it costs no more.
+a search without switches gets a budget of iterations (:data:`ONE_EDGE_ITERATIONS`; a count, not a
+time, so a seed still gives one plan), and its plan wins if it costs no more.
 """
 
 from __future__ import annotations
@@ -46,11 +47,15 @@ from .scene import Scene, SceneError, check_regions, check_switch_cost, check_tr
 from .transit import TransitPlanner
 from .validity import CollisionModel
 
-__all__ = ["plan", "MAX_CONTROL_STEPS", "SWITCH_SHARE"]
+__all__ = ["plan", "MAX_CONTROL_STEPS", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS", "SWITCH_SHARE"]
 #: Longest constant push the planners sample, in collision-check steps.
 MAX_CONTROL_STEPS = 30
 #: Share of sampled controls that switch edges, when switching is allowed.
 SWITCH_SHARE = 0.1
+#: When the first plan found switches, a search without switches gets this many times the
+#: iterations the first search used (at least ``ONE_EDGE_MIN_ITERATIONS``): its iterations cost
+#: about a fifth as much (no transits to find), but one edge alone usually needs more of them.
+ONE_EDGE_ITERATIONS, ONE_EDGE_MIN_ITERATIONS = 4, 1000
 
 _PLANNERS: dict[str, Callable] = {"rrt": oc.RRT, "kpiece": oc.KPIECE1, "est": oc.EST}
 
@@ -91,12 +96,27 @@ def _within_tolerance(scene: Scene, pose: np.ndarray) -> bool:
             and abs(float(wrap_angle(pose[2] - g[2]))) <= scene.tolerance_angle)
 
 
-class _PushGoal(ob.GoalSampleableRegion):
-    """Within the scene tolerance of the goal, or in its preimage under one or two stable pushes."""
+def _to_goal(preimage: GoalPreimage, transits: TransitPlanner | None, pose: np.ndarray, k: int) -> list | None:
+    """One or two pushes on edge index ``k`` from ``pose`` to the goal, or else (with ``transits``)
+    a switch to another edge and one or two pushes on it; None if neither."""
+    last = preimage.connect(pose, k)
+    if last is not None or transits is None:
+        return last
+    for other, push in enumerate(preimage.pushes):
+        if other != k and (last := preimage.connect(pose, other)) is not None:
+            transit = transits.find(pose, preimage.pushes[k].edge, push.edge)
+            if transit is not None:
+                return [transit, *last]
+    return None
 
-    def __init__(self, si, scene: Scene, preimage: GoalPreimage):
+
+class _PushGoal(ob.GoalSampleableRegion):
+    """Within the scene tolerance of the goal, or in its preimage under one or two stable pushes
+    (after a switch of edge, when switching is allowed)."""
+
+    def __init__(self, si, scene: Scene, preimage: GoalPreimage, transits: TransitPlanner | None):
         super().__init__(si)
-        self.scene, self.preimage = scene, preimage
+        self.scene, self.preimage, self.transits = scene, preimage, transits
         self._samples = 0
         self.setThreshold(1e-9)  # OMPL accepts distances strictly below the threshold
 
@@ -105,7 +125,7 @@ class _PushGoal(ob.GoalSampleableRegion):
         pose = np.array([p.getX(), p.getY(), p.getYaw()])
         if k >= len(self.preimage.pushes):  # the marker of a blocked switch
             return math.inf
-        if _within_tolerance(self.scene, pose) or self.preimage.connect(pose, k) is not None:
+        if _within_tolerance(self.scene, pose) or _to_goal(self.preimage, self.transits, pose, k) is not None:
             return 0.0
         g = self.scene.goal
         return math.hypot(pose[0] - g[0], pose[1] - g[1]) + self.scene.slider.radius * abs(
@@ -179,15 +199,17 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     deadline = clock + float(time_limit)
     search = _Search(scene, pushes, model, preimage, name, seed, step)
     segments, tree, iterations = search.run(starts, deadline, transits)
-    if segments is not None and any(s.kind == "transit" for s in segments):
-        plain, _, _ = search.run(starts, deadline, None, iterations)
-        if plain is not None and _cost(scene, plain) <= _cost(scene, segments):
-            segments = plain
     if segments is None:
         reason = ("the final push failed its re-check after rounding" if tree is None
                   else f"no plan found within the time limit of {time_limit:g} s")
         return done([], reason, tree)
-    return done(shortcut(segments), tree=tree)
+    segments = shortcut(segments)
+    if any(s.kind == "transit" for s in segments):
+        budget = max(ONE_EDGE_ITERATIONS * iterations, ONE_EDGE_MIN_ITERATIONS)
+        plain, _, _ = search.run(starts, deadline, None, budget)
+        if plain is not None and _cost(scene, plain := shortcut(plain)) <= _cost(scene, segments):
+            segments = plain
+    return done(segments, tree=tree)
 
 
 def _cost(scene: Scene, segments: list) -> float:
@@ -218,7 +240,7 @@ class _Search:
             s[0].setYaw(float(wrap_angle(self.scene.start[2])))
             s[1].value = k
             ss.addStartState(s)
-        ss.setGoal(_PushGoal(si, self.scene, self.preimage))
+        ss.setGoal(_PushGoal(si, self.scene, self.preimage, transits))
         ss.setPlanner(_PLANNERS[self.name](si))
         count = [0]
 
@@ -354,7 +376,7 @@ def _segments(path, scene: Scene, pushes: list[EdgePush], preimage: GoalPreimage
         pose = end
     if not _within_tolerance(scene, pose):
         # The goal test accepted the tree's last state; the re-composed pose differs by rounding only.
-        last = preimage.connect(pose, k)
+        last = _to_goal(preimage, transits, pose, k)
         if last is None:
             return None
         segments += last

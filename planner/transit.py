@@ -40,11 +40,25 @@ from .pushes import resolution
 from .scene import Scene
 from .validity import CollisionModel
 
-__all__ = ["ARC_STEP", "TransitPlanner", "contact_pose", "path_duration"]
+__all__ = ["AIRBORNE", "ARC_STEP", "TransitPlanner", "contact_pose", "path_duration", "transit_pieces", "transit_poses"]
 
 #: Largest turn of the pusher between two poses of a walk round a corner of the part.
 ARC_STEP = math.radians(10.0)
+#: The airborne piece of a lift's path: retreat -> approach.
+AIRBORNE = 1
 _CACHE = 4096  # transits kept; the search asks again for those on its solution path
+
+
+def _steps(path: np.ndarray) -> np.ndarray:
+    """Differences of consecutive poses, the angle the shorter way round."""
+    step = np.diff(path, axis=0)
+    step[:, 2] = wrap_angle(step[:, 2])
+    return step
+
+
+def _piece_times(step: np.ndarray, reach: float) -> np.ndarray:
+    """Time of each piece with no point within ``reach`` of the pusher's origin faster than 1 m/s."""
+    return np.hypot(step[:, 0], step[:, 1]) + reach * np.abs(step[:, 2])
 
 
 def path_duration(path: ArrayLike, reach: float) -> float:
@@ -54,9 +68,7 @@ def path_duration(path: ArrayLike, reach: float) -> float:
     >>> path_duration([[0, 0, 0], [0.3, 0.4, 0], [0.3, 0.4, np.pi / 2]], 0.02)
     0.5314...
     """
-    p = np.asarray(path, dtype=float)
-    d = np.diff(p, axis=0)
-    return float(np.sum(np.hypot(d[:, 0], d[:, 1]) + reach * np.abs(wrap_angle(d[:, 2]))))
+    return float(np.sum(_piece_times(_steps(np.asarray(path, dtype=float)), reach)))
 
 
 def contact_pose(part_pose: ArrayLike, point: ArrayLike, normal: ArrayLike, gap: float = 0.0) -> np.ndarray:
@@ -69,6 +81,50 @@ def contact_pose(part_pose: ArrayLike, point: ArrayLike, normal: ArrayLike, gap:
     local = np.asarray(point, dtype=float) + gap * np.asarray(normal, dtype=float)
     x, y = transform_points(local[None], part_pose)[0]
     return np.array([x, y, float(wrap_angle(math.atan2(-normal[1], -normal[0]) + part_pose[2]))])
+
+
+def transit_pieces(transit: Transit) -> list[tuple[np.ndarray, bool]]:
+    """The path of the pusher's face centre on ``transit`` as world polylines, each with whether
+    it is airborne: the whole path for a walk round the part; for a lift, the backing off, the
+    flight and the moving in (the face centre goes straight between poses, their ``(x, y)``
+    being interpolated linearly).
+
+    >>> lift = Transit(0, 2, "lift", np.array([[0, 0, 0], [-1, 0, 0], [3, 0, 3], [2, 0, 3]]), 6.0, np.zeros(3))
+    >>> [(xy[:, 0].tolist(), up) for xy, up in transit_pieces(lift)]
+    [([0.0, -1.0], False), ([-1.0, 3.0], True), ([3.0, 2.0], False)]
+    """
+    xy = np.asarray(transit.pusher_path, dtype=float)[:, :2]
+    if transit.mode == "lift":
+        return [(xy[: AIRBORNE + 1], False), (xy[AIRBORNE: AIRBORNE + 2], True), (xy[AIRBORNE + 1:], False)]
+    return [(xy, False)]
+
+
+def transit_poses(transit: Transit, body: ArrayLike, times: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """World poses ``(n, 3)`` of the pusher frame ``times`` (s) into ``transit``, and whether
+    each is airborne.
+
+    Between path poses the pusher moves by linear interpolation of ``(x, y, theta)``, theta the
+    shorter way, each piece taking the time :func:`planner.transit.path_duration` gives it (no
+    point of ``body``, the pusher's outline in its own frame, faster than 1 m/s); the pace is
+    stretched to the transit's ``duration`` in case a plan file states another. Only the inside
+    of a lift's middle piece is airborne: its ends, the standoff poses, are on the table.
+
+    >>> lift = Transit(0, 2, "lift", np.array([[0, 0, 0], [-1, 0, 0], [3, 0, 0], [2, 0, 0]]), 6.0, np.zeros(3))
+    >>> poses, lifted = transit_poses(lift, [[0.0, 0.0]], [0.5, 1.0, 3.0, 5.0, 5.5])
+    >>> poses[:, 0].tolist(), lifted.tolist()
+    ([-0.5, -1.0, 1.0, 3.0, 2.5], [False, False, True, False, False])
+    """
+    path = np.asarray(transit.pusher_path, dtype=float)
+    step = _steps(path)
+    pieces = _piece_times(step, np.linalg.norm(np.asarray(body, dtype=float), axis=1).max())
+    ends = np.cumsum(pieces)
+    scale = ends[-1] / transit.duration if transit.duration > 0 else 0.0
+    t = np.clip(np.asarray(times, dtype=float) * scale, 0.0, ends[-1])
+    k = np.minimum(np.searchsorted(ends, t, side="right"), len(pieces) - 1)  # zero-length pieces are skipped
+    into = t - (ends[k] - pieces[k])
+    u = np.divide(into, pieces[k], out=np.ones_like(t), where=pieces[k] > 0)
+    lifted = (transit.mode == "lift") & (k == AIRBORNE) & (u > 0) & (u < 1)
+    return path[k] + u[:, None] * step[k], lifted
 
 
 class TransitPlanner:
@@ -115,24 +171,31 @@ class TransitPlanner:
             if len(self._cache) >= _CACHE:
                 self._cache.clear()
             pose = np.asarray(part_pose, dtype=float)
-            found = [t for t in (self._walk(pose, a, b, +1), self._walk(pose, a, b, -1),
-                                 self._lift(pose, a, b) if self.mode == "lift" else None) if t is not None]
-            self._cache[key] = min(found, key=lambda t: t.duration) if found else None
+            candidates = [self._walk(pose, a, b, +1), self._walk(pose, a, b, -1)]
+            if self.mode == "lift":
+                candidates.append(self._lift(pose, a, b))
+            # Collision checks cost far more than building paths: check the quickest first.
+            candidates.sort(key=lambda t: t.duration)
+            self._cache[key] = next((t for t in candidates if self._is_free(t)), None)
         return self._cache[key]
+
+    def _is_free(self, transit: Transit) -> bool:
+        """Every in-plane piece of ``transit`` keeps the margin from obstacles and walls."""
+        path = transit.pusher_path
+        pieces = zip(path, path[1:]) if transit.mode == "plane" else ((path[0], path[1]), (path[2], path[3]))
+        return all(self.model.pusher_move_is_free(p, q, self.margin) for p, q in pieces)
 
     def _transit(self, pose: np.ndarray, a: int, b: int, mode: str, path: list[np.ndarray]) -> Transit:
         return Transit(a, b, mode, np.array(path), path_duration(path, self.reach), pose.copy())
 
-    def _lift(self, pose: np.ndarray, a: int, b: int) -> Transit | None:
+    def _lift(self, pose: np.ndarray, a: int, b: int) -> Transit:
         (_, ma, na), (_, mb, nb) = self._sides[a], self._sides[b]
         path = [contact_pose(pose, ma, na), contact_pose(pose, ma, na, self.standoff),
                 contact_pose(pose, mb, nb, self.standoff), contact_pose(pose, mb, nb)]
-        if not (self._free(path[0], path[1]) and self._free(path[2], path[3])):
-            return None
         return self._transit(pose, a, b, "lift", path)
 
-    def _walk(self, pose: np.ndarray, a: int, b: int, turn: int) -> Transit | None:
-        """Round the part counter-clockwise (``turn = +1``) or clockwise (``-1``), or None if blocked."""
+    def _walk(self, pose: np.ndarray, a: int, b: int, turn: int) -> Transit:
+        """Round the part counter-clockwise (``turn = +1``) or clockwise (``-1``)."""
         (ja, ma, na), (jb, mb, nb) = self._sides[a], self._sides[b]
         g, n = self.standoff, len(self._hull)
         path = [contact_pose(pose, ma, na), contact_pose(pose, ma, na, g)]
@@ -149,9 +212,4 @@ class TransitPlanner:
                 path.append(contact_pose(pose, self._hull[corner], (math.cos(phi), math.sin(phi)), g))
             side = following
         path += [contact_pose(pose, mb, nb, g), contact_pose(pose, mb, nb)]
-        if not all(self._free(p, q) for p, q in zip(path, path[1:])):
-            return None
         return self._transit(pose, a, b, "plane", path)
-
-    def _free(self, p: np.ndarray, q: np.ndarray) -> bool:
-        return self.model.pusher_move_is_free(p, q, self.margin)

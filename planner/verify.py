@@ -27,6 +27,16 @@ hide or excuse another. The *drift* also reports where the part would end if eac
 from the previous push's simulated end (the pusher placed on the edge afresh for each push): the
 simulator is invariant under moving the start pose, so this is each distribution's simulated
 relative motions composed, without simulating again.
+
+Transits. While the pusher moves from one edge to another the part stands still, so there is
+nothing to simulate; but each push is simulated from its own planned start with the pusher on its
+own edge, which would not notice a plan that teleports the part or the pusher between pushes.
+So before simulating, :func:`verify` checks that the plan hangs together: every segment starts
+where the one before it left the part, every push is on the edge the pusher is on, and every
+transit starts at the contact pose on that edge, ends at the contact pose on the next push's edge,
+and uses a mode the scene allows (a lift only with ``pusher.transit: lift``). The drift treats a
+transit as the identity. Whether a transit's path is collision-free is the planner's rule
+(:mod:`planner.transit`), not checked here.
 """
 
 from __future__ import annotations
@@ -45,8 +55,9 @@ from mechanics.quasistatic import (DEFAULT_STEPS, Contact, ContactMode, PushResu
 
 from .bodies import transform_points
 from .fields import SceneError
-from .plan_file import Plan, Segment
+from .plan_file import Plan, Segment, Transit
 from .scene import Scene
+from .transit import contact_pose
 
 __all__ = ["TOLERANCE", "PushCheck", "Verification", "distributions", "verify"]
 
@@ -145,9 +156,14 @@ class PushCheck:
 
 @dataclass(frozen=True, eq=False)
 class Verification:
-    """Outcome of :func:`verify`: per push, and the plan's drift when pushes are chained."""
+    """Outcome of :func:`verify`: per push, and the plan's drift when pushes are chained.
+
+    ``pushes`` holds one check per push segment, in order (transits have nothing to simulate);
+    ``segments`` is the whole plan, so that :meth:`lines` can show where the pusher switched.
+    """
 
     scene: Scene
+    segments: tuple[Segment | Transit, ...]
     supports: tuple[SupportDistribution, ...]
     kinds: tuple[str, ...]
     pushes: tuple[PushCheck, ...]
@@ -182,38 +198,63 @@ class Verification:
                          if t > 0 else s.start for t in np.asarray(times, dtype=float)])
 
     def lines(self) -> list[str]:
-        """A line per push (``plan --verify`` prints them, then :meth:`summary`)."""
+        """A line per segment, in plan order (``plan --verify`` prints them, then :meth:`summary`).
+
+        A transit has nothing to simulate and :func:`verify` refuses a plan whose transits do not
+        join up, so every transit it reports on is ``ok``; its line shows where the edge changes.
+        """
+        transits = [s for s in self.segments if s.kind == "transit"]
+        numbered = {"push": iter(enumerate(self.pushes, 1)), "transit": iter(enumerate(transits, 1))}
         out = []
-        for k, p in enumerate(self.pushes):
-            runs = len(p.results)
-            stuck = sum(r.sticks for r in p.results)
-            stopped = {s: sum(r.status == s for r in p.results) for s in ("separated", "slid_off_edge", "no_solution")}
-            notes = [f"{stuck}/{runs} stick"] + [f"{c} {s.replace('_', ' ')}" for s, c in stopped.items() if c]
-            if (ambiguous := sum(r.ambiguous_steps > 0 for r in p.results)):
-                notes.append(f"{ambiguous} ambiguous")
-            if (modes := p.non_sticking_modes()):
-                notes.append(f"modes {', '.join(modes)}")
-            out.append(f"push {k + 1}/{len(self.pushes)} (edge {p.segment.edge}, {p.segment.duration:.3f} s): "
-                       f"worst {p.position_error.max():.2e} m, {p.angle_error.max():.2e} rad "
-                       f"({self.kinds[p.worst]} run {p.worst}); {', '.join(notes)}: {'ok' if p.passed else 'SLIPS'}")
+        for s in self.segments:
+            k, item = next(numbered[s.kind])
+            out.append(self._push_line(k, item) if s.kind == "push" else
+                       f"transit {k}/{len(transits)} (edge {item.from_edge} -> {item.to_edge}, {item.mode}, "
+                       f"{item.duration:.3f} s): part still, flush on both edges: ok")
         return out
+
+    def _push_line(self, k: int, p: PushCheck) -> str:
+        """The verdict on push ``k`` (from 1) and what its runs did."""
+        runs = len(p.results)
+        stuck = sum(r.sticks for r in p.results)
+        stopped = {s: sum(r.status == s for r in p.results) for s in ("separated", "slid_off_edge", "no_solution")}
+        notes = [f"{stuck}/{runs} stick"] + [f"{c} {s.replace('_', ' ')}" for s, c in stopped.items() if c]
+        if (ambiguous := sum(r.ambiguous_steps > 0 for r in p.results)):
+            notes.append(f"{ambiguous} ambiguous")
+        if (modes := p.non_sticking_modes()):
+            notes.append(f"modes {', '.join(modes)}")
+        return (f"push {k}/{len(self.pushes)} (edge {p.segment.edge}, {p.segment.duration:.3f} s): "
+                f"worst {p.position_error.max():.2e} m, {p.angle_error.max():.2e} rad "
+                f"({self.kinds[p.worst]} run {p.worst}); {', '.join(notes)}: {'ok' if p.passed else 'SLIPS'}")
 
     def summary(self) -> str:
         """One line: the verdict, the distributions, the worst deviation and the chained drift."""
         mix = ", ".join(f"{self.kinds.count(k)} {k}" for k in dict.fromkeys(self.kinds))
         position, angle = self.worst
-        return (f"verify: {'passed' if self.passed else 'FAILED'}: {len(self.pushes)} pushes x "
+        return (f"verify: {'passed' if self.passed else 'FAILED'}: {len(self.pushes)} push{'' if len(self.pushes) == 1 else 'es'} x "
                 f"{len(self.supports)} distributions ({mix}); worst deviation {position:.2e} m, {angle:.2e} rad; "
                 f"chained drift {self.drift[0]:.2e} m, {self.drift[1]:.2e} rad "
                 f"(tolerance {self.tolerance[0]:.1e} m, {self.tolerance[1]:.1e} rad)")
 
 
+def _allowed_edge(scene: Scene, edge: int, field: str) -> None:
+    """Refuse an edge the scene does not let the pusher push (a plan made for another scene)."""
+    if edge not in scene.pusher.edges:
+        raise SceneError(field, f"edge {edge} is not one the scene lets the pusher push "
+                                f"(allowed: {', '.join(map(str, scene.pusher.edges))})")
+
+
+def _off(scene: Scene, pose: ArrayLike, expected: ArrayLike) -> bool:
+    """``pose`` is not ``expected`` to :data:`TOLERANCE` (in slider radii and radians): the same
+    pose but for rounding, as in a plan file written with full precision."""
+    gap = np.asarray(pose, dtype=float) - expected
+    return bool(np.hypot(gap[0], gap[1]) > TOLERANCE * scene.slider.radius or abs(wrap_angle(gap[2])) > TOLERANCE)
+
+
 def _contacts(scene: Scene, segment: Segment, name: str) -> tuple[Contact, ...]:
     """The scene's flat pusher on ``segment``'s edge, after checking the segment is for this scene."""
     slider, pusher, edge = scene.slider, scene.pusher, segment.edge
-    if edge not in pusher.edges:
-        raise SceneError(f"{name}.edge", f"edge {edge} is not one the scene lets the pusher push "
-                                         f"(allowed: {', '.join(map(str, pusher.edges))})")
+    _allowed_edge(scene, edge, f"{name}.edge")
     expected = slider.contact(edge, pusher.width)
     miss = min(np.abs(segment.contact - expected).max(), np.abs(segment.contact[::-1] - expected).max())
     if miss > TOLERANCE * slider.radius:  # a plan made for another part or another pusher width
@@ -222,6 +263,50 @@ def _contacts(scene: Scene, segment: Segment, name: str) -> tuple[Contact, ...]:
     if segment.duration <= 0:
         raise SceneError(f"{name}.duration", "must be > 0 to be verified")
     return edge_contacts(slider, edge, pusher.mu, pusher.width)
+
+
+def _check_transit(scene: Scene, transit: Transit, edge: int | None, name: str) -> None:
+    """Refuse a transit the scene does not allow, or one that does not leave from ``edge`` (the
+    edge the pusher is on; None at the plan's start) and reach its own ``to_edge`` flush."""
+    allowed = scene.pusher.transit
+    if allowed == "none" or (transit.mode == "lift" and allowed != "lift"):
+        raise SceneError(f"{name}.mode", f"a {transit.mode} transit is not allowed: the scene's pusher.transit "
+                                         f"is {allowed!r}")
+    if edge is not None and transit.from_edge != edge:
+        raise SceneError(f"{name}.from_edge", f"must be {edge}, the edge the pusher is on, got {transit.from_edge}")
+    ends = (("from_edge", "starts", transit.from_edge, transit.pusher_path[0]),
+            ("to_edge", "ends", transit.to_edge, transit.pusher_path[-1]))
+    for field, verb, e, pose in ends:
+        _allowed_edge(scene, e, f"{name}.{field}")
+        a, b = scene.slider.edge(e)
+        flush = contact_pose(transit.pose, (a + b) / 2, -scene.slider.inward_normal(e))
+        if _off(scene, pose, flush):
+            raise SceneError(f"{name}.pusher_path", f"{verb} at {np.round(pose, 6).tolist()}, not at the contact "
+                                                    f"pose on edge {e}: {np.round(flush, 6).tolist()}")
+
+
+def _check_chain(scene: Scene, plan: Plan) -> list[tuple[Contact, ...]]:
+    """The pusher's contacts for each push, after checking that every segment fits the scene and
+    takes over where the one before left the part and the pusher (module docstring)."""
+    pose, edge, after = plan.start, None, "the plan's start"
+    contacts = []
+    for k, segment in enumerate(plan.segments):
+        name = f"plan.segments[{k}]"
+        # A transit's pose is not in the file (it is the previous end), so only a plan built in
+        # memory can get it wrong; then the segment as a whole is at fault.
+        if _off(scene, segment.start, pose):
+            raise SceneError(name if segment.kind == "transit" else f"{name}.start",
+                             f"the part is at {np.round(segment.start, 6).tolist()}, not where {after} left it: "
+                             f"{np.round(pose, 6).tolist()}")
+        if segment.kind == "transit":
+            _check_transit(scene, segment, edge, name)
+        else:
+            if edge is not None and segment.edge != edge:
+                raise SceneError(f"{name}.edge", f"must be {edge}, the edge the pusher is on after {after} "
+                                                 f"(a change of edge needs a transit), got {segment.edge}")
+            contacts.append(_contacts(scene, segment, name))
+        pose, edge, after = segment.end, segment.edge, name
+    return contacts
 
 
 def _deviation(scene: Scene, simulated: np.ndarray, planned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
@@ -255,7 +340,9 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
     ------
     SceneError
         If a segment does not fit the scene (an edge the scene does not allow, a contact off its
-        edge, a push of no duration), naming the plan field.
+        edge, a push of no duration, a lift where the pusher must stay on the table) or does not
+        take over where the one before it left the part and the pusher (module docstring),
+        naming the plan field.
     ValueError
         If ``n < 1``.
 
@@ -267,14 +354,14 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
     >>> check.passed, len(check.pushes), check.worst[0] < 1e-12
     (True, 1, True)
     """
-    contacts = [_contacts(scene, s, f"plan.segments[{k}]") for k, s in enumerate(plan.segments)]
+    contacts = _check_chain(scene, plan)
     clock = time.perf_counter()
     supports, kinds = distributions(scene, n, seed)
     limits = (tolerance * scene.slider.radius, tolerance)
     footprint = scene.slider.polygon
     checks = []
-    chained = np.tile(plan.segments[0].start if plan.segments else plan.start, (n, 1))
-    for segment, fingers in zip(plan.segments, contacts):
+    chained = np.tile(plan.start, (n, 1))  # transits leave it be: the part stands still
+    for segment, fingers in zip([s for s in plan.segments if s.kind == "push"], contacts):
         results = tuple(simulate_push(s, fingers, segment.twist, segment.duration, footprint=footprint,
                                       start_pose=segment.start) for s in supports)
         ends = np.array([r.final_pose for r in results])
@@ -282,5 +369,5 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
         # chained * (start^-1 end): each run's own relative motion, from where it got to.
         chained = exp_twist(chained, log_pose(segment.start, ends))
     drift = _deviation(scene, chained, plan.final)
-    return Verification(scene, tuple(supports), tuple(kinds), tuple(checks),
+    return Verification(scene, tuple(plan.segments), tuple(supports), tuple(kinds), tuple(checks),
                         (float(drift[0].max()), float(drift[1].max())), limits, time.perf_counter() - clock)

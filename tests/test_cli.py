@@ -36,7 +36,8 @@ BATTERY = yaml.safe_load(BATTERY_TEXT)  # a one-step plan: solved at once
 VERTICES = BATTERY["slider"]["vertices"]
 ERROR = re.compile(r"plan: error: (.+?): (.+)")
 PLAN_KEYS = {"format", "scene", "solved", "planner", "seed", "planning_time_s", "start", "goal", "final", "segments"}
-SEGMENT_KEYS = {"kind", "edge", "contact", "twist", "duration", "start", "end"}
+SEGMENT_KEYS = {"push": {"kind", "edge", "contact", "twist", "duration", "start", "end"},
+                "transit": {"kind", "from_edge", "to_edge", "mode", "pusher_path", "duration"}}
 L_SHAPE = [[0.0, 0.0], [0.09, 0.0], [0.09, 0.035], [0.035, 0.035], [0.035, 0.09], [0.0, 0.09]]  # edges 2, 3 concave
 
 # The goal sits inside a closed ring of four walls: free of collision, but no path leads there.
@@ -110,7 +111,7 @@ def plan_json(path: Path) -> dict:
     assert set(data) == PLAN_KEYS
     assert data["format"] == "stablepush.plan/1"
     for segment in data["segments"]:
-        assert set(segment) == SEGMENT_KEYS and segment["kind"] == "push"
+        assert set(segment) == SEGMENT_KEYS[segment["kind"]]
     return data
 
 
@@ -217,6 +218,12 @@ BAD_SCENES = {
     "planner seed beyond 32 bits": (battery(planner={"seed": 2**32}), "planner.seed", None),
     "planner time limit 0": (battery(planner={"time_limit": 0}), "planner.time_limit", "> 0"),
     "planner time limit of years": (battery(planner={"time_limit": 1e9}), "planner.time_limit", "at most"),
+    "transit unknown": (nested("pusher.transit", "teleport"), "pusher.transit", "must be one of"),
+    "transit a list": (nested("pusher.transit", ["plane"]), "pusher.transit", "must be one of"),
+    "transit null": (nested("pusher.transit", None), "pusher.transit", "must be one of"),
+    "switch cost negative": (battery(planner={"switch_cost": -0.01}), "planner.switch_cost", ">= 0"),
+    "switch cost a string": (battery(planner={"switch_cost": "high"}), "planner.switch_cost", "number"),
+    "switch cost infinite": (battery(planner={"switch_cost": float("inf")}), "planner.switch_cost", "finite"),
     "name with a slash": (battery(name="a/b"), "name", None),
     "name a number": (battery(name=5), "name", None),
     "name with a NUL": (battery(name="a\0b"), "name", None),
@@ -377,7 +384,7 @@ def test_battery_solves_and_writes_plan_and_recording(tmp_path):
     assert run.returncode == 0, run.stderr
     assert run.stderr == ""
     lines = run.stdout.splitlines()
-    assert len(lines) == 1 and lines[0].startswith("solved: 1 pushes"), run.stdout
+    assert len(lines) == 1 and lines[0].startswith("solved: 1 push,"), run.stdout
     out = tmp_path / "out"
     assert {p.name for p in out.iterdir()} == {"battery.json", "battery.rrd"}  # and no temporary files
     data = plan_json(out / "battery.json")
@@ -404,7 +411,7 @@ def test_default_output_folder_is_logs_name_timestamp_under_the_cwd(tmp_path, mo
 
 # --- determinism -----------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("scene, seed", [("corridor", 3), ("cluttered", 1)])
+@pytest.mark.parametrize("scene, seed", [("corridor", 3), ("cluttered", 1), ("junction", 2)])
 def test_same_seed_same_plan_across_processes(scene, seed, tmp_path):
     runs = [subprocess.Popen([str(PLAN), str(SCENES / f"{scene}.yaml"), "--seed", str(seed), "--out", out],
                              cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)

@@ -57,3 +57,54 @@ def test_unreadable_files(tmp_path):
     (tmp_path / "broken.json").write_text("{not json")
     with pytest.raises(SceneError, match="not valid JSON"):
         load_plan(tmp_path / "broken.json")
+
+
+@pytest.fixture(scope="module")
+def switching(tmp_path_factory):
+    """A plan that changes edge once, the pusher walking round the part (scenes/junction.yaml)."""
+    result = plan(load_scene(ROOT / "scenes" / "junction.yaml"), seed=1)
+    assert result.solved and result.switches == 1
+    path = tmp_path_factory.mktemp("plan") / "junction.json"
+    path.write_text(result.to_json())
+    return path, json.loads(result.to_json())
+
+
+def transit_index(data: dict) -> int:
+    return next(k for k, s in enumerate(data["segments"]) if s["kind"] == "transit")
+
+
+def test_transit_round_trip(switching):
+    path, data = switching
+    loaded = load_plan(path)
+    assert loaded.to_dict() == data
+    k = transit_index(data)
+    transit = loaded.segments[k]
+    assert transit.kind == "transit" and transit.from_edge != transit.to_edge
+    assert loaded.switches == 1 and loaded.pushes == len(data["segments"]) - 1
+    # The part stands still: the transit's pose is the end of the push before it.
+    assert transit.start.tolist() == transit.end.tolist() == data["segments"][k - 1]["end"]
+
+
+@pytest.mark.parametrize("edit, field", [
+    (lambda t: t.update(mode="teleport"), "mode"),
+    (lambda t: t.update(mode=None), "mode"),
+    (lambda t: t.pop("to_edge"), "to_edge"),
+    (lambda t: t.update(from_edge=1.5), "from_edge"),
+    (lambda t: t.update(pusher_path=[[0, 0, 0]]), "pusher_path"),
+    (lambda t: t.update(pusher_path="none"), "pusher_path"),
+    (lambda t: t["pusher_path"][1].__setitem__(2, "x"), "pusher_path[1][2]"),
+    (lambda t: t["pusher_path"].__setitem__(0, [0, 0]), "pusher_path[0]"),
+    (lambda t: t.update(mode="lift"), "pusher_path"),  # a walk round has more than lift's 4 poses
+    (lambda t: t.update(duration=-0.1), "duration"),
+    (lambda t: t.update(twist=[0, 0, 0]), "twist"),
+])
+def test_bad_transit_fields_are_named(switching, tmp_path, edit, field):
+    _, data = switching
+    bad = copy.deepcopy(data)
+    k = transit_index(bad)
+    edit(bad["segments"][k])
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(bad))
+    with pytest.raises(SceneError) as err:
+        load_plan(path)
+    assert err.value.field == f"plan.segments[{k}].{field}"

@@ -33,8 +33,10 @@ COR = [0.0, 0.15]  # inside edge 3's CCW stable region (mu = 0.5): a stable turn
 TURN_START = [0.02, -0.03, math.radians(20.0)]
 TURN = math.radians(30.0)
 
-STATIC = {"/log", "/world/workspace", "/world/obstacles", "/world/start", "/world/goal", "/world/tree"}
-ANIMATED = {"/world/slider", "/world/pusher", "/world/cf_path", "/world/cor", "/world/stable/ccw", "/world/stable/cw"}
+STATIC = {"/log", "/world/workspace", "/world/obstacles", "/world/start", "/world/goal", "/world/tree",
+          "/world/transits"}
+ANIMATED = {"/world/slider", "/world/pusher", "/world/pusher_lifted", "/world/cf_path", "/world/cor",
+            "/world/stable/ccw", "/world/stable/cw"}
 ANALYSIS = {"/analysis/part", "/analysis/contact", "/analysis/cor", "/analysis/stable/ccw", "/analysis/stable/cw",
             "/analysis/exact/ccw", "/analysis/exact/cw"} | {
             f"/analysis/sticking/{side}/{s}" for side in ("ccw", "cw") for s in "PUI"}
@@ -326,3 +328,170 @@ def test_the_analysis_shows_the_exact_region_even_when_planning_with_stable(turn
         exact = shapely.union_all([shapely.Polygon(r) for r in strips(tmp_path / "stable.rrd", f"/analysis/exact/{side}")])
         stable = shapely.union_all([shapely.Polygon(r) for r in strips(tmp_path / "stable.rrd", f"/analysis/stable/{side}")])
         assert exact.area > 1.05 * stable.area
+
+
+# Plans that switch edge: the shipped junction scenes, each solved at seed 1 with one transit,
+# walking round the part ("junction") or lifted over it ("narrow_junction").
+SCENES = Path(__file__).resolve().parent.parent / "scenes"
+
+
+@pytest.fixture(scope="module", params=["junction", "narrow_junction"])
+def switching(request, tmp_path_factory):
+    scene = planner.load_scene(SCENES / f"{request.param}.yaml")
+    plan = planner.plan(scene, seed=1)
+    assert plan.solved and plan.switches == 1
+    path = tmp_path_factory.mktemp(request.param) / f"{request.param}.rrd"
+    recording.write_recording(path, scene, plan)
+    return scene, plan, path
+
+
+def frame_times(path: Path) -> np.ndarray:
+    """Each frame's time on the ``time`` line, seconds."""
+    return np.array([t for _, t in rrd_rows(path, "/world/slider", "time", "step")]) / 1e9
+
+
+def segment_frames(plan, times: np.ndarray, k: int) -> np.ndarray:
+    """Frames inside segment ``k`` by the time line: from its start, before the next's."""
+    start = sum(s.duration for s in plan.segments[:k])
+    return np.flatnonzero((times >= start - 1e-9) & (times < start + plan.segments[k].duration - 1e-9))
+
+
+def the_transit(plan) -> tuple[int, planner.plan_file.Transit]:
+    (k,) = [k for k, s in enumerate(plan.segments) if s.kind == "transit"]
+    return k, plan.segments[k]
+
+
+def along(path: np.ndarray, reach: float, t: float) -> tuple[np.ndarray, int, float]:
+    """The pose ``t`` seconds into a pusher path at 1 m/s (each piece takes |dxy| + reach |dtheta|,
+    theta the shorter way), with the piece it lies on and how far along it (0 to 1)."""
+    for k, (a, b) in enumerate(zip(path, path[1:])):
+        turn = (b[2] - a[2] + math.pi) % (2 * math.pi) - math.pi
+        piece = math.hypot(*(b[:2] - a[:2])) + reach * abs(turn)
+        if t < piece or k == len(path) - 2:
+            u = min(t / piece, 1.0) if piece > 0 else 1.0
+            return np.array([*(a[:2] + u * (b[:2] - a[:2])), a[2] + u * turn]), k, u
+        t -= piece
+    raise AssertionError("a path has at least two poses")
+
+
+def test_the_pusher_follows_the_transit_path_and_is_drawn_lifted_in_the_air(switching):
+    """During the transit the pusher's rectangle (x in [-depth, 0], y in [-width/2, width/2] of its
+    frame) sits at the path pose for the frame's time; it is on ``/world/pusher_lifted`` exactly
+    when it is inside a lift's middle piece, and on ``/world/pusher`` otherwise."""
+    scene, plan, path = switching
+    width, depth = scene.pusher.width, scene.pusher.depth
+    reach = math.hypot(depth, width / 2)
+    rectangle = [[-depth, -width / 2], [0.0, -width / 2], [0.0, width / 2], [-depth, width / 2]]
+    times = frame_times(path)
+    k, transit = the_transit(plan)
+    frames = segment_frames(plan, times, k)
+    assert len(frames) >= 10
+    start = times[frames[0]]
+    assert start == pytest.approx(sum(s.duration for s in plan.segments[:k]), abs=1e-9)
+    table = rrd_rows(path, "/world/pusher", "LineStrips2D:strips", "step")
+    air = rrd_rows(path, "/world/pusher_lifted", "LineStrips2D:strips", "step")
+    airborne = 0
+    for f in frames:
+        pose, piece, u = along(transit.pusher_path, reach, times[f] - start)
+        lifted = transit.mode == "lift" and piece == 1 and 0 < u < 1
+        airborne += lifted
+        shown, hidden = (air, table) if lifted else (table, air)
+        assert hidden[f][1] == []
+        (outline,) = np.asarray(shown[f][1])
+        expected = placed(rectangle, pose)
+        assert len(outline) == 5 and np.allclose(outline[0], outline[-1])
+        assert np.abs(outline[:-1, None] - expected[None]).sum(axis=-1).min(axis=0).max() < 1e-6  # same corners
+    assert (airborne > 0) == (transit.mode == "lift")
+
+
+def test_the_part_stands_still_and_nothing_is_pushed_during_a_transit(switching):
+    scene, plan, path = switching
+    times = frame_times(path)
+    k, transit = the_transit(plan)
+    frames = segment_frames(plan, times, k)
+    slider = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
+    for f in frames:
+        np.testing.assert_allclose(slider[f][1][0], closed(placed(scene.slider.vertices, transit.pose)), atol=1e-6)
+    for entity, component in (("/world/cor", "Points2D:positions"), ("/world/stable/ccw", "LineStrips2D:strips"),
+                              ("/world/stable/cw", "LineStrips2D:strips")):
+        rows = rrd_rows(path, entity, component, "step")
+        assert all(rows[f][1] == [] for f in frames)
+    # Pushing again, on the transit's new edge: the pusher touches the part.
+    after = segment_frames(plan, times, k + 1)[0]
+    (face,) = rrd_rows(path, "/world/pusher", "LineStrips2D:strips", "step")[after][1]
+    assert shapely.Polygon(slider[after][1][0]).distance(shapely.Polygon(face)) < 1e-6
+
+
+def test_lifted_frames_are_on_their_own_entity_only_for_a_lift(switching):
+    _, plan, path = switching
+    table = rrd_rows(path, "/world/pusher", "LineStrips2D:strips", "step")
+    air = rrd_rows(path, "/world/pusher_lifted", "LineStrips2D:strips", "step")
+    assert [t for t, _ in table] == [t for t, _ in air] == list(range(len(table)))
+    assert all(len(a) + len(b) == 1 for (_, a), (_, b) in zip(table, air))  # one pusher per frame
+    lifts = [s for s in plan.segments if s.kind == "transit" and s.mode == "lift"]
+    assert any(b for _, b in air) == bool(lifts)
+    (_, labels), = rrd_rows(path, "/world/pusher_lifted", "LineStrips2D:labels")
+    assert labels == ["lifted"]
+
+
+def test_the_time_line_runs_through_every_segment(switching):
+    _, plan, path = switching
+    times = frame_times(path)
+    assert times[0] == 0 and np.all(np.diff(times) > 0)
+    assert times[-1] == pytest.approx(sum(s.duration for s in plan.segments), abs=1e-9)
+    for k in range(len(plan.segments)):  # each segment starts on a frame
+        assert times[segment_frames(plan, times, k)[0]] == pytest.approx(
+            sum(s.duration for s in plan.segments[:k]), abs=1e-9)
+    (_, text), = rrd_rows(path, "/log", "TextLog:text")
+    assert f"solved with {plan.pushes} pushes and 1 switch" in text[0]
+
+
+def test_a_switching_recording_verifies_and_draws_its_transit(switching):
+    _, plan, path = switching
+    verify(path)
+    assert entities(path) == STATIC | ANIMATED | ANALYSIS
+    _, transit = the_transit(plan)
+    (_, labels), = rrd_rows(path, "/world/transits", "LineStrips2D:labels")
+    drawn = strips(path, "/world/transits")
+    xy = transit.pusher_path[:, :2]
+    if transit.mode == "lift":
+        assert labels == ["transit 1", "transit 1 lifted", "transit 1"]
+        for strip, (a, b) in zip(drawn, [(0, 2), (1, 3), (2, 4)]):
+            np.testing.assert_allclose(strip, xy[a:b], atol=1e-6)
+    else:
+        assert labels == ["transit 1"]
+        np.testing.assert_allclose(drawn[0], xy, atol=1e-6)
+
+
+class PlannedGhost:
+    """Stands in for a Verification (planner.verify) whose pushes all stick: one check per push,
+    in plan order, transits skipped, and every run's poses the planned ones."""
+
+    passed = True
+
+    def __init__(self, scene, plan):
+        self.scene, self.pushes = scene, [s for s in plan.segments if s.kind == "push"]
+
+    def poses(self, push: int, times) -> np.ndarray:
+        s = self.pushes[push]
+        return exp_twist(s.start, s.twist, np.asarray(times, dtype=float))
+
+    def summary(self) -> str:
+        return "verify: passed"
+
+
+def test_the_ghost_follows_the_pushes_and_skips_the_transit(switching, tmp_path):
+    scene, plan, _ = switching
+    path = tmp_path / "ghost.rrd"
+    recording.write_recording(path, scene, plan, PlannedGhost(scene, plan))
+    times = frame_times(path)
+    k, _ = the_transit(plan)
+    slider = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
+    ghost = rrd_rows(path, "/world/ghost", "LineStrips2D:strips", "step")
+    steps = {step for step, _ in ghost}
+    assert not steps & set(segment_frames(plan, times, k))
+    for j in range(len(plan.segments)):
+        if j != k:
+            assert segment_frames(plan, times, j)[0] in steps
+    for step, outline in ghost:  # a push that sticks: the ghost hides under the part
+        np.testing.assert_allclose(outline[0], slider[step][1][0], atol=1e-6)

@@ -78,7 +78,11 @@ def test_every_shipped_plan_sticks_under_every_distribution(name):
     position, angle = check.worst
     assert position <= 1e-12 * scene.slider.radius and angle <= 1e-12  # one exact exponential
     assert max(check.drift) <= 1e-12
-    assert len(check.lines()) == plan.pushes and check.summary().startswith("verify: passed: ")
+    # One check per push, in order (the recording maps them onto the push segments); one line per
+    # segment, each saying what it is.
+    assert [c.segment for c in check.pushes] == [s for s in plan.segments if s.kind == "push"]
+    assert [line.split()[0] for line in check.lines()] == [s.kind for s in plan.segments]
+    assert check.summary().startswith("verify: passed: ")
 
 
 def test_distributions_mix_kinds_with_centre_at_the_cf_and_depend_on_the_seed_only():
@@ -178,6 +182,83 @@ def test_a_plan_that_does_not_fit_the_scene_names_the_field(change, field):
     assert err.value.field == field
 
 
+# -- transits -----------------------------------------------------------------------------------------
+
+def switching(name: str) -> tuple[planner.Scene, planner.Plan, int]:
+    """The scene's seed-1 plan and the index of its first transit (it has one: the scene needs it)."""
+    scene, plan = planned(name)
+    return scene, plan, next(k for k, s in enumerate(plan.segments) if s.kind == "transit")
+
+
+@pytest.mark.parametrize("name, mode", [("junction", "plane"), ("narrow_junction", "lift")])
+def test_a_switching_plan_verifies_with_a_line_for_its_transit(name, mode):
+    scene, plan, k = switching(name)
+    transit = plan.segments[k]
+    assert transit.mode == mode and plan.segments[k - 1].edge == transit.from_edge != transit.to_edge
+    check = verify(scene, plan, n=6)
+    assert check.passed, "\n".join(check.lines())
+    assert check.lines()[k] == (f"transit 1/{plan.switches} (edge {transit.from_edge} -> {transit.to_edge}, {mode}, "
+                                f"{transit.duration:.3f} s): part still, flush on both edges: ok")
+
+
+def _moved_path(t, at: int, by=(1e-3, 0.0, 0.0)):
+    path = t.pusher_path.copy()
+    path[at] += by
+    return dataclasses.replace(t, pusher_path=path)
+
+
+def _lifted(t):
+    return dataclasses.replace(t, mode="lift", pusher_path=t.pusher_path[[0, 1, -2, -1]])
+
+
+# Each: the transit's replacement, the replacement of the push after it, and the field at fault
+# (relative to the transit's index k).
+TAMPERED = {
+    "first pose shifted": (lambda t: _moved_path(t, 0), None, (0, "pusher_path")),
+    "first pose turned": (lambda t: _moved_path(t, 0, (0.0, 0.0, 1e-4)), None, (0, "pusher_path")),
+    "last pose shifted": (lambda t: _moved_path(t, -1, (0.0, -1e-4, 0.0)), None, (0, "pusher_path")),
+    "wrong from_edge": (lambda t: dataclasses.replace(t, from_edge=t.to_edge), None, (0, "from_edge")),
+    "to_edge not the path's": (lambda t: dataclasses.replace(t, to_edge=(t.to_edge + 1) % 4), None, (0, "pusher_path")),
+    "edge not pushable": (lambda t: dataclasses.replace(t, to_edge=7), None, (0, "to_edge")),
+    "lift in a plane scene": (_lifted, None, (0, "mode")),
+    "part moved": (lambda t: dataclasses.replace(t, pose=t.pose + [0.0, 1e-3, 0.0]), None, (0, None)),
+    "next push on another edge": (None, lambda p, t: dataclasses.replace(p, edge=t.from_edge), (1, "edge")),
+    "next push elsewhere": (None, lambda p, t: dataclasses.replace(p, start=p.start + [1e-3, 0.0, 0.0]),
+                            (1, "start")),
+}
+
+
+@pytest.mark.parametrize("transit, push, fault", TAMPERED.values(), ids=TAMPERED.keys())
+def test_a_transit_that_does_not_join_up_names_the_field(transit, push, fault):
+    scene, plan, k = switching("junction")
+    segments = list(plan.segments)
+    if transit is not None:
+        segments[k] = transit(segments[k])
+    if push is not None:
+        segments[k + 1] = push(segments[k + 1], segments[k])
+    offset, field = fault
+    with pytest.raises(planner.SceneError) as err:
+        verify(scene, dataclasses.replace(plan, segments=segments), n=2)
+    assert err.value.field == ".".join(filter(None, [f"plan.segments[{k + offset}]", field]))
+
+
+def test_a_change_of_edge_needs_a_transit():
+    scene, plan, k = switching("junction")
+    with pytest.raises(planner.SceneError) as err:
+        verify(scene, dataclasses.replace(plan, segments=plan.segments[:k] + plan.segments[k + 1:]), n=2)
+    assert err.value.field == f"plan.segments[{k}].edge" and "needs a transit" in str(err.value)
+
+
+@pytest.mark.parametrize("allowed, name", [("none", "junction"), ("plane", "narrow_junction")])
+def test_a_transit_the_scene_does_not_allow_names_its_mode(allowed, name):
+    scene, plan, k = switching(name)
+    strict = dataclasses.replace(scene, pusher=dataclasses.replace(scene.pusher, transit=allowed))
+    with pytest.raises(planner.SceneError) as err:
+        verify(strict, plan, n=2)
+    assert err.value.field == f"plan.segments[{k}].mode" and repr(allowed) in str(err.value)
+    assert verify(scene, plan, n=2).passed  # the scene as it is allows it
+
+
 # -- recording ---------------------------------------------------------------------------------------
 
 def test_the_recording_shows_the_worst_run_as_a_ghost(tmp_path):
@@ -235,9 +316,9 @@ def test_command_verifies_a_good_plan_file_and_exits_0(plan_files, tmp_path):
     assert run.returncode == 0, run.stderr
     assert run.stderr == ""
     head, push, overall = run.stdout.splitlines()
-    assert head.startswith(f"loaded {good}: 1 pushes -> out/battery.json")
+    assert head.startswith(f"loaded {good}: 1 push -> out/battery.json")
     assert push.startswith("push 1/1 (edge 3,") and push.endswith(": ok") and "12/12 stick" in push
-    assert overall.startswith("verify: passed: 1 pushes x 12 distributions") and "worst deviation" in overall
+    assert overall.startswith("verify: passed: 1 push x 12 distributions") and "worst deviation" in overall
     assert {p.name for p in (tmp_path / "out").iterdir()} == {"battery.json", "battery.rrd"}
     rrd_verify(tmp_path / "out" / "battery.rrd")
 
@@ -256,7 +337,7 @@ def test_command_exits_3_on_a_tampered_plan(plan_files, tmp_path):
 def test_planning_with_verify_prints_the_verdict(tmp_path, capsys):
     assert main([str(ROOT / "scenes" / "battery.yaml"), "--verify", "3", "--out", str(tmp_path)]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0].startswith("solved: 1 pushes") and lines[-1].startswith("verify: passed: 1 pushes x 3")
+    assert lines[0].startswith("solved: 1 push,") and lines[-1].startswith("verify: passed: 1 push x 3")
 
 
 @pytest.mark.parametrize("args, field", [
@@ -283,3 +364,26 @@ def test_bad_verify_input_exits_1_with_one_line_and_writes_nothing(args, field, 
     captured = capsys.readouterr()
     assert captured.out == "" and error_field(captured.err) == field
     assert {p.name for p in tmp_path.iterdir()} == before  # no logs/, no outputs
+
+
+def test_command_verifies_a_switching_plan_file_and_refuses_a_tampered_transit(tmp_path):
+    """Through ``plan --verify N --plan FILE``: a transit shows as a line; a transit whose pusher
+    does not start flush on the edge it leaves is bad input (exit 1, one line naming the field)."""
+    scene, plan, k = switching("junction")
+    good = tmp_path / "good.json"
+    write_atomic(good, plan.to_json())
+    data = json.loads(plan.to_json())
+    data["segments"][k]["pusher_path"][0][1] += 1e-3
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    command = [str(PLAN), str(ROOT / "scenes" / "junction.yaml"), "--verify", "3", "--out"]
+    run = subprocess.run([*command, "good", "--plan", str(good)], capture_output=True, text=True, cwd=tmp_path,
+                         timeout=60)
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.splitlines()[1:-1]
+    assert [line.split()[0] for line in lines] == [s.kind for s in plan.segments] and lines[k].endswith(": ok")
+    run = subprocess.run([*command, "bad", "--plan", str(bad)], capture_output=True, text=True, cwd=tmp_path,
+                         timeout=60)
+    assert run.returncode == 1 and run.stdout == ""
+    assert error_field(run.stderr) == f"plan.segments[{k}].pusher_path"
+    assert not (tmp_path / "bad").exists()
