@@ -8,7 +8,8 @@ the general multi-contact analysis: :mod:`.cones` (polyhedral cones of twists an
 :mod:`.wrenches` (contact forces, §3.1), :mod:`.support` (support friction, §3.2),
 :mod:`.force_status` (P/U/I, §3.3-3.4), :mod:`.possible_motions` (the combined analysis, §4),
 :mod:`.stable_pushing` (guaranteed-stable pushes and one-step goals, §4-5.1),
-:mod:`.exact_region` (the exact stable pushes of an edge, containing STABLE's),
+:mod:`.exact_region` (the exact stable pushes of an edge, containing STABLE's), :mod:`.regions`
+(either method of an edge's stable pushes),
 :mod:`.contact_synthesis` (which edges realise a motion, §5.2), :mod:`.figures` (the paper's
 figures redrawn). :mod:`.quasistatic` is an independent simulator that checks pushes without any
 of the stable-region code.
@@ -17,8 +18,8 @@ of the stable-region code.
 from .cones import Cone, cor_halfplanes
 from .contact_synthesis import EdgeRegions, edge_regions, stable_edges
 from .contacts import ContactConfiguration
-from .exact_region import ExactRegion, exact_region
-from .force_status import Verdict, force_status, force_status_regions, ray_twist
+from .exact_region import DeadlineExceeded, ExactRegion, exact_region
+from .force_status import Verdict, force_possible, force_status, force_status_regions, ray_twist
 from .kinematics import (
     contact_modes,
     kinematic_cone,
@@ -30,10 +31,11 @@ from .kinematics import (
 from .possible_motions import ModeMotions, mode_possible, possible_motions
 from .se2 import exp_twist, log_pose, relative_pose, wrap_angle
 from .slider import Slider
-from .stable import DEFAULT_TIP_FACTOR, StableRegion, stable_region
+from .regions import METHODS, stable_region
+from .stable import DEFAULT_TIP_FACTOR, StableRegion, procedure_stable
 from .stable_pushing import GOALS, classify_goal
 from .steering import StableSteering
-from .support import SupportCells, SupportLoads, SupportModel, effective_cf, support_friction, unit_loads
+from .support import LoadBatch, SupportCells, SupportLoads, SupportModel, effective_cf, support_friction, unit_loads
 from .twist import cor_to_twist, point_velocity, twist_to_cor
 from .wrenches import contact_wrench_cone, friction_cone_edges, moment_labels, point_wrench
 
@@ -41,8 +43,11 @@ __all__ = [
     "Cone",
     "ContactConfiguration",
     "DEFAULT_TIP_FACTOR",
+    "DeadlineExceeded",
     "EdgeRegions",
     "GOALS",
+    "LoadBatch",
+    "METHODS",
     "ModeMotions",
     "ExactRegion",
     "Slider",
@@ -61,6 +66,7 @@ __all__ = [
     "effective_cf",
     "exact_region",
     "exp_twist",
+    "force_possible",
     "force_status",
     "force_status_regions",
     "friction_cone_edges",
@@ -73,6 +79,7 @@ __all__ = [
     "point_velocity",
     "point_wrench",
     "possible_motions",
+    "procedure_stable",
     "ray_twist",
     "relative_cone",
     "relative_mode",

@@ -2,7 +2,7 @@
 
 A flat pusher on an edge pushes stably when the slider stays stuck to it whatever the support
 pressure: sticking ``ss`` is force possible (**P**) for every distribution on the part's footprint
-with its centre at the CF (:func:`~.force_status.force_status`, certified), and, by Lynch & Mason's
+with its centre at the CF (:func:`~.force_status.force_possible`, certified), and, by Lynch & Mason's
 Theorem 4, a rotation's centre lies beyond the part along the edge so that no other mode can
 occur. Procedure STABLE (:mod:`.stable`) is a closed-form inner bound of this set; here the set
 itself is traced, so it contains STABLE's and is as large as the guarantee allows.
@@ -20,6 +20,12 @@ Construction, in the push plane (:mod:`.push_plane`), where the set is a bounded
    still fails at the finest spacing has both its vertices pulled halfway back to ``S``, until
    all pass.
 4. The region is that star-shaped polygon united with ``S``.
+
+The certifications are batched: the rays' bisections run side by side, one batch of twists per
+step, and a pass of step 3 checks all its edges in one batch (in order, an edge whose end an
+earlier edge pulled back being checked again), so each batch's support LPs are solved together
+(:func:`~.force_status.force_possible`); no step depends on the order, so the region is the one a
+twist-by-twist trace gives. ``deadline`` stops the construction between batches.
 
 **Robustness (Lynch 1992, §6).** A friction coefficient known only within an interval gives the
 region of its lowest value (sticking there implies sticking above it). A CF known only within a
@@ -49,6 +55,7 @@ MECHANICS.md §6.2 fixture A (2 x 1 block pushed on its whole bottom face, mu = 
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -57,19 +64,23 @@ import shapely
 from numpy.typing import ArrayLike
 
 from .contacts import ContactConfiguration
-from .force_status import force_status
+from .force_status import force_possible
 from .push_plane import PushPlane
 from .slider import Slider
-from .stable import StableRegion, stable_region
+from .stable import StableRegion, procedure_stable
 from .support import SupportModel
 from .twist import twist_to_cor
 from .wrenches import contact_wrench_cone
 
-__all__ = ["ExactRegion", "exact_region"]
+__all__ = ["DeadlineExceeded", "ExactRegion", "exact_region"]
 
 #: How far beyond STABLE's section a ray is searched, in units of that section's size: far past any
 #: stable push (sideways pushes are force impossible), so the cap never binds in practice.
 _REACH = 8.0
+
+
+class DeadlineExceeded(RuntimeError):
+    """An exact region was not finished by the deadline it was given."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -181,13 +192,14 @@ def exact_region(
     steps: int = 12,
     margin: float = 0.02,
     checks: int = 4,
+    deadline: float | None = None,
 ) -> ExactRegion:
     """The exact guaranteed-stable pushes of ``edge`` (module docstring).
 
     Parameters
     ----------
     slider, edge, width
-        As for :func:`~.stable.stable_region`.
+        As for :func:`~.stable.procedure_stable`.
     mu : float or (float, float)
         Pusher-slider friction, or an interval holding it (Lynch 1992, §6). Sticking is force
         possible for every value once it is at the lowest, whose friction cone lies inside the
@@ -205,6 +217,9 @@ def exact_region(
         safety margin.
     checks : int
         Points certified on each boundary edge between neighbouring rays, besides the vertices.
+    deadline : float, optional
+        A :func:`time.perf_counter` time; past it the construction stops with
+        :class:`DeadlineExceeded` (checked before each batch of certifications).
 
     Examples
     --------
@@ -228,7 +243,7 @@ def exact_region(
         raise ValueError(f"mu must be > 0 (an interval: low <= high), got {mu}")
     if not cf_radius >= 0:
         raise ValueError(f"cf_radius must be >= 0, got {cf_radius}")
-    stable = stable_region(slider, edge, mu_lo, width)
+    stable = procedure_stable(slider, edge, mu_lo, width)
     if stable.is_empty:
         return ExactRegion(stable, shapely.Polygon(), np.zeros(2), cf_radius)
     if rays < 8:
@@ -244,45 +259,64 @@ def exact_region(
     trusted = cf_radius == 0  # STABLE's region is proven only for a known CF
 
     def stable_at(points: np.ndarray) -> np.ndarray:
-        """Certified P, strictly inside Theorem 4's strip, or (if trusted) inside STABLE's region."""
+        """Certified P, strictly inside Theorem 4's strip, or (if trusted) inside STABLE's region;
+        all ``points`` (``k, 2``) at once."""
+        if deadline is not None and time.perf_counter() > deadline:
+            raise DeadlineExceeded(f"the exact region of edge {edge} was not finished by the deadline")
         points = np.atleast_2d(points)
         twists = plane.twists(points)
         known = stable.contains(twists) if trusted else np.zeros(len(points), dtype=bool)
-        return np.array([bool(k) or (w_lo < p[1] < w_hi and force_status(v, cone, support).status == "P")
-                         for p, v, k in zip(points, twists, known)])
+        ask = ~known & (w_lo < points[:, 1]) & (points[:, 1] < w_hi)
+        known[ask] = force_possible(twists[ask], cone, support)
+        return known
 
     if not trusted and not stable_at(centre)[0]:
         return ExactRegion(stable, shapely.Polygon(), np.zeros(2), cf_radius)
     size = max(float(np.ptp(np.asarray(inner.bounds).reshape(2, 2), axis=0).max()), 1e-9)
 
-    def along(angle: float) -> np.ndarray:
+    def along(angles: float | np.ndarray) -> np.ndarray:
         # Exact zeros on the axes: a ray along w = 0 must stay on the translations, not turn
         # about centres 1e16 away.
-        return np.where(np.abs(e := np.array([np.cos(angle), np.sin(angle)])) < 1e-12, 0.0, e)
+        e = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
+        return np.where(np.abs(e) < 1e-12, 0.0, e)
 
-    def trace(angle: float) -> list[float]:
-        """``[base, reach]`` of the ray at ``angle``: where STABLE's region ends (or 0) and the
-        last certified point found by bisection, less the margin."""
-        e = along(angle)
-        base = inner.intersection(shapely.LineString([centre, centre + 2 * _REACH * size * e])).length if trusted else 0.0
-        cap = _REACH * size
-        if e[1] != 0:
-            cap = min(cap, ((w_hi if e[1] > 0 else w_lo) - centre[1]) / e[1])
-        lo, hi = base, cap * (1 - 1e-9)
-        if stable_at(centre + hi * e)[0]:
-            lo = hi
+    def trace(angles: list[float]) -> dict[float, list[float]]:
+        """``{angle: [base, reach]}`` of the rays at ``angles``: where STABLE's region ends (or 0)
+        and the last certified point found by bisection, less the margin. The rays' bisections
+        run side by side, one batch of certifications per step."""
+        e = along(np.asarray(angles, dtype=float))
+        if trusted:
+            spokes = shapely.linestrings(np.stack([np.broadcast_to(centre, e.shape), centre + 2 * _REACH * size * e], axis=1))
+            base = shapely.length(shapely.intersection(inner, spokes))
         else:
-            for _ in range(steps):
-                mid = (lo + hi) / 2
-                lo, hi = (mid, hi) if stable_at(centre + mid * e)[0] else (lo, mid)
-        return [base, base + (1 - margin) * (lo - base)]
+            base = np.zeros(len(e))
+        cap = np.full(len(e), _REACH * size)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            strip = (np.where(e[:, 1] > 0, w_hi, w_lo) - centre[1]) / e[:, 1]
+        cap = np.where(e[:, 1] != 0, np.minimum(cap, strip), cap)
+        lo, hi = base.copy(), cap * (1 - 1e-9)
+        at_cap = stable_at(centre + hi[:, None] * e)
+        lo[at_cap] = hi[at_cap]
+        open_ = np.flatnonzero(~at_cap)
+        for _ in range(steps):
+            mid = (lo[open_] + hi[open_]) / 2
+            ok = stable_at(centre + mid[:, None] * e[open_])
+            lo[open_[ok]], hi[open_[~ok]] = mid[ok], mid[~ok]
+        reach = base + (1 - margin) * (lo - base)
+        return {a: [b, r] for a, b, r in zip(angles, base.tolist(), reach.tolist())}
 
-    found = {a: trace(a) for a in 2 * np.pi * np.arange(rays) / rays}
+    found = trace(list(2 * np.pi * np.arange(rays) / rays))
     # Certify every vertex and ``checks`` points of every edge. A failing edge gets a ray of its
     # own in the middle (down to 1/16 of the initial spacing), then, if still failing, has its
     # ends pulled halfway back to their base.
     finest = 2 * np.pi / rays / 16
     fractions = np.arange(checks + 1) / (checks + 1)
+
+    def samples(edges: list[float], following: dict[float, float]) -> np.ndarray:
+        """The vertex and ``checks`` points of each edge from ray ``a`` to ray ``following[a]`` (``k, checks + 1, 2``)."""
+        ends = np.array([[centre + found[k][1] * along(k) for k in (a, following[a])] for a in edges])
+        return ends[:, :1] + fractions[None, :, None] * (ends[:, 1:] - ends[:, :1])
+
     pending = set(found)
     while True:
         keys = sorted(found)
@@ -293,22 +327,28 @@ def exact_region(
         pending = {a for a in pending if found[a][1] > found[a][0] or found[following[a]][1] > found[following[a]][0]}
         if not pending:
             break
-        grown = set()
-        for a in sorted(pending):
+        edges = sorted(pending)
+        passed = dict(zip(edges, stable_at(samples(edges, following).reshape(-1, 2)).reshape(len(edges), -1).all(axis=1)))
+        grown, moved, new_rays = set(), set(), []
+        for a in edges:
             b = following[a]
-            ends = [centre + found[k][1] * along(k) for k in (a, b)]
-            if np.all(stable_at(ends[0] + fractions[:, None] * (ends[1] - ends[0]))):
+            if {a, b} & moved:  # checked before an end moved
+                passed[a] = bool(stable_at(samples([a], following)[0]).all())
+            if passed[a]:
                 continue
             gap = (b - a) % (2 * np.pi)
             if gap > finest:
                 mid = (a + gap / 2) % (2 * np.pi)
-                found[mid] = trace(mid)
+                new_rays.append(mid)
                 grown |= {a, mid}
                 continue
             for k in (a, b):
                 base, reach = found[k]
                 found[k][1] = base if reach - base < 1e-6 * size else base + 0.5 * (reach - base)
+            moved |= {a, b}
             grown |= {preceding[a], a, b}
+        if new_rays:
+            found.update(trace(new_rays))
         pending = grown
     traced = shapely.Polygon([centre + found[k][1] * along(k) for k in keys]).buffer(0)
     polygon = shapely.union_all([traced, inner.buffer(0)]) if trusted else traced

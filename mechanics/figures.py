@@ -26,10 +26,17 @@ and ``steps`` trade detail for time. Needs matplotlib (``pip install -e '.[figur
 from __future__ import annotations
 
 import argparse
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
-import matplotlib
+try:
+    import matplotlib
+except ModuleNotFoundError:
+    _NEEDS = "mechanics.figures needs matplotlib, which the figures extra installs: pip install -e '.[figures]'"
+    if __name__ == "__main__":  # a command gets one line, not a traceback
+        sys.exit(f"python -m {_NEEDS}")
+    raise ModuleNotFoundError(_NEEDS, name="matplotlib") from None
 
 matplotlib.use("Agg")  # files only: no display needed
 

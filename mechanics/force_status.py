@@ -43,7 +43,7 @@ from .cones import Cone
 from .support import SupportModel, unit_loads
 from .twist import cor_to_twist
 
-__all__ = ["Verdict", "force_status", "force_status_regions", "ray_twist"]
+__all__ = ["Verdict", "force_possible", "force_status", "force_status_regions", "ray_twist"]
 
 
 @dataclass(frozen=True)
@@ -67,29 +67,51 @@ def _verdict(consistent: set[str], level: int) -> Verdict:
     return Verdict(status, "".join(s for s in "PUI" if s in consistent), level)
 
 
-def _status_at(twist: np.ndarray, cone: Cone, support: SupportModel, level: int) -> set[str]:
-    """The statuses not ruled out with the samples of ``level``."""
-    loads = support.loads(twist, level)
-    tol = 1e-9 * (1.0 + float(np.linalg.norm(support.cf)) + support.radius)
-    # P: every row's support value must be certified <= 0; one sample violation refutes it.
-    refuted, certified = False, True
-    for a in cone.rows:
-        value, lam = loads.sample_support(-a)
-        if value > tol:
-            refuted = True
-            break
-        certified = certified and loads.upper_bound(-a, lam) <= 0
-    if certified and not refuted:
-        return {"P"}
-    beta, lam, value = loads.minimax(cone.rows)
-    if value < -tol and loads.is_negative(beta @ cone.rows, lam, tol):
-        return {"I"}
-    consistent = {"P", "U", "I"}
-    if refuted or value < -tol:  # the samples show a load outside W
-        consistent.discard("P")
-    if value >= -tol:  # a sample distribution's load is in W
-        consistent.discard("I")
-    return consistent
+def _tolerance(support: SupportModel) -> float:
+    """How far a sample value may pass zero and still count as rounding."""
+    return 1e-9 * (1.0 + float(np.linalg.norm(support.cf)) + support.radius)
+
+
+def _sticking(twists: np.ndarray, cone: Cone, support: SupportModel, level: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(certified, refuted)`` per rotation of ``twists`` (``K, 3``) with the samples of ``level``:
+    every row's support value certified ``<= 0`` (P proven), or some sample distribution's load
+    violating a row (P disproven)."""
+    batch = support.batch(twists, level)
+    values, lams = batch.sample_support(-cone.rows)
+    refuted = np.any(values > _tolerance(support), axis=1)
+    certified = np.zeros(len(twists), dtype=bool)
+    if not refuted.all():  # bounding the cells costs more than the LPs: only where it can help
+        rest = support.batch(twists[~refuted], level)
+        certified[~refuted] = np.all(rest.upper_bound(-cone.rows, lams[~refuted]) <= 0, axis=1)
+    return certified, refuted
+
+
+def _statuses_at(twists: np.ndarray, cone: Cone, support: SupportModel, level: int) -> list[set[str]]:
+    """The statuses not ruled out for each rotation of ``twists`` (``K, 3``) with the samples of
+    ``level``: the P proofs in one batch, then the I proofs of the others in another."""
+    certified, refuted = _sticking(twists, cone, support, level)
+    tol = _tolerance(support)
+    value = np.full(len(twists), np.nan)
+    impossible = np.zeros(len(twists), dtype=bool)
+    rest = np.flatnonzero(~certified)
+    if len(rest):
+        beta, lam, value[rest] = support.batch(twists[rest], level).minimax(cone.rows)
+        separated = value[rest] < -tol  # a hyperplane the samples' loads all miss: prove it for all loads
+        if separated.any():
+            check = support.batch(twists[rest[separated]], level)
+            impossible[rest[separated]] = check.is_negative(beta[separated] @ cone.rows, lam[separated], tol)
+    out = []
+    for proven, disproven, shown, v in zip(certified, refuted, impossible, value):
+        if proven or shown:
+            out.append({"P"} if proven else {"I"})
+            continue
+        consistent = {"P", "U", "I"}
+        if disproven or v < -tol:  # the samples show a load outside W
+            consistent.discard("P")
+        if v >= -tol:  # a sample distribution's load is in W
+            consistent.discard("I")
+        out.append(consistent)
+    return out
 
 
 def _translation_status(v: np.ndarray, cone: Cone, support: SupportModel) -> Verdict:
@@ -135,19 +157,65 @@ def force_status(twist: ArrayLike, cone: Cone, support: SupportModel, refinement
     >>> force_status(cor_to_twist([0, 0.5], 1), cone, support).status
     'U'
     """
-    v = np.asarray(twist, dtype=float)
+    return _verdicts(np.asarray(twist, dtype=float)[None], cone, support, refinements)[0]
+
+
+def _without_samples(v: np.ndarray, cone: Cone, support: SupportModel) -> Verdict | None:
+    """The verdict of a twist that needs no support samples, else ``None``."""
     if len(cone.rows) == 0:  # the contact forces span the wrench space
         return Verdict("P", "P", 0)
     if v[2] == 0:
         return _translation_status(v, cone, support)
     if cone.dimension == 0:  # no contact force, and any motion needs one
         return Verdict("I", "I", 0)
-    consistent = {"P", "U", "I"}
+    return None
+
+
+def _verdicts(twists: np.ndarray, cone: Cone, support: SupportModel, refinements: int) -> list[Verdict]:
+    """:func:`force_status` of each of ``twists`` (``K, 3``), refining those still open together."""
+    verdicts = [_without_samples(v, cone, support) for v in twists]
+    rotations = [k for k, verdict in enumerate(verdicts) if verdict is None]
+    consistent = {k: {"P", "U", "I"} for k in rotations}
+    open_ = rotations
     for level in range(refinements + 1):
-        consistent &= _status_at(v, cone, support, level)
-        if len(consistent) == 1:
+        if not open_:
             break
-    return _verdict(consistent, level)
+        for k, found in zip(open_, _statuses_at(twists[open_], cone, support, level)):
+            consistent[k] &= found
+            verdicts[k] = _verdict(consistent[k], level)
+        open_ = [k for k in open_ if len(consistent[k]) > 1]
+    return verdicts
+
+
+def force_possible(twists: ArrayLike, cone: Cone, support: SupportModel, refinements: int = 1) -> np.ndarray:
+    """Whether each of ``twists`` (shape ``(..., 3)``) is proven force possible (P) for a mode
+    with composite wrench ``cone``: ``force_status(twist, cone, support, refinements).status ==
+    "P"`` for each, computed for all of them at once (the LPs batched, the I proofs skipped).
+
+    Examples
+    --------
+    Fixture A (MECHANICS.md §6.2): turning CCW about (-3, 0.5) or (-3, 1.2) and pushing straight
+    are P for both ends sticking; the mirror CW turn and a sideways push are not.
+
+    >>> from mechanics import ContactConfiguration, Slider, contact_wrench_cone, cor_to_twist
+    >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+    >>> cone = contact_wrench_cone(ContactConfiguration.slider_edge(block, 0, 0.5), "ss")
+    >>> twists = [*cor_to_twist([[-3, 0.5], [-3, 1.2], [-3, 0.5]], [1, 1, -1]), [0, 1, 0], [1, 0, 0]]
+    >>> force_possible(twists, cone, SupportModel.of_slider(block, "footprint")).tolist()
+    [True, True, False, True, False]
+    """
+    v = np.asarray(twists, dtype=float)
+    flat = v.reshape(-1, 3)
+    known = [_without_samples(twist, cone, support) for twist in flat]
+    out = np.array([verdict is not None and verdict.status == "P" for verdict in known], dtype=bool)
+    open_ = np.array([k for k, verdict in enumerate(known) if verdict is None], dtype=int)
+    for level in range(refinements + 1):
+        if len(open_) == 0:
+            break
+        certified, refuted = _sticking(flat[open_], cone, support, level)
+        out[open_[certified]] = True
+        open_ = open_[~certified & ~refuted]
+    return out.reshape(v.shape[:-1])
 
 
 def ray_twist(cf: ArrayLike, angle: float, tau: ArrayLike, sense: int, scale: float) -> np.ndarray:
@@ -166,22 +234,26 @@ def ray_twist(cf: ArrayLike, angle: float, tau: ArrayLike, sense: int, scale: fl
     return (1 - tau) * at_cf + tau * at_infinity + 0.0
 
 
-def _ray(cone: Cone, support: SupportModel, angle: float, sense: int, steps: int, refinements: int) -> tuple[str, str, float]:
-    """``(inner, outer, distance)``: status near the CF, status towards infinity, and the
-    distance of the transition from the CF (0 if the status does not change)."""
-    def status(tau: float) -> str:
-        twist = ray_twist(support.cf, angle, tau, sense, support.radius)
-        return force_status(twist, cone, support, refinements).status
+def _rays(cone: Cone, support: SupportModel, rays: list[tuple[float, int]], steps: int,
+          refinements: int) -> list[tuple[str, str, float]]:
+    """Per ray ``(angle, sense)`` from the CF, ``(inner, outer, distance)``: status near the CF,
+    status towards infinity, and the distance of the transition from the CF (0 if the status does
+    not change). The rays' bisections run side by side, one batch of verdicts per step."""
+    def statuses(which: np.ndarray, taus: np.ndarray) -> np.ndarray:
+        twists = np.array([ray_twist(support.cf, rays[j][0], tau, rays[j][1], support.radius) for j, tau in zip(which, taus)])
+        return np.array([v.status for v in _verdicts(twists.reshape(-1, 3), cone, support, refinements)], dtype=object)
 
-    inner, outer = status(0.0), status(1.0)
-    if inner == outer:
-        return inner, outer, 0.0
-    lo, hi = 0.0, 1.0
+    every = np.arange(len(rays))
+    inner, outer = np.split(statuses(np.r_[every, every], np.r_[np.zeros(len(rays)), np.ones(len(rays))]), 2)
+    turning = np.flatnonzero(inner != outer)
+    lo, hi = np.zeros(len(rays)), np.ones(len(rays))
     for _ in range(steps):
-        mid = (lo + hi) / 2
-        lo, hi = (lo, mid) if status(mid) == outer else (mid, hi)
+        mid = (lo[turning] + hi[turning]) / 2
+        beyond = statuses(turning, mid) == outer[turning]
+        hi[turning[beyond]], lo[turning[~beyond]] = mid[beyond], mid[~beyond]
     tau = (lo + hi) / 2
-    return inner, outer, support.radius * tau / (1 - tau)
+    distance = np.where(inner != outer, support.radius * tau / (1 - tau), 0.0)
+    return list(zip(inner.tolist(), outer.tolist(), distance.tolist()))
 
 
 def force_status_regions(
@@ -220,9 +292,9 @@ def force_status_regions(
     corners = np.array(box.exterior.coords)
     far = 2 * float(np.max(np.linalg.norm(corners - cf, axis=1)))
     angles = 2 * np.pi * np.arange(rays) / rays
+    traced = _rays(cone, support, [(a, sense) for sense in (1, -1) for a in angles], steps, refinements)
     out = {}
-    for sense in (1, -1):
-        found = [_ray(cone, support, a, sense, steps, refinements) for a in angles]
+    for sense, found in zip((1, -1), (traced[:rays], traced[rays:])):
         pieces: dict[str, list[shapely.Polygon]] = {"P": [], "U": [], "I": []}
         for j, (inner, outer, dist) in enumerate(found):
             for k in ((j - 1) % rays, (j + 1) % rays):

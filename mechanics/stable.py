@@ -25,7 +25,7 @@ from .push_plane import PushPlane
 from .slider import Slider
 from .twist import cor_to_twist
 
-__all__ = ["StableRegion", "stable_region", "DEFAULT_TIP_FACTOR"]
+__all__ = ["StableRegion", "procedure_stable", "DEFAULT_TIP_FACTOR"]
 
 #: Peshkin & Sanderson's tip line lies slightly beyond r^2/p; MECHANICS.md §2.5 found violations
 #: 0.5 % inside it, so the line is moved out by 2 %.
@@ -44,7 +44,7 @@ def _halfplane_row(d: np.ndarray, offset: float, sense: int) -> np.ndarray:
 class StableRegion:
     """The stable pushes of one edge: a convex cone of slider-frame twists.
 
-    Build it with :func:`stable_region`. A twist ``V`` of sense ``s`` (``s = sign(omega)``) is in
+    Build it with :func:`procedure_stable`. A twist ``V`` of sense ``s`` (``s = sign(omega)``) is in
     the region iff ``s * omega >= 0`` and ``rows[s] @ V >= 0``; translations belong to both.
     """
 
@@ -123,7 +123,7 @@ class StableRegion:
         STABLE's region is convex: the hull of the extremal twists, with its centroid.
 
         >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
-        >>> polygon, centre = stable_region(block, 0, 0.5, tip_factor=1.0).section()
+        >>> polygon, centre = procedure_stable(block, 0, 0.5, tip_factor=1.0).section()
         >>> np.round(polygon.bounds, 6).tolist(), (np.round(centre, 12) + 0.0).tolist()
         ([-0.5, -0.559017, 0.5, 0.559017], [0.0, 0.0])
         """
@@ -158,18 +158,16 @@ class StableRegion:
         return out
 
 
-def stable_region(
+def procedure_stable(
     slider: Slider,
     edge: int,
     mu: float,
     width: float | None = None,
     tip_factor: float = DEFAULT_TIP_FACTOR,
-    method: str = "stable",
 ) -> StableRegion:
     """Procedure STABLE for a flat pusher of ``width`` centred on ``edge`` with friction ``mu``.
 
-    With ``method="exact"``, the exact region of :func:`mechanics.exact_region.exact_region` (an
-    :class:`~mechanics.exact_region.ExactRegion` with the same interface, containing this one).
+    :func:`mechanics.stable_region` chooses between this and the exact region.
 
     Parameters
     ----------
@@ -183,8 +181,6 @@ def stable_region(
         edge. Default: the whole edge.
     tip_factor : float
         Moves the tip line of step 2 from ``r^2/p`` to ``tip_factor * r^2/p`` (>= 1 is safer).
-    method : {"stable", "exact"}
-        Procedure STABLE (closed form) or the exact region (traced by certified force status).
 
     Examples
     --------
@@ -193,7 +189,7 @@ def stable_region(
     translations are those within atan(0.5) = 26.565 deg of the normal:
 
     >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
-    >>> region = stable_region(block, 0, 0.5, tip_factor=1.0)
+    >>> region = procedure_stable(block, 0, 0.5, tip_factor=1.0)
     >>> region.cor_vertices(1).round(12).tolist(), region.cor_vertices(-1).round(12).tolist()
     ([[-2.0, 0.5]], [[2.0, 0.5]])
     >>> np.degrees(region.translation_range).round(3).tolist()
@@ -205,15 +201,9 @@ def stable_region(
     stably (Proposition 6):
 
     >>> off_centre = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]], cf=[0.9, 0.5])
-    >>> stable_region(off_centre, 0, 0.5, width=0.5).is_empty
+    >>> procedure_stable(off_centre, 0, 0.5, width=0.5).is_empty
     True
     """
-    if method == "exact":
-        from .exact_region import exact_region  # it builds on this module's region
-
-        return exact_region(slider, edge, mu, width)
-    if method != "stable":
-        raise ValueError(f"method must be 'stable' or 'exact', got {method!r}")
     if not mu > 0:
         raise ValueError(f"mu must be > 0, got {mu}")
     if not slider.is_pushable(edge):

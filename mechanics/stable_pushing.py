@@ -27,7 +27,7 @@ from .contacts import ContactConfiguration
 from .force_status import force_status
 from .possible_motions import possible_motions
 from .slider import Slider
-from .stable import stable_region
+from .stable import procedure_stable
 from .support import SupportModel
 from .wrenches import contact_wrench_cone
 
@@ -65,7 +65,7 @@ def classify_goal(
     v = np.asarray(twist, dtype=float)
     support = SupportModel.of_slider(slider) if support is None else support
     # STABLE proves stability for the known CF only.
-    if mu > 0 and support.cf_radius == 0 and stable_region(slider, edge, mu, width).contains(v):
+    if mu > 0 and support.cf_radius == 0 and procedure_stable(slider, edge, mu, width).contains(v):
         return "guaranteed"
     config = ContactConfiguration.slider_edge(slider, edge, mu, width)
     sticking = "s" * len(config)

@@ -37,11 +37,17 @@ in the disk, so they stay admissible.
 
 A support point exactly at the COR does not slide: its static friction may point anywhere (with
 at most the sliding magnitude), the limit of pressure concentrated near the COR. The samples
-therefore include the COR with a fan of friction directions when the COR lies in ``S``.
+therefore include the COR when it lies in ``S``: with the friction direction that suits the
+question best in a support function's LP, with a fan of directions in :meth:`LoadBatch.minimax`.
+
+These LPs have a handful of constraints (total weight, centroid, and for the minimax one per
+row of the cone), so they are solved by a simplex method run on many twists and directions at
+once in numpy (:class:`LoadBatch`, :func:`_simplex`); HiGHS is only a fallback.
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
@@ -49,14 +55,12 @@ from functools import cached_property
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike
-from scipy.optimize import linprog
-from scipy.spatial import ConvexHull, QhullError
 
 from .slider import Slider
 from .twist import point_velocity, twist_to_cor
 from .wrenches import point_wrench
 
-__all__ = ["SupportCells", "SupportLoads", "SupportModel", "effective_cf", "support_friction", "unit_loads"]
+__all__ = ["LoadBatch", "SupportCells", "SupportLoads", "SupportModel", "effective_cf", "support_friction", "unit_loads"]
 
 #: Friction directions tried at a support point on the COR (the LP mixes them).
 COR_DIRECTIONS = 32
@@ -156,6 +160,34 @@ class SupportCells:
         return cls(nodes[inside(nodes)], nodes, cells, anchors, reach)
 
 
+def _centre_directions() -> np.ndarray:
+    """Corners of the unit ``CF_DIRECTIONS``-gon: where sample distributions may put their centre
+    (times the CF's uncertainty radius)."""
+    angle = 2 * np.pi * np.arange(CF_DIRECTIONS) / CF_DIRECTIONS
+    return np.stack([np.cos(angle), np.sin(angle)], axis=1)
+
+
+def _triangle_around(x: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Indices of three of the points ``x`` whose triangle holds ``target`` (a feasible simplex
+    basis): among corners of their hull (at most 16 evenly spread, else all), the one whose
+    smallest barycentric weight of ``target`` is largest.
+
+    >>> sorted(_triangle_around(np.array([[0.0, 0], [2, 0], [0, 2], [0.5, 0.5]]), np.array([0.5, 0.5])).tolist())
+    [0, 1, 2]
+    """
+    corners = np.asarray(shapely.MultiPoint(x).convex_hull.exterior.coords)[:-1]
+    index = np.argmin(np.linalg.norm(x[None] - corners[:, None], axis=2), axis=1)
+    for pick in (index[np.linspace(0, len(index), min(16, len(index)), endpoint=False).astype(int)], index):
+        triples = np.array(list(itertools.combinations(pick, 3)))
+        m = np.stack([np.ones(triples.shape), x[triples, 0], x[triples, 1]], axis=1)  # columns: the corners
+        ok = np.abs(np.linalg.det(m)) > 1e-12
+        weights = np.linalg.solve(m[ok], np.broadcast_to(np.r_[1.0, target], (int(ok.sum()), 3))[..., None])[..., 0]
+        best = int(np.argmax(weights.min(axis=1)))
+        if weights[best].min() >= -1e-12:
+            return triples[ok][best]
+    raise ValueError("the target lies outside the samples' hull")
+
+
 def _disk_cells(cf: np.ndarray, radius: float, n: int) -> list[np.ndarray]:
     """Polar grid: ``n`` rings, sectors with arcs ``<= radius / n``; each sector's outer arc is
     replaced by its two tangents (apex outside the arc) so the cells cover the disk."""
@@ -218,6 +250,8 @@ class SupportModel:
         self.polygon = polygon
         self.resolution = int(resolution)
         self._cells: dict[int, SupportCells] = {}
+        self._lp: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        self._triangle: dict[int, np.ndarray] = {}
 
     def __repr__(self) -> str:
         extra = f", cf_radius={self.cf_radius:g}" if self.cf_radius else ""
@@ -270,20 +304,348 @@ class SupportModel:
 
     def loads(self, twist: ArrayLike, level: int = 0) -> SupportLoads:
         """The possible loads of ``twist``, represented by the samples of ``level``."""
-        return SupportLoads(self, np.asarray(twist, dtype=float), self.cells(level))
+        return SupportLoads(self, np.asarray(twist, dtype=float), level)
+
+    def batch(self, twists: ArrayLike, level: int = 0) -> LoadBatch:
+        """The possible loads of each of ``twists`` (shape ``(K, 3)``), represented by the samples of ``level``."""
+        return LoadBatch(self, twists, level)
+
+    def envelope_lp(self, level: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(columns, rhs, basis)``: the discrete LP of :meth:`LoadBatch.sample_support` at
+        ``level`` and a feasible starting basis for it (cached).
+
+        Lengths are in units of :attr:`radius`. A sample ``x`` is the column ``(1, (x - CF)/r)``: the
+        rows are the total weight and the centroid. With an uncertain CF a fourth row holds the
+        centre's weight ``rho/r``, spread over columns ``(0, -e_j, 1)`` for the corners ``e_j`` of the
+        32-gon, so that the centroid may be any point of the 32-gon of radius ``rho``. The start is
+        a triangle of samples holding the CF (:meth:`cf_triangle`), or a corner of that 32-gon.
+        """
+        if level not in self._lp:
+            cells = self.cells(level)
+            x = (cells.points - self.cf) / self.radius
+            columns = np.vstack([np.ones(len(x)), x.T])
+            rhs = np.array([1.0, 0.0, 0.0])
+            start = self.cf_triangle(level)
+            if self.cf_radius > 0:
+                e = _centre_directions()
+                hull = shapely.MultiPoint(x).convex_hull
+                depth = shapely.distance(hull.exterior, shapely.points(self.cf_radius / self.radius * e))
+                inside = shapely.contains_xy(hull, *(self.cf_radius / self.radius * e).T)
+                if not inside.any():
+                    raise ValueError("the CF's uncertainty disk leaves the support region")
+                j = int(np.argmax(np.where(inside, depth, -np.inf)))
+                columns = np.r_[columns, np.zeros((1, len(x)))]
+                columns = np.c_[columns, np.r_[np.zeros((1, CF_DIRECTIONS)), -e.T, np.ones((1, CF_DIRECTIONS))]]
+                rhs = np.r_[rhs, self.cf_radius / self.radius]
+                start = np.r_[_triangle_around(x, self.cf_radius / self.radius * e[j]), len(x) + j]
+            self._lp[level] = columns, rhs, start
+        return self._lp[level]
+
+    def cf_triangle(self, level: int = 0) -> np.ndarray:
+        """Indices of three samples of ``level`` whose triangle holds the CF as deep inside as can be
+        (a feasible start for the LPs over distributions centred at the CF; cached)."""
+        if level not in self._triangle:
+            self._triangle[level] = _triangle_around((self.cells(level).points - self.cf) / self.radius, np.zeros(2))
+        return self._triangle[level]
+
+
+class LoadBatch:
+    """Loads of many twists over the admissible distributions of a :class:`SupportModel`, batched.
+
+    ``twists`` has shape ``(K, 3)``; every method takes directions ``ys`` of shape ``(R, 3)`` (the
+    same for every twist) or ``(K, R, 3)`` and answers per twist and direction, shape ``(K, R)``.
+    For a direction ``y`` the *support function* ``sup y . L`` over distributions is bracketed by
+    :meth:`sample_support` (the discrete LP: a lower bound, attained by a sample distribution, or
+    its limit at the COR) and :meth:`upper_bound` (guaranteed for the continuum).
+
+    The discrete LP has three constraints (total weight and centroid; four with an uncertain CF),
+    so each is solved by a few pivots of the simplex method, all of them at once in numpy
+    (:func:`_simplex`). A sample at the COR, when the COR lies in the region, carries the friction
+    direction that suits ``y`` best (static friction may point anywhere there).
+
+    Examples
+    --------
+    CCW turns about the CF of the unit disk and about points 1.5, 10 and 10^6 to its left: the
+    largest moment of the load about the CF falls from 1 (all the weight on the rim) towards 0 (a
+    translation's load passes through the CF), while the largest force along ``y`` stays 1 (a
+    sample moving straight up). The guaranteed bounds lie above.
+
+    >>> from mechanics import cor_to_twist
+    >>> batch = SupportModel.disk([0, 0], 1.0).batch(cor_to_twist([[0, 0], [-1.5, 0], [-10, 0], [-1e6, 0]], 1))
+    >>> moment_and_push = [[0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]
+    >>> values, lams = batch.sample_support(moment_and_push)
+    >>> values.round(3).tolist()
+    [[1.0, 1.0], [0.553, 1.0], [0.099, 1.0], [0.0, 1.0]]
+    >>> bool(np.all(batch.upper_bound(moment_and_push, lams) >= values))
+    True
+    """
+
+    def __init__(self, model: SupportModel, twists: ArrayLike, level: int = 0):
+        self.model, self.level, self.cells = model, level, model.cells(level)
+        self.cf = model.cf
+        self.twists = np.asarray(twists, dtype=float).reshape(-1, 3)
+        cor, sense = twist_to_cor(self.twists)
+        self.sense = sense.astype(int)
+        rotation = self.sense != 0
+        self.cor = np.where(rotation[:, None], cor, model.cf)  # a translation's stands in, unused
+        self.cor_in_region = rotation & model.covers(self.cor)
+
+    def __len__(self) -> int:
+        return len(self.twists)
+
+    def _directions(self, ys: ArrayLike) -> np.ndarray:
+        """``ys`` as ``(K, R, 3)``: one set for every twist, or a set per twist."""
+        ys = np.asarray(ys, dtype=float)
+        return np.broadcast_to(ys, (len(self), *ys.shape[-2:]))
+
+    def _arm(self, ys: np.ndarray) -> np.ndarray:
+        """``u`` with ``y . g(x) = u . v^(x) + sense y_m |x - c|`` for a rotation about ``c``, shape ``(K, R, 2)``."""
+        spin = np.stack([-self.cor[:, 1], self.cor[:, 0]], axis=-1)
+        return ys[..., :2] + ys[..., 2:] * spin[:, None, :]
+
+    def sample_support(self, ys: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """``(values, lams)``: the largest ``y . L`` over sample distributions, shape ``(K, R)``, and
+        the LP's duals ``lam`` (``K, R, 2``), with ``value = max over samples of y . g + lam . (x - CF)``
+        (plus ``cf_radius`` times the support of ``-lam`` on the 32-gon of centres)."""
+        ys = self._directions(ys)
+        k, r = ys.shape[:2]
+        columns, rhs, start = self.model.envelope_lp(self.level)
+        costs = np.einsum("knj,krj->krn", unit_loads(self.twists[:, None, :], self.cells.points[None]), ys)
+        # The centre's columns (uncertain CF) cost nothing.
+        costs = np.concatenate([costs, np.zeros((k, r, columns.shape[1] - costs.shape[2]))], axis=2)
+        if self.cor_in_region.any():
+            at_cor = np.where(self.cor_in_region[:, None], np.linalg.norm(self._arm(ys), axis=-1), -np.inf)
+            costs = np.concatenate([costs, at_cor[..., None]], axis=2)
+            extra = np.zeros((k, len(rhs), 1))
+            extra[:, :3, 0] = np.c_[np.ones(k), (self.cor - self.cf) / self.model.radius]
+            per_twist = np.concatenate([np.broadcast_to(columns, (k, *columns.shape)), extra], axis=2)
+            columns = np.broadcast_to(per_twist[:, None], (k, r, *per_twist.shape[1:])).reshape(k * r, len(rhs), -1)
+        duals, _ = _simplex(costs.reshape(k * r, -1), columns, rhs, np.broadcast_to(start, (k * r, len(rhs))))
+        return (duals @ rhs).reshape(k, r), (-duals[:, 1:3] / self.model.radius).reshape(k, r, 2)
+
+    @cached_property
+    def _cell_geometry(self) -> tuple[np.ndarray, ...]:
+        """Per twist and cell, seen from the COR ``c``: the cell's distance (0 if it holds ``c``),
+        the largest distance to a vertex, the angular range ``[lo, hi]`` of the directions from
+        ``c`` to its points, measured from the direction of its anchor (exact for a convex cell),
+        and that anchor direction; shapes ``(K, C)`` and ``(K, C, 2)``."""
+        cells = self.cells
+        # Components apart, (K, cells, vertices) each: the vertices relative to c, and the edges.
+        corners = cells.nodes[cells.cells]
+        vx, vy = (corners[None, ..., i] - self.cor[:, None, None, i] for i in (0, 1))
+        ex, ey = np.roll(vx, -1, axis=2) - vx, np.roll(vy, -1, axis=2) - vy
+        length2 = ex * ex + ey * ey
+        along = np.clip(np.divide(-(vx * ex + vy * ey), length2, out=np.zeros_like(length2), where=length2 > 0), 0, 1)
+        outside = np.hypot(vx + along * ex, vy + along * ey).min(axis=2)
+        turn = ex * -vy + ey * vx  # side of c for each edge
+        eps = 1e-12 * self.model.radius**2
+        holds = np.all(turn >= -eps, axis=2) | np.all(turn <= eps, axis=2)
+        base = cells.anchors[None] - self.cor[:, None, :]
+        bx, by = base[..., :1], base[..., 1:]
+        angle = np.arctan2(bx * vy - by * vx, bx * vx + by * vy)
+        return np.where(holds, 0.0, outside), np.hypot(vx, vy).max(axis=2), angle.min(axis=2), angle.max(axis=2), base
+
+    def cell_bounds(self, ys: ArrayLike, lams: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Upper bounds of ``psi(x) = y . g(x) + lam . (x - CF)`` per cell (``K, R, C``), which cells
+        hold the COR ``c`` (``K, C``), and (for those) ``psi``'s envelope ``E`` at ``c`` and its slope
+        ``k`` away from it (``K, R``): ``psi <= E + k |x - c|``. A translation has no COR (``E = -inf``)."""
+        ys, cells = self._directions(ys), self.cells
+        lams = np.broadcast_to(np.asarray(lams, dtype=float), (*ys.shape[:2], 2))
+        linear_nodes = np.einsum("nj,krj->krn", cells.nodes - self.cf, lams)
+        psi = np.einsum("knj,krj->krn", unit_loads(self.twists[:, None, :], cells.nodes[None]), ys) + linear_nodes
+        vertex_max = psi[..., cells.cells].max(axis=-1)
+        rotation = (self.sense != 0)[:, None, None]
+        # psi = w . (x - c)/r + sense y_m r + lam . (x - CF), r = |x - c|, w = sense (u_y, -u_x).
+        arm = self._arm(ys)
+        sense = self.sense[:, None, None]
+        w = sense * np.stack([arm[..., 1], -arm[..., 0]], axis=-1)
+        u = np.linalg.norm(w, axis=-1)[..., None]
+        radial = (self.sense[:, None] * ys[..., 2])[..., None]
+        dist, reach_c, lo, hi, base = (g[:, None] for g in self._cell_geometry)
+        away = dist > 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # Second order: psi + M/2 |x - a|^2 is convex on a cell away from c when M bounds psi's
+            # Hessian from below: the Hessian of w . (x - c)/r is >= -1.5 |w| / r^2, that of
+            # sense y_m r is >= min(0, sense y_m) / r. So psi <= max over vertices + M/2 reach^2.
+            curvature = 1.5 * u / dist**2 + np.maximum(0.0, -radial) / dist
+            second = np.where(away, vertex_max + curvature / 2 * cells.reach**2, np.inf)
+        # First order, term by term: w . (x - c)/r over the cell's range of directions, the
+        # radial term at the nearest or farthest point, lam . x at a vertex.
+        phi = np.arctan2(base[..., 0] * w[..., 1:] - base[..., 1] * w[..., :1], base[..., 0] * w[..., :1]
+                         + base[..., 1] * w[..., 1:])
+        direction = np.where((lo <= phi) & (phi <= hi), u, u * np.maximum(np.cos(phi - lo), np.cos(phi - hi)))
+        linear = linear_nodes[..., cells.cells].max(axis=-1)
+        first = direction + radial * np.where(radial > 0, reach_c, dist) + linear
+        # A cell holding c: u . v^ <= |u| and lam . (x - c) <= |lam| r.
+        envelope = u[..., 0] + np.einsum("krj,kj->kr", lams, self.cor - self.cf)
+        slope = radial[..., 0] + np.linalg.norm(lams, axis=-1)
+        first = np.where(away, first, envelope[..., None] + slope[..., None] * np.where(slope[..., None] > 0, reach_c, 0.0))
+        bounds = np.where(rotation, np.minimum(first, second), vertex_max)  # a translation's psi is affine
+        touching = ~away[:, 0] & rotation[:, 0]
+        return bounds, touching, np.where(rotation[..., 0], envelope, -np.inf), np.where(rotation[..., 0], slope, 0.0)
+
+    def upper_bound(self, ys: ArrayLike, lams: ArrayLike) -> np.ndarray:
+        """Guaranteed upper bounds on ``y . L`` over *all* admissible distributions, shape ``(K, R)``.
+
+        Weak duality: ``y . L(mu) = integral of psi d mu`` for any multiplier ``lam``, with
+        ``psi(x) = y . g(x) + lam . (x - CF)``, so the supremum of ``psi`` over the region bounds
+        it; that supremum is bounded cell by cell (second order away from the COR, first order
+        near it, where the static friction of a point at the COR may point anywhere). An uncertain
+        CF adds ``cf_radius |lam|``.
+        """
+        bounds, *_ = self.cell_bounds(ys, lams)
+        return bounds.max(axis=-1) + self.model.cf_radius * np.linalg.norm(lams, axis=-1)
+
+    def is_negative(self, ys: ArrayLike, lams: ArrayLike, tol: float = 0.0) -> np.ndarray:
+        """Whether ``y . L < 0`` is guaranteed for every admissible distribution, one direction
+        ``y`` (``K, 3``) and multiplier ``lam`` (``K, 2``) per twist.
+
+        True when ``psi < 0`` on the region except at the COR, where ``psi``'s envelope is
+        ``<= tol`` and ``psi`` falls away from it (then a distribution with any moving weight has
+        ``y . L < 0``; one wholly at the COR is not a motion).
+        """
+        lams = np.asarray(lams, dtype=float)
+        bounds, touching, envelope, slope = self.cell_bounds(np.asarray(ys, dtype=float)[:, None], lams[:, None])
+        bounds, envelope, slope = bounds[:, 0], envelope[:, 0], slope[:, 0]  # the one direction per twist
+        if self.model.cf_radius > 0:  # no exemption at the COR: the centre term is positive
+            return np.all(bounds + self.model.cf_radius * np.linalg.norm(lams, axis=-1)[:, None] < 0, axis=1)
+        at_cor_ok = (envelope <= tol) & (slope < 0)
+        return np.all((bounds < 0) | (touching & at_cor_ok[:, None]), axis=1)
+
+    def minimax(self, rows: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(beta, lam, values)`` per twist: the convex weights ``beta`` (``K, R``) of ``rows``
+        minimising the largest ``(beta . rows) . L`` over sample distributions, the centroid
+        multiplier ``lam`` (``K, 2``) of that minimum, and the minimum (``K``).
+
+        The LP solved is its dual, over sample distributions: the largest least row value
+        ``min_j rows_j . L``. A sample at the COR, when the COR lies in the region, stands for a
+        fan of ``COR_DIRECTIONS`` friction directions. A distribution entirely at the COR moves
+        nothing and needs no force; only a COR at the CF admits it, and there the moving weight is
+        normalised instead of the total: the value is ``inf`` when no weights bound it (the fan
+        reaches into every half-space the rows allow).
+        """
+        rows = np.asarray(rows, dtype=float).reshape(-1, 3)
+        k, r = len(self), len(rows)
+        rho, radius, cf = self.model.cf_radius, self.model.radius, self.cf
+        points = np.broadcast_to(self.cells.points, (k, *self.cells.points.shape))
+        loads, present = unit_loads(self.twists[:, None, :], points), np.ones(points.shape[:2], dtype=bool)
+        if self.cor_in_region.any():
+            angle = 2 * np.pi * np.arange(COR_DIRECTIONS) / COR_DIRECTIONS
+            fan = np.stack([np.cos(angle), np.sin(angle)], axis=1)
+            at_cor = np.broadcast_to(self.cor[:, None, :], (k, COR_DIRECTIONS, 2))
+            points = np.concatenate([points, at_cor], axis=1)
+            loads = np.concatenate([loads, point_wrench(at_cor, fan[None])], axis=1)
+            present = np.c_[present, np.broadcast_to(self.cor_in_region[:, None], at_cor.shape[:2])]
+        n = points.shape[1]
+        moving = np.linalg.norm(point_velocity(self.twists[:, None, :], points), axis=-1) > 0
+        at_cf = (self.sense != 0) & (np.linalg.norm(self.cor - cf, axis=1) <= 1e-9 * radius)
+        # Columns: samples (rows' values, weight, centroid / r), z+ and z- (the least row value),
+        # a slack per row, and with an uncertain CF the centre's 32-gon and its slack.
+        z, centres = n, n + 2 + r
+        a = np.zeros((k, r + 3 + (rho > 0), centres + (CF_DIRECTIONS + 1 if rho > 0 else 0)))
+        a[:, :r, :n] = np.einsum("knj,rj->krn", loads, rows) * present[:, None]
+        a[:, r, :n] = present & (moving | ~at_cf[:, None])
+        a[:, r + 1:r + 3, :n] = np.swapaxes((points - cf) / radius * present[..., None], 1, 2)
+        a[:, :r, z], a[:, :r, z + 1], a[:, :r, z + 2:centres] = -1.0, 1.0, -np.eye(r)
+        rhs = np.zeros(a.shape[1])
+        rhs[r] = 1.0
+        if rho > 0:
+            a[:, r + 1:r + 3, centres:-1] = -rho / radius * _centre_directions().T
+            a[:, r + 3, centres:] = rhs[r + 3] = 1.0
+        costs = np.zeros((k, a.shape[2]))
+        costs[:, z], costs[:, z + 1] = 1.0, -1.0
+        # Start: the CF's triangle, z its least row value, the other rows' slacks (and the centre's).
+        triangle = self.model.cf_triangle(self.level)
+        weights = np.linalg.solve(a[0, r:r + 3, triangle].T, [1.0, 0.0, 0.0])
+        values = a[:, :r, triangle] @ weights
+        least = np.argmin(values, axis=1)
+        slacks = np.broadcast_to(z + 2 + np.arange(r), (k, r))
+        basis = np.c_[np.broadcast_to(triangle, (k, 3)), np.where(values[np.arange(k), least] >= 0, z, z + 1),
+                      slacks[slacks != (z + 2 + least)[:, None]].reshape(k, r - 1),
+                      np.full((k, int(rho > 0)), a.shape[2] - 1)].astype(int)
+        duals, unbounded = _simplex(costs, a, rhs, basis)
+        beta, lam, value = -duals[:, :r], -duals[:, r + 1:r + 3] / radius, duals @ rhs
+        beta[unbounded], lam[unbounded], value[unbounded] = np.nan, 0.0, np.inf
+        return beta, lam, value
+
+
+def _simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, basis: np.ndarray,
+             limit: int = 100) -> tuple[np.ndarray, np.ndarray]:
+    """Optimal duals of the LPs ``max costs[p] . s`` s.t. ``columns s = rhs``, ``s >= 0``, one per
+    row of ``costs``, and which LPs are unbounded (their duals mean nothing).
+
+    The revised simplex method on all problems at once: each pivot costs one product of the
+    duals with the columns. ``columns`` (``m, n``) is shared, or one per problem (``P, m, n``);
+    ``basis`` (``P, m``) must be feasible; a cost of ``-inf`` keeps a column out. The returned
+    duals ``pi`` (``P, m``) satisfy ``pi . column <= cost`` to rounding, and ``pi . rhs`` is the
+    optimum. Pivots follow Dantzig's rule (the largest reduced cost), which converges in a few
+    pivots but can cycle on the degenerate vertices a grid through the CF makes (a sample at the
+    CF, others in line with it); after ``limit // 4`` pivots the open problems follow Bland's
+    rule (lowest indices), which cannot cycle. One still open after ``limit`` (rounding) goes to
+    HiGHS.
+
+    >>> # Weights on 0, 1 and 3 (points of a line) with mean 1: the best of costs 0, 2 and 9 mixes 0 and 3.
+    >>> pi, unbounded = _simplex(np.array([[0.0, 2.0, 9.0]]), np.array([[1.0, 1, 1], [-1, 0, 2]]),
+    ...                          np.array([1.0, 0]), np.array([[0, 1]]))
+    >>> (pi @ [1.0, 0]).round(12).tolist(), unbounded.tolist()
+    ([3.0], [False])
+    """
+    problems, m = basis.shape
+    shared = columns.ndim == 2
+    basis = np.array(basis)
+    duals = np.zeros((problems, m))
+    unbounded = np.zeros(problems, dtype=bool)
+    tol = 1e-12 * (1.0 + np.max(np.abs(np.where(np.isfinite(costs), costs, 0.0)), axis=1))
+    open_ = np.arange(problems)
+    for pivot in range(limit):
+        bland = pivot >= limit // 4
+        a = columns if shared else columns[open_]
+        cols = (a[:, basis[open_]].transpose(1, 0, 2) if shared
+                else np.take_along_axis(a, basis[open_][:, None, :], axis=2))
+        c = costs[open_]
+        pi = np.linalg.solve(np.swapaxes(cols, 1, 2), np.take_along_axis(c, basis[open_], axis=1)[..., None])[..., 0]
+        duals[open_] = pi
+        reduced = c - (pi @ a if shared else np.einsum("pm,pmn->pn", pi, a))
+        improving = reduced > tol[open_, None]
+        going = improving.any(axis=1)
+        if not going.any():
+            return duals, unbounded
+        enter = np.argmax(improving if bland else reduced, axis=1)[going]
+        open_, cols = open_[going], cols[going]
+        entering = a[:, enter].T if shared else a[going][np.arange(len(open_)), :, enter]
+        weights = np.linalg.solve(cols, np.broadcast_to(rhs, (len(open_), m))[..., None])[..., 0]
+        step = np.linalg.solve(cols, entering[..., None])[..., 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(step > 1e-11, np.maximum(weights, 0.0) / step, np.inf)
+        bounded = np.isfinite(ratio).any(axis=1)  # else the entering column grows without end
+        unbounded[open_[~bounded]] = True
+        open_, enter, ratio = open_[bounded], enter[bounded], ratio[bounded]
+        if bland:  # of the tied leaving columns, the lowest
+            ratio = np.where(ratio <= ratio.min(axis=1, keepdims=True), basis[open_], np.inf)
+        basis[open_, np.argmin(ratio, axis=1)] = enter
+    from scipy.optimize import linprog  # rarely needed: scipy.optimize takes a third of a second to import
+
+    for p in open_:
+        a = columns if shared else columns[p]
+        keep = np.isfinite(costs[p])
+        res = linprog(rhs, A_ub=-a[:, keep].T, b_ub=-costs[p, keep], bounds=[(None, None)] * m, method="highs")
+        if res.status == 2:  # no feasible duals: the LP itself is unbounded
+            unbounded[p] = True
+        elif res.status != 0:
+            raise RuntimeError(f"support LP failed: {res.message}")
+        else:
+            duals[p] = res.x
+    return duals, unbounded
 
 
 class SupportLoads:
-    """Loads of one twist over the admissible distributions of a :class:`SupportModel`.
+    """Loads of one twist over the admissible distributions of a :class:`SupportModel`: a
+    :class:`LoadBatch` of one, answering with scalars.
 
-    ``points`` and ``wrenches`` are the sample points and their unit loads, with the fan of
-    friction directions at the COR when it lies in the region. For a direction ``y`` the *support
-    function* ``sup y . L`` over distributions is bracketed by :meth:`sample_support` (the discrete
-    LP: a lower bound, attained by a sample distribution) and :meth:`upper_bound`.
-
-    A distribution entirely at the COR moves nothing and needs no force (a zero load lies in every
-    cone of contact forces); it is left out. Only a COR at the CF admits it, and there
-    :meth:`minimax` normalises the moving weight instead of the total.
+    For a direction ``y`` the *support function* ``sup y . L`` over distributions is bracketed by
+    :meth:`sample_support` (the discrete LP: a lower bound, attained by a sample distribution) and
+    :meth:`upper_bound`; :meth:`minimax` and :meth:`is_negative` find and check a hyperplane
+    separating every load from a cone.
 
     Examples
     --------
@@ -297,154 +659,26 @@ class SupportLoads:
     (1.0, 1.003427, 1.003427)
     """
 
-    def __init__(self, model: SupportModel, twist: np.ndarray, cells: SupportCells):
-        self.model, self.twist, self.cells = model, twist, cells
-        self.cf = model.cf
-        cor, sense = twist_to_cor(twist)
-        self.sense = int(sense)
-        self.cor = cor if self.sense else None
-        points, wrenches = cells.points, unit_loads(twist, cells.points)
-        self._cor_in_region = self.sense != 0 and bool(model.covers(cor))
-        if self._cor_in_region:
-            angle = 2 * np.pi * np.arange(COR_DIRECTIONS) / COR_DIRECTIONS
-            fan = np.stack([np.cos(angle), np.sin(angle)], axis=1)
-            points = np.vstack([points, np.broadcast_to(cor, fan.shape)])
-            wrenches = np.vstack([wrenches, point_wrench(cor, fan)])
-        self.points, self.wrenches = points, wrenches
-        self._moving = np.linalg.norm(point_velocity(twist, points), axis=1) > 0
-        self._at_cf = self.sense != 0 and bool(np.linalg.norm(cor - self.cf) <= 1e-9 * model.radius)
-
-    def _arm(self, y: np.ndarray) -> np.ndarray:
-        """``u`` with ``y . g(x) = u . v^(x) + sense y_m |x - c|`` for a rotation about ``c``."""
-        return y[:2] + y[2] * np.array([-self.cor[1], self.cor[0]])
+    def __init__(self, model: SupportModel, twist: np.ndarray, level: int = 0):
+        self.model, self.twist, self.cf = model, twist, model.cf
+        self.batch = LoadBatch(model, twist[None], level)
 
     def sample_support(self, y: ArrayLike) -> tuple[float, np.ndarray]:
         """``(value, lam)``: the largest ``y . L`` over sample distributions, and the LP's dual
         ``lam`` (value ``= max over samples of y . g + lam . (x - CF)``)."""
-        y = np.asarray(y, dtype=float)
-        if self.model.cf_radius > 0:  # the centre may move: one LP (module docstring)
-            _, lam, value = self.minimax(y[None])
-            return value, lam
-        h, x = self.wrenches @ y, self.points - self.cf
-        if self._cor_in_region:  # the best friction direction at the COR, exactly
-            h, x = np.r_[h, np.linalg.norm(self._arm(y))], np.vstack([x, self.cor - self.cf])
-        try:
-            hull = ConvexHull(np.c_[x, h])
-        except QhullError:  # flat (e.g. a translation: y . g is affine): the LP copes
-            _, lam, value = self.minimax(y[None])
-            return value, lam
-        # The upper hull is the concave envelope of the samples; at the CF it is the lowest of its
-        # facet planes h = t - lam . x (outward normal pointing up).
-        eq = hull.equations[hull.equations[:, 2] > 1e-12]
-        k = int(np.argmin(-eq[:, 3] / eq[:, 2]))
-        return float(-eq[k, 3] / eq[k, 2]), eq[k, :2] / eq[k, 2]
+        values, lams = self.batch.sample_support(np.asarray(y, dtype=float)[None])
+        return float(values[0, 0]), lams[0, 0]
 
     def minimax(self, rows: ArrayLike) -> tuple[np.ndarray, np.ndarray, float]:
-        """``(beta, lam, value)`` minimising over convex weights ``beta`` of ``rows`` the largest
-        ``(beta . rows) . L`` over sample distributions (one LP; its dual is the max-min).
-
-        ``value`` is ``inf`` when no weights bound it (a COR at the CF whose fan of friction
-        forces reaches into every half-space the rows allow).
-        """
-        rows = np.asarray(rows, dtype=float).reshape(-1, 3)
-        k, n = len(rows), len(self.points)
-        # Rows of points that do not move carry no "t" when the moving weight is normalised.
-        t_column = np.where(self._moving | (not self._at_cf), -1.0, 0.0)
-        a_ub = np.c_[self.wrenches @ rows.T, self.points - self.cf, t_column, np.zeros(n)]
-        rho = self.model.cf_radius
-        if rho > 0:
-            # u >= -e_j . lam for the inscribed polygon's corners e_j: the LP's dual lets the
-            # centre move to any point of that polygon, and the objective pays rho u for it.
-            angle = 2 * np.pi * np.arange(CF_DIRECTIONS) / CF_DIRECTIONS
-            e = np.stack([np.cos(angle), np.sin(angle)], axis=1)
-            a_ub = np.r_[a_ub, np.c_[np.zeros((CF_DIRECTIONS, k)), -e, np.zeros(CF_DIRECTIONS), -np.ones(CF_DIRECTIONS)]]
-        res = linprog(
-            np.r_[np.zeros(k + 2), 1.0, rho], A_ub=a_ub, b_ub=np.zeros(len(a_ub)),
-            A_eq=np.r_[np.ones(k), 0.0, 0.0, 0.0, 0.0][None], b_eq=[1.0],
-            bounds=[(0, None)] * k + [(None, None)] * 3 + [(0, None)], method="highs",
-        )
-        if res.status == 2 and self._at_cf:
-            return np.full(k, np.nan), np.zeros(2), np.inf
-        if res.status != 0:
-            raise RuntimeError(f"support LP failed: {res.message}")
-        return res.x[:k], res.x[k:k + 2], float(res.x[k + 2] + rho * res.x[-1])
-
-    @cached_property
-    def _cell_geometry(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Per cell, seen from the COR ``c``: its distance (0 if it holds ``c``), the largest
-        distance to a vertex, and the angular range ``[lo, hi]`` of the directions from ``c`` to its
-        points, measured from the direction of its anchor (exact for a convex cell)."""
-        cells = self.cells
-        v = cells.nodes[cells.cells] - self.cor  # (cells, vertices, 2), relative to c
-        edge = np.roll(v, -1, axis=1) - v
-        length2 = np.sum(edge**2, axis=2)
-        along = np.clip(np.divide(-np.sum(v * edge, axis=2), length2, out=np.zeros_like(length2), where=length2 > 0), 0, 1)
-        outside = np.linalg.norm(v + along[..., None] * edge, axis=2).min(axis=1)
-        turn = edge[..., 0] * -v[..., 1] + edge[..., 1] * v[..., 0]  # side of c for each edge
-        eps = 1e-12 * self.model.radius**2
-        holds = np.all(turn >= -eps, axis=1) | np.all(turn <= eps, axis=1)
-        base = cells.anchors - self.cor
-        angle = np.arctan2(base[:, None, 0] * v[..., 1] - base[:, None, 1] * v[..., 0], np.sum(base[:, None] * v, axis=2))
-        return np.where(holds, 0.0, outside), np.linalg.norm(v, axis=2).max(axis=1), angle.min(axis=1), angle.max(axis=1)
-
-    def _cell_bounds(self, y: np.ndarray, lam: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
-        """Upper bounds of ``psi(x) = y . g(x) + lam . (x - CF)`` per cell, which cells hold the
-        COR ``c``, and (for those) ``psi``'s envelope ``E`` at ``c`` and its slope ``k`` away from it:
-        ``psi <= E + k |x - c|``."""
-        cells = self.cells
-        psi = unit_loads(self.twist, cells.nodes) @ y + (cells.nodes - self.cf) @ lam
-        vertex_max = psi[cells.cells].max(axis=1)
-        if self.sense == 0:  # psi is affine: its maximum on a cell is at a vertex
-            return vertex_max, np.zeros(len(vertex_max), dtype=bool), -np.inf, 0.0
-        # psi = w . (x - c)/r + sense y_m r + lam . (x - CF), r = |x - c|, w = sense (u_y, -u_x).
-        arm = self._arm(y)
-        w = self.sense * np.array([arm[1], -arm[0]])
-        u = float(np.linalg.norm(w))
-        radial = self.sense * y[2]
-        dist, reach_c, lo, hi = self._cell_geometry
-        away = dist > 0
-        # Second order: psi + M/2 |x - a|^2 is convex on a cell away from c when M bounds psi's
-        # Hessian from below: the Hessian of w . (x - c)/r is >= -1.5 |w| / r^2, that of
-        # sense y_m r is >= min(0, sense y_m) / r. So psi <= max over vertices + M/2 reach^2.
-        with np.errstate(divide="ignore", invalid="ignore"):
-            curvature = 1.5 * u / dist**2 + max(0.0, -radial) / dist
-            second = np.where(away, vertex_max + curvature / 2 * cells.reach**2, np.inf)
-        # First order, term by term: w . (x - c)/r over the cell's range of directions, the
-        # radial term at the nearest or farthest point, lam . x at a vertex.
-        base = cells.anchors - self.cor
-        phi = np.arctan2(base[:, 0] * w[1] - base[:, 1] * w[0], base @ w)
-        direction = np.where((lo <= phi) & (phi <= hi), u, u * np.maximum(np.cos(phi - lo), np.cos(phi - hi)))
-        linear = ((cells.nodes - self.cf) @ lam)[cells.cells].max(axis=1)
-        first = direction + radial * np.where(radial > 0, reach_c, dist) + linear
-        # A cell holding c: u . v^ <= |u| and lam . (x - c) <= |lam| r.
-        envelope = u + float(lam @ (self.cor - self.cf))
-        slope = radial + float(np.linalg.norm(lam))
-        first = np.where(away, first, envelope + slope * np.where(slope > 0, reach_c, 0.0))
-        return np.minimum(first, second), ~away, envelope, slope
+        """``(beta, lam, value)`` of :meth:`LoadBatch.minimax`."""
+        beta, lam, value = self.batch.minimax(rows)
+        return beta[0], lam[0], float(value[0])
 
     def upper_bound(self, y: ArrayLike, lam: ArrayLike) -> float:
-        """A guaranteed upper bound on ``y . L`` over *all* admissible distributions.
-
-        Weak duality: ``y . L(mu) = integral of psi d mu`` for any multiplier ``lam``, with
-        ``psi(x) = y . g(x) + lam . (x - CF)``, so the supremum of ``psi`` over the region bounds
-        it; that supremum is bounded cell by cell (second order away from the COR, first order
-        near it, where the static friction of a point at the COR may point anywhere). An uncertain
-        CF adds ``cf_radius |lam|``.
-        """
-        lam = np.asarray(lam, dtype=float)
-        bounds, *_ = self._cell_bounds(np.asarray(y, dtype=float), lam)
-        return float(bounds.max()) + self.model.cf_radius * float(np.linalg.norm(lam))
+        """A guaranteed upper bound on ``y . L`` over *all* admissible distributions
+        (:meth:`LoadBatch.upper_bound`)."""
+        return float(self.batch.upper_bound(np.asarray(y, dtype=float)[None], np.asarray(lam, dtype=float)[None, None])[0, 0])
 
     def is_negative(self, y: ArrayLike, lam: ArrayLike, tol: float = 0.0) -> bool:
-        """Whether ``y . L < 0`` is guaranteed for every admissible distribution.
-
-        True when ``psi < 0`` on the region except at the COR, where ``psi``'s envelope is
-        ``<= tol`` and ``psi`` falls away from it (then a distribution with any moving weight has
-        ``y . L < 0``; one wholly at the COR is not a motion).
-        """
-        lam = np.asarray(lam, dtype=float)
-        bounds, touching, envelope, slope = self._cell_bounds(np.asarray(y, dtype=float), lam)
-        if self.model.cf_radius > 0:  # no exemption at the COR: the centre term is positive
-            return bool(np.all(bounds + self.model.cf_radius * float(np.linalg.norm(lam)) < 0))
-        at_cor_ok = envelope <= tol and slope < 0
-        return bool(np.all((bounds < 0) | (touching & at_cor_ok)))
+        """Whether ``y . L < 0`` is guaranteed for every admissible distribution (:meth:`LoadBatch.is_negative`)."""
+        return bool(self.batch.is_negative(np.asarray(y, dtype=float)[None], np.asarray(lam, dtype=float)[None], tol)[0])

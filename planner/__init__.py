@@ -9,10 +9,10 @@ pusher geometry), :mod:`.validity` (fcl collision rule), :mod:`.pushes` (stable 
 """
 
 from .one_step import OneStep, one_step
-from .plan_file import Plan, Segment, load_plan
+from .plan_file import Plan, Segment, Transit, load_plan
 from .scene import DEFAULT_PLANNER, Scene, SceneError, load_scene, parse_scene
 from .search import plan
 from .verify import Verification, verify
 
-__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Scene", "SceneError", "Segment", "load_plan", "load_scene", "one_step",
-           "parse_scene", "plan", "Verification", "verify"]
+__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Scene", "SceneError", "Segment", "Transit", "load_plan", "load_scene",
+           "one_step", "parse_scene", "plan", "Verification", "verify"]

@@ -8,6 +8,7 @@ and a recording with the simulated ghost). ``--plan`` without ``--verify`` is ba
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
 solved (one line saying why; nothing is verified), 3 verified and some push slipped beyond the
 tolerance. Output files are written atomically, so an interrupted run leaves no half-written file.
+:func:`read_inputs` checks everything a run reads before anything is computed or written.
 """
 
 from __future__ import annotations
@@ -17,16 +18,35 @@ import atexit
 import os
 import sys
 import time
-from dataclasses import replace
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 
+from .fields import shown
 from .plan_file import Plan, load_plan, write_atomic
+from .regions import cache_folder
 from .scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS,
-                    TRANSITS, Scene, SceneError, check_seed, check_time_limit, load_scene)
+                    TRANSITS, PlannerOptions, Scene, SceneError, check_seed, check_time_limit, load_scene)
 from .search import plan
 from .verify import Verification, verify
 
-__all__ = ["main"]
+__all__ = ["Inputs", "main", "read_inputs"]
+
+_EPILOG = f"""\
+exit codes:
+  0    solved (and verified, with --verify)
+  1    bad input: one line "plan: error: <field>: <problem>", nothing written
+  2    not solved within the time limit (the files are still written, "solved": false),
+       or a usage error of these options
+  3    --verify: a push slips in the simulator
+  130  interrupted
+
+Defaults: a scene's planner: mapping (and pusher.transit) sets its own, which these options
+override; without them --planner {DEFAULT_PLANNER}, --time-limit {PlannerOptions.time_limit:g}, \
+--seed {PlannerOptions.seed}, --regions {DEFAULT_REGIONS}, --transit {DEFAULT_TRANSIT}.
+Exact regions are computed once per part (about 0.1-0.25 s an edge; the time limit bounds them
+and the search together, and they may take half of it) and cached in $STABLEPUSH_CACHE, else
+$XDG_CACHE_HOME/stablepush or ~/.cache/stablepush (here: {{cache}})."""
 
 
 def _silence_nanobind_leak_report() -> None:
@@ -38,13 +58,17 @@ def _silence_nanobind_leak_report() -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="plan", description="Plan guaranteed-stable pushes for a YAML scene.")
-    p.add_argument("scene", help="scene file (YAML)")
+    p = argparse.ArgumentParser(prog="plan", description="Plan guaranteed-stable pushes for a YAML scene.",
+                                epilog=_EPILOG.format(cache=cache_folder()),
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("scene", help="scene file (YAML; its format is in the README)")
     p.add_argument("--planner", choices=PLANNERS, help=f"OMPL control planner (default: the scene's, else {DEFAULT_PLANNER})")
     p.add_argument("--time-limit", type=float, metavar="S",
-                   help=f"planning time limit in seconds (at most {MAX_TIME_LIMIT:g})")
+                   help=f"planning time limit in seconds, at most {MAX_TIME_LIMIT:g} (default: the scene's, "
+                        f"else {PlannerOptions.time_limit:g})")
     p.add_argument("--seed", type=int, metavar="N",
-                   help=f"random seed (1..{MAX_SEED}); the same seed gives the same plan")
+                   help=f"random seed, 1..{MAX_SEED}; the same seed gives the same plan (default: the scene's, "
+                        f"else {PlannerOptions.seed})")
     p.add_argument("--regions", choices=REGIONS,
                    help=f"stable pushes: procedure STABLE or the exact region (default: the scene's, else {DEFAULT_REGIONS})")
     p.add_argument("--transit", choices=TRANSITS,
@@ -57,20 +81,32 @@ def _parser() -> argparse.ArgumentParser:
     return p
 
 
-def main(argv: list[str] | None = None) -> int:
+@dataclass(frozen=True)
+class Inputs:
+    """A command line, checked: the scene with the flags applied, and what to do with it."""
+
+    scene: Scene  # with --regions and --transit applied
+    planner: str
+    time_limit: float
+    seed: int
+    out: Path  # the output folder (not created yet)
+    verify: int | None  # --verify N
+    plan_path: str | None  # --plan FILE
+    given: Plan | None  # that file's plan, to verify instead of planning
+
+
+def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
+    """Parse and check the command line ``argv`` and read the files it names, computing and
+    writing nothing: every bad input is found here, before any planning.
+
+    Raises
+    ------
+    SceneError
+        Naming the flag or field at fault.
+    SystemExit
+        On argparse's usage errors (code 2) and ``--help`` (code 0).
+    """
     args = _parser().parse_args(argv)
-    atexit.register(_silence_nanobind_leak_report)
-    try:
-        return _run(args)
-    except SceneError as err:
-        print(f"plan: error: {err}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        print("plan: interrupted", file=sys.stderr)
-        return 130
-
-
-def _run(args: argparse.Namespace) -> int:
     limit = None if args.time_limit is None else check_time_limit(args.time_limit, "--time-limit")
     seed = None if args.seed is None else check_seed(args.seed, "--seed")
     if args.verify is not None and args.verify < 1:
@@ -82,26 +118,53 @@ def _run(args: argparse.Namespace) -> int:
         scene = replace(scene, planner=replace(scene.planner, regions=args.regions))
     if args.transit:  # and verify checks a plan's lifts against it
         scene = replace(scene, pusher=replace(scene.pusher, transit=args.transit))
-    name = args.planner or scene.planner.name
-    limit = limit or scene.planner.time_limit
-    seed = seed or scene.planner.seed
     out = Path(args.out) if args.out else _fresh_folder(Path("logs") / f"{scene.name}-{time.strftime('%Y%m%d-%H%M%S')}")
-    if out.exists() and not out.is_dir():  # found now, not after the search
-        raise SceneError("--out", f"{str(out)!r} exists and is not a folder")
-    if args.plan is not None:
-        result = load_plan(args.plan)
+    try:
+        taken = out.exists() and not out.is_dir()
+    except (OSError, ValueError) as err:  # a name too long, or with a NUL
+        raise SceneError("--out", f"cannot use {shown(str(out))}: {getattr(err, 'strerror', None) or err}") from None
+    if taken:  # found now, not after the search
+        raise SceneError("--out", f"{shown(str(out))} exists and is not a folder")
+    return Inputs(scene, args.planner or scene.planner.name, limit or scene.planner.time_limit,
+                  seed or scene.planner.seed, out, args.verify, args.plan,
+                  None if args.plan is None else load_plan(args.plan))
+
+
+def main(argv: list[str] | None = None) -> int:
+    atexit.register(_silence_nanobind_leak_report)
+    try:
+        return _run(read_inputs(argv))
+    except SceneError as err:
+        print(f"plan: error: {err}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("plan: interrupted", file=sys.stderr)
+        return 130
+
+
+def _run(inputs: Inputs) -> int:
+    scene, out, name, seed, limit = inputs.scene, inputs.out, inputs.planner, inputs.seed, inputs.time_limit
+    if inputs.given is not None:
+        result = inputs.given
     else:
-        if sys.stderr.isatty():  # a search can take seconds; scripts get just the one line of outcome
+        tty = sys.stderr.isatty()  # a search can take seconds; scripts get just the one line of outcome
+        if tty:
             print(f"planning {scene.name} with {name} (seed {seed}, limit {limit:g} s) ...", file=sys.stderr,
                   flush=True)
-        result = plan(scene, seed=seed, time_limit=limit, planner=name)
+        result = plan(scene, seed=seed, time_limit=limit, planner=name, progress=_progress if tty else None)
+        if tty:
+            print("\r\033[K", end="", file=sys.stderr, flush=True)  # clear the progress line
+        if result.note and result.solved:
+            print(f"plan: note: {result.note}", file=sys.stderr)
     # The planning seed also draws the random distributions, so a run is repeatable as a whole.
-    check = verify(scene, result, args.verify, seed) if args.verify and (result.solved or args.plan) else None
+    check = (verify(scene, result, inputs.verify, seed)
+             if inputs.verify and (result.solved or inputs.given is not None) else None)
     _write_outputs(out, scene, result, check)
-    if not result.solved and args.plan is None:
+    if not result.solved and inputs.given is None:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
         return 2
-    head = (f"loaded {args.plan}: {result.contents()}{'' if result.solved else ' (not solved)'}" if args.plan
+    head = (f"loaded {inputs.plan_path}: {result.contents()}{'' if result.solved else ' (not solved)'}"
+            if inputs.given is not None
             else f"solved: {result.contents()}, path length {result.path_length(scene.slider.cf):.3f} m, "
                  f"planning time {result.planning_time_s:.2f} s")
     print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd")
@@ -109,6 +172,11 @@ def _run(args: argparse.Namespace) -> int:
         return 0
     print("\n".join([*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]))
     return 0 if check.passed else 3
+
+
+def _progress(k: int, n: int) -> None:
+    """One line on the terminal, rewritten for each stable region computed."""
+    print(f"\rcomputing stable regions: edge {k} of {n}", end="", file=sys.stderr, flush=True)
 
 
 def _fresh_folder(base: Path) -> Path:

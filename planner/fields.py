@@ -1,26 +1,87 @@
 """Checked input fields: each check raises :class:`SceneError` naming the field at fault.
 
 Scene files and plan files share these, so both report bad input the same way: one line,
-``field: problem``, which the command line prints before exiting with code 1.
+``field: problem``, which the command line prints before exiting with code 1. Whatever the input
+holds, the line stays one line and short: values are quoted by :func:`shown` (plain numbers,
+control characters escaped, at most :data:`MAX_SHOWN` characters) and :class:`SceneError` escapes
+anything left that could break the line.
 """
 
 from __future__ import annotations
 
+import re
+import reprlib
 import sys
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-__all__ = ["SceneError", "integer", "keys", "number", "vector"]
+__all__ = ["MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "shown", "vector"]
+
+#: Most characters of a bad value a message quotes: enough to recognise it, never a flood.
+MAX_SHOWN = 100
+#: Longest field name and problem a message keeps (clipped beyond): a line of about 300 characters at most.
+_MAX_FIELD, _MAX_PROBLEM = 100, 196
+
+
+def _printable(text: str) -> str:
+    """``text`` with each non-printable character (newlines, tabs, NUL, U+2028...) as its escape."""
+    return text if text.isprintable() else "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def _clipped(text: str, size: int) -> str:
+    """``text``, or if it is longer than ``size`` characters its start and ``...``, ``size`` in all."""
+    return text if len(text) <= size else text[:size - 3] + "..."
 
 
 class SceneError(ValueError):
-    """Bad input, with the dotted name of the field at fault (``str()`` is ``"field: problem"``)."""
+    """Bad input, with the dotted name of the field at fault (``str()`` is ``"field: problem"``).
+
+    Both parts are escaped and clipped (the field to 100 characters, the problem to 196), so the
+    message is one short line whatever input they quote:
+
+    >>> str(SceneError("a\\nb", "unknown key"))
+    'a\\\\nb: unknown key'
+    """
 
     def __init__(self, field: str, problem: str):
-        super().__init__(f"{field}: {problem}")
-        self.field = field
-        self.problem = problem
+        self.field = _clipped(_printable(field), _MAX_FIELD)
+        self.problem = _clipped(_printable(problem), _MAX_PROBLEM)
+        super().__init__(f"{self.field}: {self.problem}")
+
+
+_REPR = reprlib.Repr()
+_REPR.maxstring = _REPR.maxother = MAX_SHOWN  # reprlib elides the middle of long strings and reprs
+_REPR.maxlist = _REPR.maxtuple = _REPR.maxdict = 8
+
+
+def shown(value: Any) -> str:
+    """``value`` as a message quotes it: its ``repr`` (so control characters are escaped), numpy
+    numbers as plain ones, long lists, strings and nestings elided, at most :data:`MAX_SHOWN` characters.
+
+    >>> shown(np.array([-0.1, 0.1])), shown("a\\tb"), shown([[0, 0]] * 50)
+    ('[-0.1, 0.1]', "'a\\\\tb'", '[[0, 0], [0, 0], [0, 0], [0, 0], [0, 0], [0, 0], [0, 0], [0, 0], ...]')
+    >>> len(shown("x" * 10**6)) <= MAX_SHOWN
+    True
+    """
+    if isinstance(value, (np.ndarray, np.generic)):
+        value = value.tolist()
+    return _clipped(_REPR.repr(value), MAX_SHOWN)
+
+
+#: A key that names itself plainly in a dotted field name; any other is quoted (:func:`shown`).
+_PLAIN_KEY = re.compile(r"[A-Za-z0-9_-]{1,40}")
+
+
+def member(name: str, key: Any) -> str:
+    """The dotted field name of ``key`` in the mapping ``name`` (the top level, ``scene``, adds no prefix).
+
+    >>> member("pusher", "mu"), member("scene", "colour"), member("slider", "a.b\\n")
+    ('pusher.mu', 'colour', "slider.'a.b\\\\n'")
+    """
+    text = key if isinstance(key, str) and _PLAIN_KEY.fullmatch(key) else shown(key)
+    return text if name == "scene" else f"{name}.{text}"
 
 
 def keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> dict:
@@ -29,32 +90,47 @@ def keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str, 
         raise SceneError(name, f"must be a mapping with keys {', '.join(required + optional)}")
     for key in value:
         if key not in required + optional:
-            raise SceneError(f"{name}.{key}" if name != "scene" else str(key), "unknown key")
+            raise SceneError(member(name, key), "unknown key")
     for key in required:
         if key not in value:
-            raise SceneError(f"{name}.{key}" if name != "scene" else key, "missing")
+            raise SceneError(member(name, key), "missing")
     return value
 
 
-def number(value: Any, name: str, positive: bool = False) -> float:
-    """``value`` as a finite float (> 0 if ``positive``)."""
+@dataclass(frozen=True)
+class Limit:
+    """The largest magnitude a kind of number may have (``bound``), in ``unit``."""
+
+    bound: float
+    unit: str
+
+    def check(self, value: float, name: str) -> float:
+        """``value``, if its magnitude is at most ``bound``; else a :class:`SceneError` naming ``name``."""
+        if abs(value) > self.bound:
+            raise SceneError(name, f"must be at most {self.bound:g} {self.unit} in absolute value, "
+                                   f"got {shown(float(value))}")
+        return value
+
+
+def number(value: Any, name: str, positive: bool = False, limit: Limit | None = None) -> float:
+    """``value`` as a finite float (> 0 if ``positive``; within ``limit`` if given)."""
     # Comparing (exactly, for ints) rather than math.isfinite(), which raises on ints beyond a float.
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not abs(value) <= sys.float_info.max:
-        raise SceneError(name, f"must be a finite number, got {value!r}")
+        raise SceneError(name, f"must be a finite number, got {shown(value)}")
     if positive and not value > 0:
-        raise SceneError(name, f"must be > 0, got {value!r}")
-    return float(value)
+        raise SceneError(name, f"must be > 0, got {shown(value)}")
+    return float(value if limit is None else limit.check(value, name))
 
 
 def integer(value: Any, name: str) -> int:
     """``value`` as an int (booleans are not integers here)."""
     if isinstance(value, bool) or not isinstance(value, int):
-        raise SceneError(name, f"must be an integer, got {value!r}")
+        raise SceneError(name, f"must be an integer, got {shown(value)}")
     return value
 
 
-def vector(value: Any, name: str, size: int) -> np.ndarray:
-    """``value`` as a list of ``size`` finite numbers."""
+def vector(value: Any, name: str, size: int, limit: Limit | None = None) -> np.ndarray:
+    """``value`` as a list of ``size`` finite numbers (each within ``limit`` if given)."""
     if not isinstance(value, (list, tuple)) or len(value) != size:
-        raise SceneError(name, f"must be a list of {size} numbers, got {value!r}")
-    return np.array([number(v, f"{name}[{i}]") for i, v in enumerate(value)])
+        raise SceneError(name, f"must be a list of {size} numbers, got {shown(value)}")
+    return np.array([number(v, f"{name}[{i}]", limit=limit) for i, v in enumerate(value)])

@@ -79,8 +79,7 @@ def draw_plan(scene: Scene, result: Plan, path: str, copies_per_metre: float = 4
     ax.plot(*np.array(cf_path).T, color="#e08a1e", lw=1.2)
     ax.set_xlim(xmin, xmax), ax.set_ylim(ymin, ymax)
     ax.set_aspect("equal")
-    switches = f", {result.switches} switch{'' if result.switches == 1 else 'es'}" if result.switches else ""
-    ax.set_title(f"{scene.name}: {result.pushes} stable pushes{switches}" if result.solved
+    ax.set_title(f"{scene.name}: {result.contents()}" if result.solved
                  else f"{scene.name}: not solved")
     fig.tight_layout()
     fig.savefig(path)

@@ -10,18 +10,20 @@ that no point of the slider or pusher moves faster than 1 m/s. With that scale, 
 
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import ExactRegion, StableRegion, StableSteering, point_velocity
+from mechanics import DeadlineExceeded, ExactRegion, StableRegion, StableSteering, point_velocity, stable_region
 
 from .bodies import body_outline
-from .regions import edge_region
+from .regions import edge_region, is_cached
 from .scene import Scene, SceneError
 
-__all__ = ["EdgePush", "clearance_margin", "edge_pushes", "resolution"]
+__all__ = ["EdgePush", "RegionTimeout", "clearance_margin", "edge_pushes", "resolution"]
 
 
 def resolution(scene: Scene) -> float:
@@ -54,21 +56,78 @@ class EdgePush:
         return v / self.speed(v)[..., None]
 
 
-def edge_pushes(scene: Scene) -> list[EdgePush]:
+class RegionTimeout(Exception):
+    """The deadline passed before every allowed edge's stable region was computed.
+
+    ``pushes`` holds the :class:`EdgePush` of each other edge that has stable pushes (what
+    :func:`edge_pushes` would return for those edges alone), ``pending`` the allowed edges not
+    computed. Finished regions are cached (:mod:`.regions`), so a later run goes further.
+    """
+
+    def __init__(self, pushes: list[EdgePush], pending: tuple[int, ...]):
+        self.pushes, self.pending = pushes, pending
+        named = ", ".join(map(str, pending[:4])) + (f", ... ({len(pending)} in all)" if len(pending) > 4 else "")
+        super().__init__(f"the stable regions of edge{'s' if len(pending) > 1 else ''} {named} were not computed "
+                         f"within the time limit ({len(pushes)} edge{'' if len(pushes) == 1 else 's'} with stable "
+                         "pushes ready)")
+
+
+def edge_pushes(scene: Scene, deadline: float | None = None,
+                progress: Callable[[int, int], None] | None = None) -> list[EdgePush]:
     """An :class:`EdgePush` for each allowed edge that has stable pushes.
+
+    Parameters
+    ----------
+    scene : Scene
+    deadline : float, optional
+        A :func:`time.perf_counter` time by which the regions must be done: edges are computed in
+        order, the one running at the deadline is abandoned and those not begun are skipped, but
+        cached ones are still read.
+    progress : callable, optional
+        ``progress(k, n)`` is called before computing the ``k``-th (from 1) of the ``n`` regions
+        that are not cached; regions read from the cache are not reported.
 
     Raises
     ------
     SceneError
-        If no allowed edge has any (the friction cone of the contact cannot push through the CF), or
-        if procedure STABLE is asked for with an uncertain CF.
+        If no allowed edge has any (the friction cone of the contact cannot push through the CF, or
+        not for every CF the scene's ``slider.cf_uncertainty`` allows), or if procedure STABLE is
+        asked for with an uncertain CF. An edge on which procedure STABLE finds no push has no
+        exact region to compute (Proposition 6), so such input fails at once.
+    RegionTimeout
+        If ``deadline`` passed first; it holds the pushes of the edges done.
     """
-    p = scene.pusher
-    out = []
+    p, slider = scene.pusher, scene.slider
+    method, rho = scene.planner.regions, scene.cf_uncertainty
+    todo = [e for e in p.edges if not is_cached(slider, e, p.mu, p.width, method, rho)]
+    out, pending = [], []
     for e in p.edges:
-        region = edge_region(scene.slider, e, p.mu, p.width, scene.planner.regions, scene.cf_uncertainty)
+        if e in todo:
+            if deadline is not None and time.perf_counter() > deadline:
+                pending.append(e)  # a cached edge after it still costs nothing
+                continue
+            if progress is not None:
+                progress(todo.index(e) + 1, len(todo))
+        try:
+            region = edge_region(slider, e, p.mu, p.width, method, rho, deadline)
+        except DeadlineExceeded:
+            pending.append(e)
+            continue
         if not region.is_empty:
-            out.append(EdgePush(e, region, StableSteering(region), body_outline(scene.slider, e, p.width, p.depth)))
+            out.append(EdgePush(e, region, StableSteering(region), body_outline(slider, e, p.width, p.depth)))
+    if pending:
+        raise RegionTimeout(out, tuple(pending))
     if not out:
-        raise SceneError("pusher.edges", "no allowed edge has a stable push (no contact force can pass through the cf)")
+        raise _no_stable_push(scene)
     return out
+
+
+def _no_stable_push(scene: Scene) -> SceneError:
+    """Why no allowed edge has a stable push: the CF's uncertainty, if the CF known exactly would
+    leave one (procedure STABLE's region, cheap and inside the exact one, has pushes), else the edges."""
+    p = scene.pusher
+    if scene.cf_uncertainty > 0 and any(not stable_region(scene.slider, e, p.mu, p.width).is_empty for e in p.edges):
+        return SceneError("slider.cf_uncertainty", f"is too large: no allowed edge has a push stable for every CF "
+                                                   f"within {scene.cf_uncertainty:g} m of the cf, though with the cf "
+                                                   "known exactly some have")
+    return SceneError("pusher.edges", "no allowed edge has a stable push (no contact force can pass through the cf)")

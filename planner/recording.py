@@ -66,7 +66,7 @@ above the text log.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import rerun as rr
@@ -79,11 +79,12 @@ from mechanics import (ContactConfiguration, Slider, SupportModel, contact_wrenc
 
 from .bodies import pusher_frame_body
 from .plan_file import Plan, Segment, Transit, atomic_path
-from .pushes import edge_pushes
 from .regions import edge_region
 from .scene import Scene
 from .transit import contact_pose, transit_pieces, transit_poses
-from .verify import Verification
+
+if TYPE_CHECKING:  # the simulator behind it imports most of scipy: not needed to draw a plan
+    from .verify import Verification
 
 __all__ = ["ANALYSIS_RAYS", "FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS", "write_recording"]
 
@@ -297,8 +298,11 @@ def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> tuple[np.n
     steps = [rr.TimeColumn("step", sequence=np.arange(len(times))), rr.TimeColumn("time", duration=times)]
     slider = scene.slider
     window = (*(slider.cf - 4 * slider.radius), *(slider.cf + 4 * slider.radius))
-    regions = {push.edge: {sense: _outline(poly) for sense, poly in push.region.cor_polygons(window).items()}
-               for push in edge_pushes(scene)}
+    # Only the pushed edges' regions: they are cached, the plan used them (others may not be done).
+    p = scene.pusher
+    regions = {e: {sense: _outline(poly) for sense, poly in edge_region(
+        slider, e, p.mu, p.width, scene.planner.regions, scene.cf_uncertainty).cor_polygons(window).items()}
+        for e in {s.edge for s in plan.segments if s.kind == "push"}}
     # Per frame: the COR and the regions' outlines, none or one each.
     cor: list[np.ndarray] = []
     stable: dict[int, list[np.ndarray]] = {1: [], -1: []}

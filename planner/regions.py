@@ -1,8 +1,8 @@
 """Each edge's stable region for planning, computed once per part.
 
 Procedure STABLE is a closed form; the exact region (:mod:`mechanics.exact_region`) costs about a
-second or two of certified linear programmes per edge. It depends only on the part, the edge, the
-friction and the pusher's width, so it is kept in memory for the process and on disk across runs:
+tenth of a second of certified linear programmes per edge. It depends only on the part, the edge,
+the friction and the pusher's width, so it is kept in memory for the process and on disk across runs:
 a JSON file per region under ``$STABLEPUSH_CACHE`` (default ``$XDG_CACHE_HOME/stablepush`` or
 ``~/.cache/stablepush``), named by a hash of everything it depends on, written atomically. A cache
 that cannot be read or written is ignored: the region is then computed again, never guessed.
@@ -23,10 +23,11 @@ from mechanics import ExactRegion, Slider, StableRegion, exact_region, stable_re
 from .fields import SceneError
 from .plan_file import write_atomic
 
-__all__ = ["cache_folder", "edge_region"]
+__all__ = ["cache_folder", "edge_region", "is_cached"]
 
 #: Bump when the exact region's construction changes, so old cache files are not used.
-_VERSION = 2
+#: 3: the support LPs by a batched simplex (its duals can differ where the LP is degenerate).
+_VERSION = 3
 
 _memory: dict[str, ExactRegion] = {}
 
@@ -45,6 +46,10 @@ def _key(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: f
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
 
 
+def _path(key: str) -> Path:
+    return cache_folder() / f"exact-{key}.json"
+
+
 def _read(path: Path, stable: StableRegion, cf_radius: float) -> ExactRegion | None:
     try:
         data = json.loads(path.read_text())
@@ -57,8 +62,18 @@ def _read(path: Path, stable: StableRegion, cf_radius: float) -> ExactRegion | N
     return ExactRegion(stable, polygon, centre, cf_radius)
 
 
-def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None,
-                method: str = "exact", cf_radius: float = 0.0) -> StableRegion | ExactRegion:
+def is_cached(slider: Slider, edge: int, mu: float, width: float | None = None, method: str = "exact",
+              cf_radius: float = 0.0) -> bool:
+    """Whether :func:`edge_region` would answer without computing an exact region (a file that
+    turns out unreadable is computed all the same)."""
+    if method == "stable" or stable_region(slider, edge, mu, width).is_empty:
+        return True
+    key = _key(slider, edge, mu, width, cf_radius)
+    return key in _memory or _path(key).is_file()
+
+
+def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None, method: str = "exact",
+                cf_radius: float = 0.0, deadline: float | None = None) -> StableRegion | ExactRegion:
     """The ``method`` (``'stable'`` or ``'exact'``) stable region of ``edge``, cached as above;
     ``cf_radius`` (exact only) makes it hold for every CF within that distance of the slider's.
 
@@ -66,6 +81,9 @@ def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None
     ------
     SceneError
         For ``method='stable'`` with ``cf_radius > 0``: procedure STABLE assumes a known CF.
+    mechanics.DeadlineExceeded
+        When an exact region must be computed and is not done by ``deadline`` (a
+        :func:`time.perf_counter` time); nothing is cached then.
     """
     if method == "stable" and cf_radius > 0:
         raise SceneError("planner.regions", "procedure STABLE assumes a known CF; slider.cf_uncertainty needs "
@@ -76,10 +94,10 @@ def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None
     key = _key(slider, edge, mu, width, cf_radius)
     if key in _memory:
         return _memory[key]
-    path = cache_folder() / f"exact-{key}.json"
+    path = _path(key)
     region = _read(path, stable, cf_radius)
     if region is None:
-        region = exact_region(slider, edge, mu, width, cf_radius=cf_radius)
+        region = exact_region(slider, edge, mu, width, cf_radius=cf_radius, deadline=deadline)
         polygon, centre = region.section()
         if isinstance(polygon, shapely.Polygon) and polygon.area > 0:  # a degenerate one is cheap: not stored
             try:

@@ -16,12 +16,13 @@ import numpy as np
 import shapely
 import yaml
 
-from mechanics import Slider
+from mechanics import Slider, wrap_angle
 
 from .bodies import slider_at
-from .fields import SceneError, integer, keys, number, vector
+from .fields import Limit, SceneError, integer, keys, member, number, shown, vector
 
-__all__ = ["DEFAULT_PLANNER", "DEFAULT_REGIONS", "DEFAULT_SWITCH_COST", "DEFAULT_TRANSIT", "REGIONS", "TRANSITS",
+__all__ = ["ANGLE", "LENGTH", "MAX_NODES", "MAX_SCENE_BYTES", "MIN_SIZE", "MU_RANGE",
+           "DEFAULT_PLANNER", "DEFAULT_REGIONS", "DEFAULT_SWITCH_COST", "DEFAULT_TRANSIT", "REGIONS", "TRANSITS",
            "check_switch_cost", "check_transit", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
            "check_regions", "check_seed", "check_time_limit", "load_scene", "parse_scene", "PLANNERS"]
 
@@ -47,6 +48,26 @@ MAX_SEED = 2**32 - 1
 MAX_TIME_LIMIT = 86400.0
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
 _MAX_NAME_BYTES = 200
+#: Every coordinate and length of a scene, in metres: a kilometre is far beyond any table, keeps
+#: squares and areas far from overflow, and is where the recording's 32-bit floats still resolve
+#: 0.1 mm (float64 resolves 1e-13 m there, so a MIN_SIZE feature anywhere is exact to 1e-7).
+LENGTH = Limit(1e3, "m")
+#: The pusher's width and depth and a box's sides, in metres (a micron): thinner is no body.
+MIN_SIZE = 1e-6
+#: Every angle of a scene, in degrees: 2777 turns, wrapped to within 1e-10 degrees. Beyond some
+#: 1e16 degrees a float has no digits left below a turn, so the heading it meant is lost.
+ANGLE = Limit(1e6, "degrees")
+#: Friction coefficients read: from all but frictionless to all but a wall (a cone of 89.94 degrees
+#: each side); far beyond them the cone's arithmetic underflows or overflows.
+MU_RANGE = (1e-3, 1e3)
+#: Largest scene file read: a scene is a few kilobytes; a megabyte holds parts of thousands of
+#: vertices and still parses in a few seconds.
+MAX_SCENE_BYTES = 1_000_000
+#: Most values (nodes) a scene file may hold, counting each alias as all of the node it names:
+#: a part of 30000 vertices, or a megabyte of plain numbers, and no more.
+MAX_NODES = 100_000
+#: Deepest nesting of lists and mappings read: a scene's own goes 5 deep (obstacles[0].box.center).
+_MAX_DEPTH = 16
 
 
 @dataclass(frozen=True)
@@ -104,31 +125,170 @@ def load_scene(path: str | Path) -> Scene:
 
 def _read_yaml(path: Path) -> Any:
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise SceneError("scene", f"cannot read {str(path)!r}: {err.strerror or err}") from None
-    except UnicodeDecodeError as err:
-        raise SceneError("scene", f"{str(path)!r} is not UTF-8 text (bad byte at offset {err.start})") from None
+        with path.open("rb") as f:
+            raw = f.read(MAX_SCENE_BYTES + 1)  # no more: a huge file or a device is refused unread
+    except (OSError, ValueError) as err:  # ValueError: a NUL in the path
+        raise SceneError("scene", f"cannot read {shown(str(path))}: {getattr(err, 'strerror', None) or err}") from None
+    if len(raw) > MAX_SCENE_BYTES:
+        raise SceneError("scene", f"{shown(str(path))} is larger than {MAX_SCENE_BYTES} bytes")
     try:
-        return yaml.load(text, Loader=_Loader)
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise SceneError("scene", f"{shown(str(path))} is not UTF-8 text (bad byte at offset {err.start})") from None
+    try:
+        return _parse_yaml(text)
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        where = f" at {_position(mark)}" if mark else ""
         problem = getattr(err, "problem", None) or " ".join(str(err).split())  # some messages span two lines
-        raise SceneError("scene", f"malformed YAML{where}: {problem}") from None
-    except RecursionError:
-        raise SceneError("scene", "malformed YAML: nested too deeply") from None
-    except ValueError as err:  # PyYAML lets Python's own limits through, e.g. on ints of over 4300 digits
-        raise SceneError("scene", f"malformed YAML: {err}") from None
+        kind = "unsupported" if isinstance(err, _Refused) else "malformed"
+        raise SceneError("scene", f"{kind} YAML{where}: {problem}") from None
 
 
-class _Loader(yaml.SafeLoader):
-    """PyYAML's safe loader that also reads ``1e-3`` as a number: YAML 1.1 wants a dot (``1.0e-3``)
-    and PyYAML would otherwise hand the scene the string ``"1e-3"``."""
+def _parse_yaml(text: str) -> Any:
+    """The document in ``text`` (YAML 1.2 core schema, :class:`_Loader`), once :func:`_check_events`
+    and :func:`_check_keys` have found nothing to refuse."""
+    _check_events(text)
+    loader = _Loader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:  # an empty file
+            return None
+        _check_keys(node, "scene")
+        return loader.construct_document(node)
+    finally:
+        loader.dispose()
 
 
-_Loader.add_implicit_resolver(
-    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*(?:\.[0-9_]*)?[eE][-+]?[0-9]+$"), list("-+0123456789"))
+class _Refused(yaml.MarkedYAMLError):
+    """Valid YAML that a scene may not use."""
+
+
+def _check_events(text: str) -> None:
+    """Refuse, before anything is built, a document that nests or expands beyond bounds.
+
+    An alias stands for all of the node it names, so a few hundred bytes of aliases of aliases
+    expand to gigabytes: each node's size is counted with its aliases expanded, and a document
+    may hold :data:`MAX_NODES` nodes and nest :data:`_MAX_DEPTH` deep (building it recurses).
+    """
+    done: dict[str, tuple[int, int]] = {}  # anchor -> (nodes, depth) of the node it names
+    stack: list[list] = []  # open lists and mappings: [anchor, nodes so far, depth of the deepest child]
+    # depth: how many lists and mappings a node nests, 0 for a scalar; it sits in len(stack) more.
+    for event in yaml.parse(text, Loader=_Loader):
+        if isinstance(event, yaml.CollectionStartEvent):
+            stack.append([event.anchor, 1, 0])
+            size, depth = 1, 0  # its depth is counted on the stack until it ends
+        elif isinstance(event, yaml.AliasEvent):
+            if event.anchor not in done:  # undefined, or inside the node it names: a loop
+                raise _Refused(problem=f"alias *{event.anchor} does not name a whole node before it",
+                               problem_mark=event.start_mark)
+            size, depth = done[event.anchor]
+        elif isinstance(event, yaml.CollectionEndEvent):
+            anchor, size, deepest = stack.pop()
+            depth = deepest + 1
+            if anchor is not None:
+                done[anchor] = size, depth
+        elif isinstance(event, yaml.ScalarEvent):
+            size, depth = 1, 0
+            if event.anchor is not None:
+                done[event.anchor] = size, depth
+        else:  # stream and document boundaries
+            continue
+        if depth + len(stack) > _MAX_DEPTH:
+            raise _Refused(problem=f"lists and mappings nest more than {_MAX_DEPTH} deep",
+                           problem_mark=event.start_mark)
+        if stack and not isinstance(event, yaml.CollectionStartEvent):
+            stack[-1][1] += size
+            stack[-1][2] = max(stack[-1][2], depth)
+            size = stack[-1][1]
+        if size > MAX_NODES:
+            raise _Refused(problem=f"more than {MAX_NODES} values, counting what aliases stand for",
+                           problem_mark=event.start_mark)
+
+
+def _check_keys(node: yaml.Node, name: str) -> None:
+    """Refuse a key given twice in any mapping under ``node`` (named ``name``): PyYAML would keep the
+    last one silently, and an edit that added a second ``mu:`` would seem to do nothing."""
+    if isinstance(node, yaml.SequenceNode):
+        for i, item in enumerate(node.value):
+            _check_keys(item, f"{name}[{i}]")
+    elif isinstance(node, yaml.MappingNode):
+        first: dict[tuple[str, str], yaml.Mark] = {}
+        for key, value in node.value:
+            if not isinstance(key, yaml.ScalarNode):  # a list or mapping as a key: refused when built
+                continue
+            field = member(name, key.value)
+            if (key.tag, key.value) in first:
+                raise SceneError(field, f"duplicate key (at {_position(first[key.tag, key.value])} "
+                                        f"and {_position(key.start_mark)})")
+            first[key.tag, key.value] = key.start_mark
+            _check_keys(value, field)
+
+
+def _position(mark: yaml.Mark) -> str:
+    return f"line {mark.line + 1}, column {mark.column + 1}"
+
+
+class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # libyaml's parser, when PyYAML has it: 6 times faster
+    """PyYAML's safe loader reading YAML 1.2's core schema, not YAML 1.1's.
+
+    So ``1e-3`` is a number (YAML 1.1 wants ``1.0e-3``), ``017`` is 17 (not octal 15; octal is
+    ``0o17``), and ``1:30`` (not 90), ``yes``, ``on`` and ``2001-12-14`` are strings; merge keys
+    (``<<``) are plain keys and only the core tags (``!!str``, ``!!int``, ``!!float``, ``!!bool``,
+    ``!!null``, ``!!seq``, ``!!map``) are known.
+    """
+
+    yaml_implicit_resolvers: dict = {}
+    yaml_constructors: dict = {}
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict:
+        return yaml.constructor.BaseConstructor.construct_mapping(self, node, deep)  # without 1.1's merge keys
+
+
+# YAML 1.2 core schema (§10.3.2); ints before floats, which also match "1".
+_NULL = re.compile(r"(?:~|null|Null|NULL|)\Z")
+_BOOL = re.compile(r"(?:true|True|TRUE|false|False|FALSE)\Z")
+_INT = re.compile(r"(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)\Z")
+_FLOAT = re.compile(r"(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+                    r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))\Z")
+for _tag, _pattern, _first in (("null", _NULL, ["~", "n", "N", ""]), ("bool", _BOOL, list("tTfF")),
+                               ("int", _INT, list("-+0123456789")), ("float", _FLOAT, list("-+.0123456789"))):
+    _Loader.add_implicit_resolver(f"tag:yaml.org,2002:{_tag}", _pattern, _first)
+
+
+def _scalar(loader: _Loader, node: yaml.ScalarNode, pattern: re.Pattern, kind: str) -> str:
+    """The text of ``node``, which its tag says is a ``kind``: it must read as one by YAML 1.2."""
+    text = loader.construct_scalar(node)
+    if not pattern.match(text):
+        raise yaml.constructor.ConstructorError(problem=f"{shown(text)} is not a YAML 1.2 {kind}",
+                                                problem_mark=node.start_mark)
+    return text
+
+
+def _construct_bool(loader: _Loader, node: yaml.ScalarNode) -> bool:
+    return _scalar(loader, node, _BOOL, "boolean").lower() == "true"
+
+
+def _construct_int(loader: _Loader, node: yaml.ScalarNode) -> int:
+    text = _scalar(loader, node, _INT, "integer")
+    try:
+        return int(text[2:], 8 if text[1] == "o" else 16) if text[:2] in ("0o", "0x") else int(text)
+    except ValueError:  # Python reads at most 4300 digits (sys.get_int_max_str_digits)
+        raise yaml.constructor.ConstructorError(problem=f"an integer of {len(text)} digits is too long",
+                                                problem_mark=node.start_mark) from None
+
+
+def _construct_float(loader: _Loader, node: yaml.ScalarNode) -> float:
+    text = _scalar(loader, node, _FLOAT, "number").lower()
+    return float(text.replace(".inf", "inf").replace(".nan", "nan"))
+
+
+for _tag, _constructor in (("null", yaml.SafeLoader.construct_yaml_null), ("bool", _construct_bool),
+                           ("int", _construct_int), ("float", _construct_float),
+                           ("str", yaml.SafeLoader.construct_yaml_str), ("seq", yaml.SafeLoader.construct_yaml_seq),
+                           ("map", yaml.SafeLoader.construct_yaml_map)):
+    _Loader.add_constructor(f"tag:yaml.org,2002:{_tag}", _constructor)
+_Loader.add_constructor(None, yaml.SafeLoader.construct_undefined)  # any other tag is an error
 
 
 def _points(value: Any, name: str) -> np.ndarray:
@@ -136,7 +296,7 @@ def _points(value: Any, name: str) -> np.ndarray:
         raise SceneError(name, "must be a list of [x, y] points")
     if len(value) < 3:
         raise SceneError(name, f"needs at least 3 vertices, got {len(value)}")
-    return np.array([vector(p, f"{name}[{i}]", 2) for i, p in enumerate(value)])
+    return np.array([vector(p, f"{name}[{i}]", 2, LENGTH) for i, p in enumerate(value)])
 
 
 def _polygon(value: Any, name: str) -> shapely.Polygon:
@@ -145,8 +305,11 @@ def _polygon(value: Any, name: str) -> shapely.Polygon:
 
 def _simple_polygon(pts: np.ndarray, name: str) -> shapely.Polygon:
     # Area first: the ring of collinear points doubles back on itself, and "self-intersecting"
-    # would send the reader looking for a crossing. The threshold is the one Slider uses.
-    if shapely.MultiPoint(pts).convex_hull.area <= 1e-12 * max(1.0, float(np.ptp(pts)) ** 2):
+    # would send the reader looking for a crossing. The threshold is the one Slider uses,
+    # area <= 1e-12 * max(1, extent) ** 2, compared by square roots so that no square overflows.
+    with np.errstate(over="ignore"):  # an extent beyond a float is inf, and no zero area
+        extent = float(np.ptp(pts))
+    if math.sqrt(shapely.MultiPoint(pts).convex_hull.area) <= 1e-6 * max(1.0, extent):
         raise SceneError(name, "polygon has zero area (its vertices are collinear or too close together)")
     if not shapely.LinearRing(pts).is_simple:
         raise SceneError(name, "polygon is self-intersecting")
@@ -159,11 +322,12 @@ def _obstacle(value: Any, name: str) -> shapely.Polygon:
     if "polygon" in value:
         return _polygon(value["polygon"], f"{name}.polygon")
     box = keys(value["box"], f"{name}.box", ("center", "size"), ("angle",))
-    cx, cy = vector(box["center"], f"{name}.box.center", 2)
-    w, h = vector(box["size"], f"{name}.box.size", 2)
+    cx, cy = vector(box["center"], f"{name}.box.center", 2, LENGTH)
+    w, h = vector(box["size"], f"{name}.box.size", 2, LENGTH)
     if not (w > 0 and h > 0):
-        raise SceneError(f"{name}.box.size", f"must be positive, got {[w, h]}")
-    angle = math.radians(number(box.get("angle", 0.0), f"{name}.box.angle"))
+        raise SceneError(f"{name}.box.size", f"must be positive, got {shown(box['size'])}")
+    _at_least_min_size(min(w, h), f"{name}.box.size", box["size"])
+    angle = math.radians(number(box.get("angle", 0.0), f"{name}.box.angle", limit=ANGLE))
     corners = np.array([[-w, -h], [w, -h], [w, h], [-w, h]]) / 2
     rot = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
     return shapely.Polygon(corners @ rot.T + [cx, cy])
@@ -174,18 +338,23 @@ def _slider(value: Any) -> Slider:
     vertices = _points(spec["vertices"], "slider.vertices")
     _simple_polygon(vertices, "slider.vertices")
     # A repeated vertex makes an edge of no length, with no normal to push along; shapely accepts it.
-    repeated = np.flatnonzero(np.all(vertices == np.roll(vertices, -1, axis=0), axis=1))
+    # Nearly repeated is as bad: the edge's direction is rounding noise, or its square underflows to 0.
+    repeated = np.flatnonzero(np.hypot(*(vertices - np.roll(vertices, -1, axis=0)).T) < MIN_SIZE)
     if len(repeated):
         k = int(repeated[0])
-        raise SceneError("slider.vertices", f"vertices {k} and {(k + 1) % len(vertices)} coincide, so edge {k} "
-                                            "has no length (do not repeat the first vertex at the end)")
+        raise SceneError("slider.vertices", f"vertices {k} and {(k + 1) % len(vertices)} coincide (closer than "
+                                            f"{MIN_SIZE:g} m), so edge {k} has no length (do not repeat the first "
+                                            "vertex at the end)")
     try:
-        Slider(vertices)
+        part = Slider(vertices)
     except ValueError as err:
         raise SceneError("slider.vertices", str(err)) from None
+    if not part.pushable_edges:  # a star: otherwise each edge would be refused later, as unstable
+        raise SceneError("slider.vertices", "no edge lies on the part's convex hull, so a flat pusher cannot push "
+                                            "any (each edge has a vertex beyond its line)")
     if "cf" not in spec:
-        return Slider(vertices)
-    cf = vector(spec["cf"], "slider.cf", 2)  # outside the try: a SceneError is a ValueError too
+        return part
+    cf = vector(spec["cf"], "slider.cf", 2, LENGTH)  # outside the try: a SceneError is a ValueError too
     try:
         return Slider(vertices, cf)
     except ValueError as err:
@@ -194,8 +363,8 @@ def _slider(value: Any) -> Slider:
 
 def _pusher(value: Any, slider: Slider) -> Pusher:
     spec = keys(value, "pusher", ("width", "depth", "mu"), ("edges", "transit"))
-    width = number(spec["width"], "pusher.width", positive=True)
-    depth = number(spec["depth"], "pusher.depth", positive=True)
+    width, depth = (_at_least_min_size(number(spec[key], f"pusher.{key}", positive=True, limit=LENGTH),
+                                       f"pusher.{key}", spec[key]) for key in ("width", "depth"))
     mu, mu_high = _friction(spec["mu"])
     transit = check_transit(spec.get("transit", DEFAULT_TRANSIT), "pusher.transit")
     if "edges" not in spec:
@@ -217,18 +386,35 @@ def _pusher(value: Any, slider: Slider) -> Pusher:
 
 
 def _friction(value: Any) -> tuple[float, float | None]:
-    """``pusher.mu``: a number > 0, or an interval ``[low, high]`` with ``0 < low <= high``."""
-    if not isinstance(value, (list, tuple)):
-        return number(value, "pusher.mu", positive=True), None
-    low, high = vector(value, "pusher.mu", 2)
-    if not 0 < low <= high:
-        raise SceneError("pusher.mu", f"an interval must be [low, high] with 0 < low <= high, got {list(value)}")
-    return float(low), float(high)
+    """``pusher.mu``: a number in :data:`MU_RANGE`, or an interval ``[low, high]`` in it, ``low <= high``."""
+    interval = isinstance(value, (list, tuple))
+    if interval:
+        low, high = vector(value, "pusher.mu", 2)
+        if not 0 < low <= high:
+            raise SceneError("pusher.mu", f"an interval must be [low, high] with 0 < low <= high, got {shown(value)}")
+    else:
+        low = high = number(value, "pusher.mu", positive=True)
+    if not (MU_RANGE[0] <= low and high <= MU_RANGE[1]):
+        raise SceneError("pusher.mu", f"must be from {MU_RANGE[0]:g} to {MU_RANGE[1]:g}, got {shown(value)}")
+    return float(low), float(high) if interval else None
 
 
-def _pose(value: Any, name: str, slider: Slider, obstacles, workspace) -> np.ndarray:
+def _at_least_min_size(size: float, name: str, given: Any) -> float:
+    """``size``, the least dimension of a body, if it is at least :data:`MIN_SIZE` (``given`` is
+    the field's value, for the message)."""
+    if size < MIN_SIZE:
+        raise SceneError(name, f"must be at least {MIN_SIZE:g} m, got {shown(given)}")
+    return size
+
+
+def _pose(value: Any, name: str, slider: Slider, obstacles: tuple[shapely.Polygon, ...],
+          workspace: tuple[float, float, float, float]) -> np.ndarray:
+    """A pose ``[x, y, degrees]`` as ``(x, y, radians)`` with the angle in ``[-pi, pi)``, as the
+    plan's segments have theirs; the part there must be in the workspace and clear of obstacles."""
     x, y, theta = vector(value, name, 3)
-    pose = np.array([x, y, math.radians(theta)])
+    LENGTH.check(x, f"{name}[0]")
+    LENGTH.check(y, f"{name}[1]")
+    pose = np.array([x, y, float(wrap_angle(math.radians(ANGLE.check(theta, f"{name}[2]"))))])
     body = slider_at(slider.polygon, pose)
     if not shapely.box(*workspace).contains(body):
         raise SceneError(name, "the part is not inside the workspace")
@@ -251,20 +437,20 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
         raise SceneError("obstacles", "must be a list")
     obstacles = tuple(_obstacle(o, f"obstacles[{k}]") for k, o in enumerate(obstacles_spec))
     ws = keys(spec["workspace"], "workspace", ("min", "max"))
-    lo, hi = vector(ws["min"], "workspace.min", 2), vector(ws["max"], "workspace.max", 2)
+    lo, hi = vector(ws["min"], "workspace.min", 2, LENGTH), vector(ws["max"], "workspace.max", 2, LENGTH)
     if not np.all(hi > lo):
         raise SceneError("workspace", f"is empty or inverted: max {hi.tolist()} must exceed min {lo.tolist()}")
     workspace = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
     start = _pose(spec["start"], "start", slider, obstacles, workspace)
     goal = _pose(spec["goal"], "goal", slider, obstacles, workspace)
     tol = keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
-    tol_pos = number(tol.get("position", 0.01), "tolerance.position", positive=True)
-    tol_ang = math.radians(number(tol.get("angle", 2.0), "tolerance.angle", positive=True))
+    tol_pos = number(tol.get("position", 0.01), "tolerance.position", positive=True, limit=LENGTH)
+    tol_ang = math.radians(number(tol.get("angle", 2.0), "tolerance.angle", positive=True, limit=ANGLE))
     opts = keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed", "regions", "switch_cost"))
     planner = PlannerOptions(
         name=_one_of(opts.get("name", DEFAULT_PLANNER), PLANNERS, "planner.name"),
-        time_limit=check_time_limit(opts.get("time_limit", 10.0), "planner.time_limit"),
-        seed=check_seed(opts.get("seed", 1), "planner.seed"),
+        time_limit=check_time_limit(opts.get("time_limit", PlannerOptions.time_limit), "planner.time_limit"),
+        seed=check_seed(opts.get("seed", PlannerOptions.seed), "planner.seed"),
         regions=check_regions(opts.get("regions", DEFAULT_REGIONS), "planner.regions"),
         switch_cost=check_switch_cost(opts.get("switch_cost", DEFAULT_SWITCH_COST), "planner.switch_cost"),
     )
@@ -278,14 +464,14 @@ def _cf_uncertainty(spec: dict, slider: Slider) -> float:
     radius = number(spec.get("cf_uncertainty", 0.0), "slider.cf_uncertainty")
     if not 0 <= radius < slider.radius:
         raise SceneError("slider.cf_uncertainty", f"must be >= 0 and less than the part's radius "
-                                                  f"{slider.radius:.4g}, got {radius!r}")
+                                                  f"{slider.radius:.4g}, got {shown(radius)}")
     return radius
 
 
 def _name(value: Any) -> str:
     # The name names the output files, so it must make a plain file name.
     if not isinstance(value, str) or not value or not value.isprintable() or any(c in value for c in "/\\"):
-        raise SceneError("name", f"must be a plain non-empty string, got {value!r}")
+        raise SceneError("name", f"must be a plain non-empty string, got {shown(value)}")
     if len(value.encode()) > _MAX_NAME_BYTES:
         raise SceneError("name", f"must be at most {_MAX_NAME_BYTES} bytes long, got {len(value.encode())}")
     return value
@@ -293,7 +479,7 @@ def _name(value: Any) -> str:
 
 def _one_of(value: Any, choices: tuple[str, ...], name: str) -> str:
     if value not in choices:
-        raise SceneError(name, f"must be one of {', '.join(choices)}, got {value!r}")
+        raise SceneError(name, f"must be one of {', '.join(choices)}, got {shown(value)}")
     return value
 
 
@@ -317,9 +503,9 @@ def check_switch_cost(value: Any, name: str) -> float:
     ...
     planner.fields.SceneError: planner.switch_cost: must be >= 0, got -0.1
     """
-    cost = number(value, name)
+    cost = number(value, name, limit=LENGTH)
     if cost < 0:
-        raise SceneError(name, f"must be >= 0, got {value!r}")
+        raise SceneError(name, f"must be >= 0, got {shown(value)}")
     return cost
 
 
@@ -335,5 +521,5 @@ def check_time_limit(value: Any, name: str) -> float:
     """``value`` as a planning time limit in seconds; else a :class:`SceneError` naming ``name``."""
     limit = number(value, name, positive=True)
     if limit > MAX_TIME_LIMIT:
-        raise SceneError(name, f"must be at most {MAX_TIME_LIMIT:g} s, got {value!r}")
+        raise SceneError(name, f"must be at most {MAX_TIME_LIMIT:g} s, got {shown(value)}")
     return limit

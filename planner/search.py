@@ -42,7 +42,7 @@ from mechanics import exp_twist, wrap_angle
 from .one_step import connect
 from .plan_file import Plan, Segment, Transit
 from .preimage import GoalPreimage
-from .pushes import EdgePush, clearance_margin, edge_pushes, resolution
+from .pushes import EdgePush, RegionTimeout, clearance_margin, edge_pushes, resolution
 from .scene import Scene, SceneError, check_regions, check_switch_cost, check_transit
 from .transit import TransitPlanner
 from .validity import CollisionModel
@@ -143,13 +143,19 @@ class _PushGoal(ob.GoalSampleableRegion):
 
 
 def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
-         regions: str | None = None, transit: str | None = None, switch_cost: float | None = None) -> Plan:
+         regions: str | None = None, transit: str | None = None, switch_cost: float | None = None,
+         progress: Callable[[int, int], None] | None = None) -> Plan:
     """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``.
 
     Arguments left as ``None`` take the scene's options: ``regions`` is ``'stable'`` (procedure
     STABLE) or ``'exact'`` (the exact region, the default); ``transit`` is ``'plane'``, ``'lift'``
     or ``'none'`` (``pusher.transit``); ``switch_cost`` is in metres (``planner.switch_cost``). With a
     given seed, a run that solves within the time limit returns the same plan every time.
+
+    The time limit bounds the edges' stable regions (computed once per part and cached; they may
+    take half of it: a part with many edges plans with those done in time, and says so in
+    ``Plan.note``, or ends unsolved if none is) and the search together; ``progress(k, n)`` hears of the ``k``-th of the ``n``
+    regions that must be computed.
 
     Raises
     ------
@@ -168,35 +174,43 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     name = opts.name if planner is None else planner
     if name not in _PLANNERS:
         raise SceneError("planner", f"must be one of {', '.join(_PLANNERS)}, got {name!r}")
-    pushes = edge_pushes(scene)  # per part, and cached (planner.regions): not part of the search's time
     clock = time.perf_counter()
-    model = CollisionModel(scene, [p.edge for p in pushes])
+    deadline = clock + float(time_limit)  # for the regions and the search alike
     step, margin = resolution(scene), clearance_margin(scene)
     result = Plan(scene.path, False, name, seed, 0.0, scene.start.copy(), scene.goal.copy())
 
     def done(segments: list, reason: str = "", tree=None) -> Plan:
         result.solved = not reason
         result.segments = segments
-        result.reason = reason
+        result.reason = f"{reason}; {result.note}" if reason and result.note else reason
         if tree is not None:
             result.tree = tree
         result.planning_time_s = time.perf_counter() - clock
         return result
 
+    # Found before any region is computed: the pusher has no room at the start on any edge.
+    model = CollisionModel(scene, scene.pusher.edges)
+    if not any(model.clearance(scene.start, e) > step / 2 for e in scene.pusher.edges):
+        raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
+    try:  # regions are cached per part (planner.regions); they may take half the time, not all
+        pushes = edge_pushes(scene, clock + float(time_limit) / 2, progress)
+    except RegionTimeout as timeout:
+        if not timeout.pushes:
+            return done([], str(timeout))
+        pushes, result.note = timeout.pushes, str(timeout)
     starts = [k for k, p in enumerate(pushes) if model.clearance(scene.start, p.edge) > step / 2]
     if not starts:
-        raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
+        raise SceneError("start", "the pusher has room only on edges with no stable push")
     if _within_tolerance(scene, scene.start):
         return done([])
     preimage = GoalPreimage(scene.goal, pushes, model, margin, scene.slider.radius)
     switching = scene.pusher.transit != "none" and len(pushes) > 1
     transits = TransitPlanner(scene, [p.edge for p in pushes], model, margin) if switching else None
     shortcut = _Shortcut(pushes, model, margin, transits)
-    for k in starts:  # one or two pushes may do, as in the paper's one-step planning
-        direct = preimage.connect(scene.start, k)
-        if direct is not None:
-            return done(shortcut(direct))
-    deadline = clock + float(time_limit)
+    # One or two pushes may do, as in the paper's one-step planning: the cheapest over the edges.
+    direct = [found for k in starts if (found := preimage.connect(scene.start, k)) is not None]
+    if direct:
+        return done(min((shortcut(d) for d in direct), key=lambda d: _cost(scene, d)))
     search = _Search(scene, pushes, model, preimage, name, seed, step)
     segments, tree, iterations = search.run(starts, deadline, transits)
     if segments is None:

@@ -3,6 +3,7 @@ import os
 import sys
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 
 def _silence_nanobind_leak_report() -> None:
@@ -29,3 +30,13 @@ def region_cache(request, tmp_path_factory):
         os.environ.pop("STABLEPUSH_CACHE")
     else:
         os.environ["STABLEPUSH_CACHE"] = old
+
+
+# Hypothesis (tests/test_fuzz_scenes.py): CI runs a fixed, derandomised budget that keeps the fuzz
+# tests within about half a minute on two cores; `--hypothesis-profile long` runs 10,000 examples a
+# test with fresh randomness (its example database, in .hypothesis/, which Hypothesis git-ignores
+# itself, replays a failure first on the next run). Examples touch files, so no deadline.
+_FUZZ = dict(deadline=None, print_blob=True, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+settings.register_profile("ci", max_examples=800, derandomize=True, **_FUZZ)
+settings.register_profile("long", max_examples=10_000, **_FUZZ)
+settings.load_profile("ci")  # the plugin's --hypothesis-profile, read later, overrides it

@@ -504,3 +504,17 @@ def test_time_limit_flag_overrides_the_scenes(tmp_path, monkeypatch, capsys):
     assert "0.5 s" in capsys.readouterr().err
     data = plan_json(tmp_path / "out" / "walled.json")
     assert data["planner"] == "rrt" and data["planning_time_s"] < 2.0
+
+
+# --- help ------------------------------------------------------------------------------------------
+
+def test_help_lists_exit_codes_defaults_and_the_region_cache(region_cache, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["--help"])
+    assert exit_.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())  # argparse wraps lines at the terminal's width
+    assert re.search(r"exit codes: 0 solved .* 1 bad input.* 2 not solved.* 3 .*slips.* 130 interrupted", text), text
+    for default in ["--planner rrt", "--time-limit 10", "--seed 1", "--regions exact", "--transit plane"]:
+        assert default in text
+    assert "$STABLEPUSH_CACHE" in text and "~/.cache/stablepush" in text
+    assert f"(here: {region_cache})" in text  # where this run's regions are

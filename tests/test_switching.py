@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from planner import SceneError, load_scene, plan
@@ -66,3 +67,15 @@ def test_bad_options_name_themselves(option, value):
     with pytest.raises(SceneError) as err:
         plan(load_scene(SCENES / "battery.yaml"), **{option: value})
     assert err.value.field == option
+
+
+def test_the_cheapest_direct_connection_wins():
+    # The CF 0.3 m straight behind, on an empty table: edge 0 finds a two-push way round through a
+    # waypoint, but edge 1 (the right face, pushing -x) does it in one straight push of 0.3 m.
+    scene = load_scene(SCENES / "parking.yaml")
+    start = np.array([0.0, 0.0, 0.0])
+    open_table = replace(scene, obstacles=(), workspace=(-2.0, -2.0, 2.0, 2.0), start=start,
+                         goal=start + [-0.3, 0.0, 0.0])
+    result = plan(open_table, seed=1)
+    assert result.solved and result.pushes == 1 and result.segments[0].edge == 1
+    assert result.path_length(scene.slider.cf) == pytest.approx(0.3, abs=1e-9)

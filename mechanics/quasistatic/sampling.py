@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike
-from scipy.optimize import linprog
+import scipy  # scipy.optimize is loaded on first use (0.3 s): planning without --verify never needs it
 
 from .support import SupportDistribution
 
@@ -116,7 +116,7 @@ def _centred(points: np.ndarray, weights: np.ndarray, cf: ArrayLike | None) -> S
     eye = np.eye(n)
     a_eq = np.hstack([np.vstack([np.ones(n), points.T]), np.zeros((3, n))])
     a_ub = np.block([[eye, -eye], [-eye, -eye]])
-    result = linprog(np.r_[np.zeros(n), np.ones(n)], A_ub=a_ub, b_ub=np.r_[w, -w], A_eq=a_eq,
+    result = scipy.optimize.linprog(np.r_[np.zeros(n), np.ones(n)], A_ub=a_ub, b_ub=np.r_[w, -w], A_eq=a_eq,
                      b_eq=np.r_[1.0, c], bounds=(0, None), method="highs")
     if result.status != 0:
         raise ValueError(f"cf {c.tolist()} is not inside the convex hull of the support points")

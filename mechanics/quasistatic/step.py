@@ -66,8 +66,7 @@ from itertools import product
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.linalg import null_space
-from scipy.optimize import brentq, linprog, nnls
+import scipy  # its linalg and optimize are imported where used: they take 0.3 s, and planning needs neither
 
 from .contact import Contact, ContactMode
 from ..wrenches import point_wrench
@@ -223,7 +222,7 @@ class _Problem:
                     rows.append(self.normal_rows[j])
                 if m is ContactMode.STICK:
                     rows.append(self.tangent_rows[j])
-            self._families[key] = null_space(np.array(rows).reshape(-1, 3), rcond=TOL)
+            self._families[key] = scipy.linalg.null_space(np.array(rows).reshape(-1, 3), rcond=TOL)
         return self._families[key]
 
     def _solve_mode(self, mode: Mode) -> list[np.ndarray]:
@@ -261,7 +260,7 @@ class _Problem:
         """Is some load of local ``twist`` a non-negative combination of ``generators``?"""
         load, at_rest = self.support.local_load(twist)
         if not at_rest.any():
-            return nnls(generators, load)[1] <= TOL
+            return scipy.optimize.nnls(generators, load)[1] <= TOL
         # COR on support point(s): each adds any force of norm <= w_k through it (inscribed polygon).
         angles = 2 * np.pi * np.arange(_FACET_SIDES) / _FACET_SIDES
         circle = np.stack([np.cos(angles), np.sin(angles)], axis=1)
@@ -272,7 +271,7 @@ class _Problem:
         a_ub = np.zeros((n_f, a_eq.shape[1]))
         for i in range(n_f):
             a_ub[i, k + i * _FACET_SIDES: k + (i + 1) * _FACET_SIDES] = 1.0  # convex combination
-        result = linprog(np.zeros(a_eq.shape[1]), A_ub=a_ub, b_ub=np.ones(n_f), A_eq=a_eq, b_eq=load,
+        result = scipy.optimize.linprog(np.zeros(a_eq.shape[1]), A_ub=a_ub, b_ub=np.ones(n_f), A_eq=a_eq, b_eq=load,
                          bounds=(0, None), method="highs")
         return result.status == 0
 
@@ -296,7 +295,7 @@ class _Problem:
             a, b = line.phis[i], line.phis[i + 1]
             ha, hb = side(a), side(b)
             # The scan's loads are batched, so a root on a grid point may have lost its sign here.
-            phi = brentq(side, a, b, xtol=1e-14) if ha * hb < 0 else (a if abs(ha) <= abs(hb) else b)
+            phi = scipy.optimize.brentq(side, a, b, xtol=1e-14) if ha * hb < 0 else (a if abs(ha) <= abs(hb) else b)
             if np.cos(phi) <= TOL:
                 continue  # the twist would be infinite
             twist = line.twist(phi)

@@ -1,0 +1,155 @@
+"""An edge's stable pushes as a Dubins car: a heading and a turning radius for the centre of friction.
+
+Lynch & Mason (1996, §4) note that pushing on one edge is a forward-only car and that shortest
+paths were known only for cars (Dubins forward-only, Reeds-Shepp with reverse). This module picks,
+for one edge, a car whose every motion is a guaranteed-stable push, so a shortest Dubins path is
+a shortest path among those pushes:
+
+* a *heading* ``h``: a unit direction in the slider frame along which the centre of friction (CF)
+  moves when the car goes straight (a stable translation);
+* a *curvature* ``kappa_max = 1 / R``: every motion with the CF moving along ``h`` at unit speed
+  while the part turns at ``kappa`` in ``[-kappa_max, kappa_max]`` is stable; the Dubins car uses
+  ``-kappa_max`` (right), ``0`` (straight) and ``+kappa_max`` (left), rotations about the points
+  ``R`` to either side of the CF.
+
+Why it is sound for any region. Those twists are ``V(kappa) = (h + kappa k x (O - cf), kappa)``,
+affine in ``kappa``, so they form a straight segment of twists, and the push plane maps straight
+segments to straight segments (:mod:`mechanics.push_plane`). The segment is accepted only if the
+region's section, shrunk by a margin, *covers* it (shapely, exact for the polygon): convex or not,
+every curvature in between, and hence every larger radius, is stable. ``kappa_max`` is the largest
+such curvature (bisection), for the heading among the stable translations that allows the
+tightest turns.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike
+
+from mechanics import wrap_angle
+
+from .pushes import EdgePush
+
+__all__ = ["EdgeCar", "edge_car"]
+
+#: Headings tried across the edge's stable translations.
+_HEADINGS = 61
+#: Margin inside the region's section (push-plane units) that the segment of twists must keep.
+_MARGIN = 1e-3
+
+
+@dataclass(frozen=True)
+class EdgeCar:
+    """The Dubins car of one edge's pushes (module docstring).
+
+    Attributes
+    ----------
+    push : EdgePush
+        The edge, its region and its body.
+    cf : (2,) ndarray
+        The centre of friction, slider frame: the car's reference point.
+    heading : (2,) ndarray
+        Unit direction of the CF's motion when going straight, slider frame.
+    radius : float
+        The least turning radius of the CF, ``1 / kappa_max``.
+    """
+
+    push: EdgePush
+    cf: np.ndarray
+    heading: np.ndarray
+    radius: float
+
+    @property
+    def heading_angle(self) -> float:
+        """Angle of :attr:`heading` in the slider frame."""
+        return math.atan2(self.heading[1], self.heading[0])
+
+    def twist(self, kappa: ArrayLike) -> np.ndarray:
+        """Slider-frame twists with the CF moving along the heading at unit speed, turning at ``kappa``.
+
+        >>> car = EdgeCar(None, np.array([0.0, 1.0]), np.array([1.0, 0.0]), 0.5)
+        >>> car.twist([0.0, 2.0]).tolist()   # straight; left about the point 0.5 to the CF's left
+        [[1.0, 0.0, 0.0], [3.0, 0.0, 2.0]]
+        """
+        k = np.asarray(kappa, dtype=float)[..., None]
+        h, c = self.heading, self.cf
+        return np.concatenate([h + k * np.array([c[1], -c[0]]), k], axis=-1)
+
+    def state(self, pose: ArrayLike) -> np.ndarray:
+        """The car's state ``(x, y, psi)`` (CF position, heading) for a slider pose.
+
+        >>> car = EdgeCar(None, np.array([0.1, 0.0]), np.array([0.0, 1.0]), 0.5)
+        >>> car.state([1.0, 0.0, 0.0]).round(12).tolist()
+        [1.1, 0.0, 1.570796326795]
+        >>> car.pose(car.state([1.0, 2.0, 3.0])).round(12).tolist()
+        [1.0, 2.0, 3.0]
+        """
+        x, y, th = (float(v) for v in pose)
+        c, s = math.cos(th), math.sin(th)
+        cx, cy = self.cf
+        return np.array([x + c * cx - s * cy, y + s * cx + c * cy, float(wrap_angle(th + self.heading_angle))])
+
+    def pose(self, state: ArrayLike) -> np.ndarray:
+        """The slider pose for a car state (inverse of :meth:`state`)."""
+        x, y, psi = (float(v) for v in state)
+        th = float(wrap_angle(psi - self.heading_angle))
+        c, s = math.cos(th), math.sin(th)
+        cx, cy = self.cf
+        return np.array([x - (c * cx - s * cy), y - (s * cx + c * cy), th])
+
+    def reach(self) -> float:
+        """Farthest point of the pushed body (part and pusher) from the CF: a body point moves at
+        most ``1 + reach / radius`` times the CF's speed."""
+        return float(np.linalg.norm(self.push.outline - self.cf, axis=1).max())
+
+
+def edge_car(push: EdgePush, cf: ArrayLike) -> EdgeCar | None:
+    """The car with the tightest turns among the edge's stable pushes, or None if it has no
+    stable translation with room to turn.
+
+    Examples
+    --------
+    The long face of a 10 x 6 cm block (mu 0.6): straight ahead, turning no tighter than about
+    8.4 cm; every curvature up to that is a stable push.
+
+    >>> from planner import load_scene
+    >>> from planner.pushes import edge_pushes
+    >>> scene = load_scene("scenes/parking.yaml")
+    >>> car = edge_car(edge_pushes(scene)[0], scene.slider.cf)
+    >>> (car.heading.round(6) + 0.0).tolist(), round(car.radius, 3)
+    ([0.0, 1.0], 0.084)
+    >>> bool(car.push.region.contains(car.twist(np.linspace(-1, 1, 201) / car.radius)).all())
+    True
+    """
+    region, cf = push.region, np.asarray(cf, dtype=float)
+    span = region.translation_range
+    if span is None:
+        return None
+    polygon, _ = region.section()
+    inner = polygon.buffer(-_MARGIN)
+    n = region.normal
+    t = np.array([n[1], -n[0]])
+    best: EdgeCar | None = None
+    for angle in np.linspace(span[0], span[1], _HEADINGS)[1:-1]:  # the ends lie on the boundary
+        heading = math.cos(angle) * n - math.sin(angle) * t
+        car = EdgeCar(push, cf, heading, math.inf)
+
+        def covered(kappa: float) -> bool:
+            ends = region.plane.points(car.twist([-kappa, kappa]))
+            return bool(np.all(np.isfinite(ends))) and inner.covers(shapely.LineString(ends))
+
+        if not covered(0.0):
+            continue
+        low, high = 0.0, 1.0 / push.region.scale
+        while covered(high):
+            low, high = high, 2.0 * high
+        for _ in range(40):
+            mid = 0.5 * (low + high)
+            low, high = (mid, high) if covered(mid) else (low, mid)
+        if low > 0 and (best is None or 1.0 / low < best.radius):
+            best = EdgeCar(push, cf, heading, 1.0 / low)
+    return best

@@ -1,0 +1,71 @@
+"""The Dubins car of an edge (planner.car): every motion it can make is a stable push.
+
+Checked against the test-only LP oracle over support distributions on the part and Theorem 4's
+condition (tests/oracle.py, which shares no code with ``mechanics``), on every shipped part's
+allowed edges.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from oracle import LPOracle, Reference, support_samples
+from planner import load_scene
+from planner.car import edge_car
+from planner.pushes import edge_pushes
+
+ROOT = Path(__file__).resolve().parent.parent
+PARTS = ["battery", "corridor", "nonconvex", "parking"]  # one scene per distinct part
+
+
+def stable_by_oracle(scene, edge: int, twist: np.ndarray) -> bool:
+    verts = scene.slider.vertices
+    ref = Reference(verts, scene.slider.cf, edge, scene.pusher.mu, width=scene.pusher.width)
+    if LPOracle(ref, support_samples(verts, 12)).max_violation(twist) > 1e-9:
+        return False
+    if twist[2] == 0:
+        return True
+    along = verts @ ref.t
+    c_t = np.array([-twist[1], twist[0]]) / twist[2] @ ref.t
+    return bool(c_t <= along.min()) if twist[2] > 0 else bool(c_t >= along.max())
+
+
+@pytest.mark.parametrize("name", PARTS)
+def test_every_curvature_of_the_car_is_stable(name):
+    scene = load_scene(ROOT / "scenes" / f"{name}.yaml")
+    cars = [edge_car(p, scene.slider.cf) for p in edge_pushes(scene)]
+    assert any(cars), "a part with stable translations has a car"
+    for car in filter(None, cars):
+        assert 0 < car.radius < 10 * scene.slider.radius
+        kappa = np.linspace(-1.0, 1.0, 41) / car.radius
+        for twist in car.twist(kappa):
+            assert stable_by_oracle(scene, car.push.edge, twist), (name, car.push.edge, twist)
+        # The CF moves along the heading at unit speed whatever the curvature.
+        cf_velocity = car.twist(kappa)[:, :2] + kappa[:, None] * np.array([-scene.slider.cf[1], scene.slider.cf[0]])
+        np.testing.assert_allclose(cf_velocity, np.tile(car.heading, (len(kappa), 1)), atol=1e-12)
+
+
+@pytest.mark.parametrize("name", PARTS)
+def test_the_radius_is_tight_for_the_region(name):
+    # A little tighter than the car's radius, one of the two turns leaves the planner's region.
+    scene = load_scene(ROOT / "scenes" / f"{name}.yaml")
+    for car in filter(None, (edge_car(p, scene.slider.cf) for p in edge_pushes(scene))):
+        tighter = car.twist(np.array([-1.0, 1.0]) / (0.97 * car.radius))
+        assert not car.push.region.contains(tighter).all()
+
+
+def test_states_and_poses_are_inverse():
+    scene = load_scene(ROOT / "scenes" / "nonconvex.yaml")
+    car = edge_car(edge_pushes(scene)[0], scene.slider.cf)
+    rng = np.random.default_rng(3)
+    for pose in rng.uniform([-1, -1, -np.pi], [1, 1, np.pi], (20, 3)):
+        back = car.pose(car.state(pose))
+        np.testing.assert_allclose(back[:2], pose[:2], atol=1e-12)
+        assert abs((back[2] - pose[2] + np.pi) % (2 * np.pi) - np.pi) < 1e-12
+        # The state's position is the CF's.
+        c, s = np.cos(pose[2]), np.sin(pose[2])
+        cf = pose[:2] + np.array([[c, -s], [s, c]]) @ scene.slider.cf
+        np.testing.assert_allclose(car.state(pose)[:2], cf, atol=1e-12)
