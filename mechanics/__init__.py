@@ -10,12 +10,14 @@ the general multi-contact analysis: :mod:`.cones` (polyhedral cones of twists an
 :mod:`.stable_pushing` (guaranteed-stable pushes and one-step goals, §4-5.1),
 :mod:`.exact_region` (the exact stable pushes of an edge, containing STABLE's), :mod:`.regions`
 (either method of an edge's stable pushes),
-:mod:`.contact_synthesis` (which edges realise a motion, §5.2), :mod:`.figures` (the paper's
+:mod:`.contact_synthesis` (which edges realise a motion, §5.2), :mod:`.controllability`
+(accessibility and STLC of a set of twists, 1996 §2), :mod:`.figures` (the paper's
 figures redrawn). :mod:`.quasistatic` is an independent simulator that checks pushes without any
 of the stable-region code.
 """
 
 from .cones import Cone, cor_halfplanes
+from .controllability import Controllability, controllability
 from .contact_synthesis import EdgeRegions, edge_regions, stable_edges
 from .contacts import ContactConfiguration
 from .exact_region import DeadlineExceeded, ExactRegion, exact_region
@@ -42,6 +44,7 @@ from .wrenches import contact_wrench_cone, friction_cone_edges, moment_labels, p
 __all__ = [
     "Cone",
     "ContactConfiguration",
+    "Controllability",
     "DEFAULT_TIP_FACTOR",
     "DeadlineExceeded",
     "EdgeRegions",
@@ -60,6 +63,7 @@ __all__ = [
     "classify_goal",
     "contact_modes",
     "contact_wrench_cone",
+    "controllability",
     "cor_halfplanes",
     "cor_to_twist",
     "edge_regions",

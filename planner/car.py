@@ -36,8 +36,12 @@ from .pushes import EdgePush
 
 __all__ = ["EdgeCar", "edge_car"]
 
-#: Headings tried across the edge's stable translations.
-_HEADINGS = 61
+#: Headings tried across the edge's stable translations, then about the best of them.
+_HEADINGS, _REFINE = 13, 4
+#: Halvings of the curvature interval: the radius to about 1e-9 of itself.
+_BISECTIONS = 32
+#: Cars found, by region (held, so its id stays its own) and CF.
+_found: dict[tuple, tuple[object, tuple[np.ndarray | None, float]]] = {}
 #: Margin inside the region's section (push-plane units) that the segment of twists must keep.
 _MARGIN = 1e-3
 
@@ -126,6 +130,20 @@ def edge_car(push: EdgePush, cf: ArrayLike) -> EdgeCar | None:
     True
     """
     region, cf = push.region, np.asarray(cf, dtype=float)
+    key = (id(region), *cf.tolist())
+    if key in _found and _found[key][0] is region:  # regions are cached objects: so are their cars
+        heading, radius = _found[key][1]
+        return None if heading is None else EdgeCar(push, cf, heading, radius)
+    car = _tightest(push, cf)
+    if len(_found) >= 256:  # STABLE's regions are made afresh for each plan: keep the memo small
+        _found.clear()
+    _found[key] = (region, (None, math.inf) if car is None else (car.heading, car.radius))
+    return car
+
+
+def _tightest(push: EdgePush, cf: np.ndarray) -> EdgeCar | None:
+    """The search behind :func:`edge_car`."""
+    region = push.region
     span = region.translation_range
     if span is None:
         return None
@@ -133,8 +151,8 @@ def edge_car(push: EdgePush, cf: ArrayLike) -> EdgeCar | None:
     inner = polygon.buffer(-_MARGIN)
     n = region.normal
     t = np.array([n[1], -n[0]])
-    best: EdgeCar | None = None
-    for angle in np.linspace(span[0], span[1], _HEADINGS)[1:-1]:  # the ends lie on the boundary
+    def radius(angle: float) -> float:
+        """The least radius of the car heading at ``angle`` from the normal (inf if none)."""
         heading = math.cos(angle) * n - math.sin(angle) * t
         car = EdgeCar(push, cf, heading, math.inf)
 
@@ -143,13 +161,27 @@ def edge_car(push: EdgePush, cf: ArrayLike) -> EdgeCar | None:
             return bool(np.all(np.isfinite(ends))) and inner.covers(shapely.LineString(ends))
 
         if not covered(0.0):
-            continue
+            return math.inf
         low, high = 0.0, 1.0 / push.region.scale
         while covered(high):
             low, high = high, 2.0 * high
-        for _ in range(40):
+        for _ in range(_BISECTIONS):
             mid = 0.5 * (low + high)
             low, high = (mid, high) if covered(mid) else (low, mid)
-        if low > 0 and (best is None or 1.0 / low < best.radius):
-            best = EdgeCar(push, cf, heading, 1.0 / low)
+        return 1.0 / low if low > 0 else math.inf
+
+    # A coarse sweep of the headings, then a finer one about the best: the radius varies smoothly
+    # with the heading, and this costs a fifth of a fine sweep.
+    grid = np.linspace(span[0], span[1], _HEADINGS)[1:-1]  # the ends lie on the boundary
+    radii = [radius(a) for a in grid]
+    k = int(np.argmin(radii))
+    step = grid[1] - grid[0] if len(grid) > 1 else 0.0
+    fine = np.linspace(grid[k] - step, grid[k] + step, 2 * _REFINE + 1)
+    fine = fine[(fine > span[0]) & (fine < span[1])]
+    radii_fine = [radius(a) for a in fine]
+    j = int(np.argmin(radii_fine))
+    if not math.isfinite(radii_fine[j]):
+        return None
+    angle = fine[j]
+    best = EdgeCar(push, cf, math.cos(angle) * n - math.sin(angle) * t, radii_fine[j])
     return best

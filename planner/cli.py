@@ -6,7 +6,8 @@ FILE`` verifies a plan file instead of planning, and writes the same outputs (th
 and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
 
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
-solved (one line saying why; nothing is verified), 3 verified and some push slipped beyond the
+solved or certified unreachable (:func:`planner.certify_unreachable`, checked before planning; one
+line saying why; nothing is verified), 3 verified and some push slipped beyond the
 tolerance. Output files are written atomically, so an interrupted run leaves no half-written file.
 :func:`read_inputs` checks everything a run reads before anything is computed or written.
 """
@@ -24,6 +25,7 @@ from pathlib import Path
 
 from .fields import shown
 from .plan_file import Plan, load_plan, write_atomic
+from .reachability import certify_unreachable
 from .regions import cache_folder
 from .scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS,
                     TRANSITS, PlannerOptions, Scene, SceneError, check_seed, check_time_limit, load_scene)
@@ -36,8 +38,9 @@ _EPILOG = f"""\
 exit codes:
   0    solved (and verified, with --verify)
   1    bad input: one line "plan: error: <field>: <problem>", nothing written
-  2    not solved within the time limit (the files are still written, "solved": false),
-       or a usage error of these options
+  2    not solved within the time limit, or the goal is certified unreachable (one line
+       "plan: unreachable: <reason>", at once); the files are still written, "solved": false
+       with the reason; or a usage error of these options
   3    --verify: a push slips in the simulator
   130  interrupted
 
@@ -144,6 +147,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _run(inputs: Inputs) -> int:
     scene, out, name, seed, limit = inputs.scene, inputs.out, inputs.planner, inputs.seed, inputs.time_limit
+    unreachable = None
     if inputs.given is not None:
         result = inputs.given
     else:
@@ -151,7 +155,12 @@ def _run(inputs: Inputs) -> int:
         if tty:
             print(f"planning {scene.name} with {name} (seed {seed}, limit {limit:g} s) ...", file=sys.stderr,
                   flush=True)
-        result = plan(scene, seed=seed, time_limit=limit, planner=name, progress=_progress if tty else None)
+        clock = time.perf_counter()
+        # The geometric certificates need no stable region: a sealed-off goal is answered at once.
+        unreachable = certify_unreachable(scene, regions=False)
+        result = (Plan(scene.path, False, name, seed, time.perf_counter() - clock, scene.start.copy(),
+                       scene.goal.copy(), reason=unreachable) if unreachable
+                  else plan(scene, seed=seed, time_limit=limit, planner=name, progress=_progress if tty else None))
         if tty:
             print("\r\033[K", end="", file=sys.stderr, flush=True)  # clear the progress line
         if result.note and result.solved:
@@ -160,6 +169,9 @@ def _run(inputs: Inputs) -> int:
     check = (verify(scene, result, inputs.verify, seed)
              if inputs.verify and (result.solved or inputs.given is not None) else None)
     _write_outputs(out, scene, result, check)
+    if unreachable:
+        print(f"plan: unreachable: {unreachable}", file=sys.stderr)
+        return 2
     if not result.solved and inputs.given is None:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
         return 2

@@ -223,7 +223,7 @@ class Plan:
             "goal": _floats(self.goal),
             "final": _floats(self.final),
             "segments": [s.to_dict() for s in self.segments],
-        }
+        } | ({"reason": self.reason} if self.reason and not self.solved else {})
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=1)
@@ -232,7 +232,7 @@ class Plan:
     def from_dict(cls, data: Any) -> "Plan":
         """A plan from its JSON form (``stablepush.plan/1``), every field checked."""
         spec = keys(data, "plan", ("format", "scene", "solved", "planner", "seed", "planning_time_s", "start",
-                                   "goal", "final", "segments"))
+                                   "goal", "final", "segments"), ("reason",))
         if spec["format"] != FORMAT:
             raise SceneError("plan.format", f"must be {FORMAT!r}, got {spec['format']!r}")
         if not isinstance(spec["solved"], bool):
@@ -247,6 +247,7 @@ class Plan:
             planning_time_s=number(spec["planning_time_s"], "plan.planning_time_s"),
             start=vector(spec["start"], "plan.start", 3),
             goal=vector(spec["goal"], "plan.goal", 3),
+            reason=str(spec.get("reason", "")),
         )
         plan.segments = _read_segments(spec["segments"], plan.start)
         final = vector(spec["final"], "plan.final", 3)

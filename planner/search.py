@@ -39,6 +39,7 @@ from ompl import util as ou
 
 from mechanics import exp_twist, wrap_angle
 
+from .dubins import DubinsShortcut
 from .one_step import connect
 from .plan_file import Plan, Segment, Transit
 from .preimage import GoalPreimage
@@ -144,7 +145,8 @@ class _PushGoal(ob.GoalSampleableRegion):
 
 def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
          regions: str | None = None, transit: str | None = None, switch_cost: float | None = None,
-         progress: Callable[[int, int], None] | None = None) -> Plan:
+         progress: Callable[[int, int], None] | None = None, *,
+         prebuilt: tuple[list[EdgePush], CollisionModel] | None = None) -> Plan:
     """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``.
 
     Arguments left as ``None`` take the scene's options: ``regions`` is ``'stable'`` (procedure
@@ -156,6 +158,10 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     take half of it: a part with many edges plans with those done in time, and says so in
     ``Plan.note``, or ends unsolved if none is) and the search together; ``progress(k, n)`` hears of the ``k``-th of the ``n``
     regions that must be computed.
+
+    ``prebuilt`` is the edges' pushes and the collision model (built with ``scene.pusher.edges``)
+    for this scene's part, pusher and options, as :func:`planner.reachability` shares them between
+    goals; they are then not rebuilt, and the time limit is the search's alone.
 
     Raises
     ------
@@ -189,11 +195,11 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
         return result
 
     # Found before any region is computed: the pusher has no room at the start on any edge.
-    model = CollisionModel(scene, scene.pusher.edges)
+    pushes, model = prebuilt or (None, CollisionModel(scene, scene.pusher.edges))
     if not any(model.clearance(scene.start, e) > step / 2 for e in scene.pusher.edges):
         raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
     try:  # regions are cached per part (planner.regions); they may take half the time, not all
-        pushes = edge_pushes(scene, clock + float(time_limit) / 2, progress)
+        pushes = pushes or edge_pushes(scene, clock + float(time_limit) / 2, progress)
     except RegionTimeout as timeout:
         if not timeout.pushes:
             return done([], str(timeout))
@@ -206,7 +212,11 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     preimage = GoalPreimage(scene.goal, pushes, model, margin, scene.slider.radius)
     switching = scene.pusher.transit != "none" and len(pushes) > 1
     transits = TransitPlanner(scene, [p.edge for p in pushes], model, margin) if switching else None
-    shortcut = _Shortcut(pushes, model, margin, transits)
+    joined, dubins = _Shortcut(pushes, model, margin, transits), DubinsShortcut(scene, pushes, model, margin)
+
+    def shortcut(segments: list) -> list:
+        """Fewer pushes where one joins several, then shorter Dubins curves where they are free."""
+        return dubins(joined(segments))
     # One or two pushes may do, as in the paper's one-step planning: the cheapest over the edges.
     direct = [found for k in starts if (found := preimage.connect(scene.start, k)) is not None]
     if direct:

@@ -376,3 +376,18 @@ def random_twists(rng, ref: Reference, n: int) -> np.ndarray:
     else:
         mix = np.zeros((0, 3))
     return np.vstack([rots, trans, near, mix])
+
+
+def guaranteed_stable(vertices, cf, edge: int, mu: float, width, twist) -> bool:
+    """Sticking for every support distribution on the part (the LP oracle) and, for a turn, its
+    centre beyond the part along the edge (Theorem 4): the push is guaranteed stable."""
+    verts = np.asarray(vertices, float)
+    ref = Reference(verts, cf, edge, mu, width=width)
+    v = np.asarray(twist, float)
+    if LPOracle(ref, support_samples(verts, 12)).max_violation(v) > 1e-9:
+        return False
+    if v[2] == 0:
+        return True
+    along = verts @ ref.t
+    c_t = np.array([-v[1], v[0]]) / v[2] @ ref.t
+    return bool(c_t <= along.min()) if v[2] > 0 else bool(c_t >= along.max())

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from oracle import LPOracle, Reference, support_samples
+from oracle import guaranteed_stable
 from planner import load_scene
 from planner.car import edge_car
 from planner.pushes import edge_pushes
@@ -22,15 +22,7 @@ PARTS = ["battery", "corridor", "nonconvex", "parking"]  # one scene per distinc
 
 
 def stable_by_oracle(scene, edge: int, twist: np.ndarray) -> bool:
-    verts = scene.slider.vertices
-    ref = Reference(verts, scene.slider.cf, edge, scene.pusher.mu, width=scene.pusher.width)
-    if LPOracle(ref, support_samples(verts, 12)).max_violation(twist) > 1e-9:
-        return False
-    if twist[2] == 0:
-        return True
-    along = verts @ ref.t
-    c_t = np.array([-twist[1], twist[0]]) / twist[2] @ ref.t
-    return bool(c_t <= along.min()) if twist[2] > 0 else bool(c_t >= along.max())
+    return guaranteed_stable(scene.slider.vertices, scene.slider.cf, edge, scene.pusher.mu, scene.pusher.width, twist)
 
 
 @pytest.mark.parametrize("name", PARTS)

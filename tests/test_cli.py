@@ -41,19 +41,16 @@ SEGMENT_KEYS = {"push": {"kind", "edge", "contact", "twist", "duration", "start"
 L_SHAPE = [[0.0, 0.0], [0.09, 0.0], [0.09, 0.035], [0.035, 0.035], [0.035, 0.09], [0.0, 0.09]]  # edges 2, 3 concave
 
 # The goal sits inside a closed ring of four walls: free of collision, but no path leads there.
-WALLED = {
-    "name": "walled",
+# A corridor just wider than the part and too narrow to turn it, pushed on its left edge only
+# (pushes go right) with the goal to its left: unreachable, but no certificate of
+# planner.reachability shows it, so the search runs out its time limit.
+BEHIND = {
+    "name": "behind",
     "slider": {"vertices": [[-0.04, -0.03], [0.04, -0.03], [0.04, 0.03], [-0.04, 0.03]]},
-    "pusher": {"width": 0.05, "depth": 0.015, "mu": 0.5},
-    "obstacles": [
-        {"box": {"center": [0.16, 0.25], "size": [0.02, 0.20]}},
-        {"box": {"center": [0.34, 0.25], "size": [0.02, 0.20]}},
-        {"box": {"center": [0.25, 0.16], "size": [0.20, 0.02]}},
-        {"box": {"center": [0.25, 0.34], "size": [0.20, 0.02]}},
-    ],
-    "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]},
-    "start": [-0.35, -0.35, 0.0],
-    "goal": [0.25, 0.25, 0.0],
+    "pusher": {"width": 0.05, "depth": 0.015, "mu": 0.5, "edges": [3], "transit": "none"},
+    "workspace": {"min": [-0.5, -0.045], "max": [0.5, 0.045]},
+    "start": [0.0, 0.0, 0.0],
+    "goal": [-0.2, 0.0, 0.0],
 }
 
 
@@ -108,7 +105,7 @@ def error_field(stderr: str) -> str:
 
 def plan_json(path: Path) -> dict:
     data = json.loads(path.read_text())
-    assert set(data) == PLAN_KEYS
+    assert set(data) == PLAN_KEYS | ({"reason"} if not data["solved"] else set())
     assert data["format"] == "stablepush.plan/1"
     for segment in data["segments"]:
         assert set(segment) == SEGMENT_KEYS[segment["kind"]]
@@ -355,7 +352,7 @@ def test_command_bad_planner_name_is_argparse_usage_error(tmp_path):
 # --- not solved ------------------------------------------------------------------------------------
 
 def test_unreachable_goal_exits_2_within_the_time_limit(tmp_path):
-    write(tmp_path, WALLED)
+    write(tmp_path, BEHIND)
     # The time limit bounds the search; the part's exact regions are computed once per part and
     # cached on disk (planner.regions), so compute them first, as any earlier run would have.
     from planner import load_scene
@@ -370,11 +367,24 @@ def test_unreachable_goal_exits_2_within_the_time_limit(tmp_path):
     lines = run.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith("plan: not solved: ") and "time limit" in lines[0], run.stderr
     assert run.stdout == ""
-    data = plan_json(tmp_path / "out" / "walled.json")
+    data = plan_json(tmp_path / "out" / "behind.json")
     assert data["solved"] is False and data["segments"] == [] and data["final"] == data["start"]
     assert 1.9 <= data["planning_time_s"] <= 3.0
-    assert (tmp_path / "out" / "walled.rrd").stat().st_size > 0
-    assert {p.name for p in (tmp_path / "out").iterdir()} == {"walled.json", "walled.rrd"}
+    assert (tmp_path / "out" / "behind.rrd").stat().st_size > 0
+    assert {p.name for p in (tmp_path / "out").iterdir()} == {"behind.json", "behind.rrd"}
+
+
+def test_a_sealed_goal_exits_2_at_once_saying_why(tmp_path):
+    """The shipped sealed scene: certified unreachable before any search or region."""
+    clock = time.perf_counter()
+    run = run_plan(str(SCENES / "unreachable" / "sealed.yaml"), "--out", "out", cwd=tmp_path)
+    assert run.returncode == 2 and time.perf_counter() - clock < 10.0  # interpreter start-up included
+    assert run.stderr.splitlines() == ["plan: unreachable: component: the goal is cut off from the start for the "
+                                       "part's inscribed disk (radius 0.03 m)"]
+    data = plan_json(tmp_path / "out" / "sealed.json")
+    assert data["solved"] is False and data["segments"] == [] and data["reason"].startswith("component")
+    assert data["planning_time_s"] < 1.0
+    assert (tmp_path / "out" / "sealed.rrd").stat().st_size > 0
 
 
 # --- solved ----------------------------------------------------------------------------------------
@@ -496,13 +506,13 @@ def test_flags_override_the_scenes_planner_options(tmp_path, monkeypatch, capsys
 
 
 def test_time_limit_flag_overrides_the_scenes(tmp_path, monkeypatch, capsys):
-    write(tmp_path, WALLED | {"planner": {"name": "rrt", "time_limit": 60}})
+    write(tmp_path, BEHIND | {"planner": {"name": "rrt", "time_limit": 60}})
     monkeypatch.chdir(tmp_path)
     clock = time.perf_counter()
     assert main(["scene.yaml", "--time-limit", "0.5", "--out", "out"]) == 2
     assert time.perf_counter() - clock < 5.0
     assert "0.5 s" in capsys.readouterr().err
-    data = plan_json(tmp_path / "out" / "walled.json")
+    data = plan_json(tmp_path / "out" / "behind.json")
     assert data["planner"] == "rrt" and data["planning_time_s"] < 2.0
 
 

@@ -1,0 +1,357 @@
+"""Near-shortest pushing paths: OMPL's optimizing planners on the Dubins space of an edge's car.
+
+Each edge's stable pushes contain a Dubins car (:mod:`planner.car`): its centre of friction goes
+straight or turns left or right at radius ``R``, and every such motion is a stable push. Dubins
+curves are the shortest paths of that car (Lynch & Mason 1996 cite them for a forward-only car),
+so OMPL's :class:`ompl.base.DubinsStateSpace` with the path-length objective and an
+asymptotically optimal planner (``RRTstar``) searches among near-shortest chains of stable pushes.
+The OMPL objects know nothing of pushing: the space is the car's, the validity checker places the
+pushed body at the car's state, and the motion validator walks a Dubins curve by conservative
+advancement (a body point moves at most ``1 + reach / R`` times the CF's speed, so from clearance
+``d`` the CF may travel ``d / (1 + reach / R)``: thin obstacles are not skipped).
+
+A solution path is a list of car states joined by Dubins curves; each curve is cut back into its
+(at most three) constant-curvature pieces (:func:`pieces`) and each piece is one push, re-checked
+for stability and collisions like any push.
+
+Searches are bounded by iterations as well as time, so that a seed gives one plan.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import replace
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from mechanics import exp_twist, relative_pose, wrap_angle
+
+from .bodies import transform_points
+from .car import EdgeCar, edge_car
+from .plan_file import Segment
+from .scene import Scene
+from .validity import CollisionModel
+
+__all__ = ["DubinsCurves", "DubinsSearch", "DubinsShortcut", "pieces"]
+
+#: Samples per turning radius of curve length when cutting a curve into pieces.
+_SAMPLES_PER_RADIUS = 200
+#: Least relative gain for which a shortcut replaces a stretch of plan: its pieces are pushes
+#: too, and a push is not worth adding for less.
+_GAIN = 0.01
+
+
+def pieces(curve, length: float, radius: float, tol: float = 1e-12) -> list[tuple[float, float]]:
+    """``(curvature, length)`` of each constant-curvature piece of a Dubins curve.
+
+    ``curve(t)`` gives the state ``(x, y, heading)`` at the fraction ``t`` of the curve's
+    ``length`` (arc length is linear in ``t``). An interval is one piece when its end follows
+    from its start by one of the three motions (left, straight or right at radius ``radius``) to
+    within ``tol``; otherwise it holds a joint and is halved, down to ``tol`` in length. A fine
+    grid first keeps whole pieces from hiding inside one interval.
+
+    >>> import numpy as np
+    >>> def turn_then_straight(t):   # left through 1 rad at R = 1, then straight: 3 m in all
+    ...     s = 3.0 * t
+    ...     a = min(s, 1.0)
+    ...     return np.sin(a) + (s - a) * np.cos(a), 1 - np.cos(a) + (s - a) * np.sin(a), a
+    >>> [(k, round(s, 9)) for k, s in pieces(turn_then_straight, 3.0, 1.0)]
+    [(1.0, 1.0), (0.0, 2.0)]
+    """
+    out: list[list[float]] = []
+
+    def add(kappa: float, ds: float) -> None:
+        if out and out[-1][0] == kappa:
+            out[-1][1] += ds
+        else:
+            out.append([kappa, ds])
+
+    def split(t0: float, p0: np.ndarray, t1: float, p1: np.ndarray) -> None:
+        ds = (t1 - t0) * length
+        for kappa in (1.0 / radius, 0.0, -1.0 / radius):
+            gap = _along(p0, kappa, ds) - p1
+            if max(abs(gap[0]), abs(gap[1]), abs(float(wrap_angle(gap[2])))) <= tol:
+                add(kappa, ds)
+                return
+        if ds <= tol:  # a joint pinned down to within tol: its sliver goes to the piece before
+            if out:
+                out[-1][1] += ds
+            return
+        tm = 0.5 * (t0 + t1)
+        pm = np.asarray(curve(tm), dtype=float)
+        split(t0, p0, tm, pm)
+        split(tm, pm, t1, p1)
+
+    if length <= 0:
+        return []
+    n = max(2, math.ceil(_SAMPLES_PER_RADIUS * length / radius))
+    grid = np.linspace(0.0, 1.0, n + 1)
+    states = [np.asarray(curve(t), dtype=float) for t in grid]
+    for k in range(n):
+        split(grid[k], states[k], grid[k + 1], states[k + 1])
+    return [(float(k), float(s)) for k, s in out if s > 0]
+
+
+def _along(state: np.ndarray, kappa: float, ds: float) -> np.ndarray:
+    """The car state after ``ds`` of arc at curvature ``kappa`` (heading wrapped to the start's branch)."""
+    x, y, psi = state
+    if kappa == 0.0:
+        return np.array([x + ds * math.cos(psi), y + ds * math.sin(psi), psi])
+    turn = kappa * ds
+    return np.array([x + (math.sin(psi + turn) - math.sin(psi)) / kappa,
+                     y - (math.cos(psi + turn) - math.cos(psi)) / kappa, psi + turn])
+
+
+class DubinsCurves:
+    """Dubins curves of one edge's car as chains of stable pushes, collision-checked.
+
+    Parameters
+    ----------
+    scene : Scene
+    car : EdgeCar
+    model : CollisionModel
+        With a body for the car's edge.
+    margin : float
+        Clearance every push keeps.
+    """
+
+    def __init__(self, scene: Scene, car: EdgeCar, model: CollisionModel, margin: float):
+        self.car, self.model, self.margin = car, model, margin
+        self.space = ob.DubinsStateSpace(car.radius)
+        bounds = ob.RealVectorBounds(2)
+        xmin, ymin, xmax, ymax = scene.workspace
+        bounds.setLow(0, xmin), bounds.setLow(1, ymin), bounds.setHigh(0, xmax), bounds.setHigh(1, ymax)
+        self.space.setBounds(bounds)
+        self.bound = 1.0 + car.reach() / car.radius
+        self._a, self._b, self._probe = (self.space.allocState() for _ in range(3))
+
+    def states(self, a: tuple[float, float, float], b: tuple[float, float, float]) -> None:
+        """Load car states ``a`` and ``b`` for :meth:`length`, :meth:`is_free` and :meth:`pushes`."""
+        for state, (x, y, psi) in ((self._a, a), (self._b, b)):
+            state.setXY(x, y), state.setYaw(psi)
+
+    def length(self) -> float:
+        """Length of the CF's path along the Dubins curve between the loaded states."""
+        return self.space.distance(self._a, self._b)
+
+    def is_free(self, a=None, b=None) -> bool:
+        """Whether the curve (between the loaded states, or OMPL states ``a`` and ``b``) keeps the
+        margin, by conservative advancement (module docstring)."""
+        a, b = (self._a, self._b) if a is None else (a, b)
+        length = self.space.distance(a, b)
+        t = 0.0
+        while True:
+            self.space.interpolate(a, b, t, self._probe)
+            d = self.model.clearance(self.car.pose(_xy_yaw(self._probe)), self.car.push.edge)
+            if d < self.margin:
+                return False
+            if t >= 1.0 or length == 0.0:
+                return True
+            t = min(1.0, t + d / (self.bound * length))
+
+    def pieces(self) -> list[tuple[float, float]]:
+        """The curve's pieces, ``(curvature, length)``, between the loaded states."""
+        def along(t: float) -> tuple[float, float, float]:
+            self.space.interpolate(self._a, self._b, t, self._probe)
+            return _xy_yaw(self._probe)
+
+        return pieces(along, self.length(), self.car.radius)
+
+    def pushes(self, pose: np.ndarray, runs: list[tuple[float, float]]) -> list[Segment] | None:
+        """One push per piece ``(curvature, length)`` from slider ``pose``; None if one fails
+        its re-check (stability, clearance) after rounding."""
+        push, out = self.car.push, []
+        for kappa, length in runs:
+            twist = self.car.twist(kappa)
+            speed = float(push.speed(twist))
+            twist, duration = twist / speed, length * speed  # no body point faster than 1 m/s
+            if not (push.region.contains(twist) and self.model.push_is_free(pose, twist, duration, push.edge,
+                                                                             self.margin)):
+                return None
+            end = exp_twist(pose, twist, duration)
+            end[2] = wrap_angle(end[2])
+            out.append(Segment(push.edge, push.region.contact, twist, duration, pose, end))
+            pose = end
+        return out
+
+    def connect(self, start: np.ndarray, goal: np.ndarray) -> list[Segment] | None:
+        """The pushes along the Dubins curve from slider pose ``start`` to ``goal``, if it is free."""
+        self.states(self.car.state(start), self.car.state(goal))
+        return self.pushes(np.asarray(start, dtype=float), self.pieces()) if self.is_free() else None
+
+
+class _Advance(ob.MotionValidator):
+    """OMPL's hook for :meth:`DubinsCurves.is_free`."""
+
+    def __init__(self, si, curves: DubinsCurves):
+        super().__init__(si)
+        self.curves = curves
+
+    def checkMotion(self, a, b) -> bool:
+        return self.curves.is_free(a, b)
+
+
+def _xy_yaw(state) -> tuple[float, float, float]:
+    return state.getX(), state.getY(), state.getYaw()
+
+
+class DubinsSearch:
+    """Shortest-path search for one edge's car among the scene's obstacles (``RRTstar``)."""
+
+    def __init__(self, curves: DubinsCurves):
+        self.curves = curves
+
+    def run(self, start: np.ndarray, goal: np.ndarray, seed: int, deadline: float,
+            iterations: int) -> list[Segment] | None:
+        """Pushes from slider pose ``start`` to ``goal`` (exactly), or None if none was found
+        within ``iterations`` (after the first solution, they keep shortening it) or by
+        ``deadline`` (perf_counter time)."""
+        ou.setLogLevel(ou.LOG_NONE)
+        ou.RNG.setSeed(seed)
+        curves, car = self.curves, self.curves.car
+        space = curves.space
+        ss = og.SimpleSetup(space)
+        si = ss.getSpaceInformation()
+        ss.setStateValidityChecker(lambda s: curves.model.clearance(car.pose(_xy_yaw(s)), car.push.edge)
+                                   >= curves.margin)
+        si.setMotionValidator(_Advance(si, curves))
+        ends = []
+        for pose in (start, goal):
+            s = space.allocState()
+            x, y, psi = car.state(pose)
+            s.setXY(x, y), s.setYaw(psi)
+            ends.append(s)
+        ss.setStartAndGoalStates(ends[0], ends[1], 1e-9)
+        ss.getProblemDefinition().setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
+        ss.setPlanner(og.RRTstar(si))
+        count = [0]
+
+        def stop() -> bool:
+            count[0] += 1
+            return count[0] > iterations or time.perf_counter() >= deadline
+
+        ss.solve(ob.PlannerTerminationCondition(stop))
+        if not ss.haveExactSolutionPath():
+            return None
+        states = [_xy_yaw(s) for s in ss.getSolutionPath().getStates()]
+        runs: list[list[float]] = []
+        for p, q in zip(states, states[1:]):
+            curves.states(p, q)
+            for kappa, length in curves.pieces():
+                if runs and runs[-1][0] == kappa:
+                    runs[-1][1] += length
+                else:
+                    runs.append([kappa, length])
+        return curves.pushes(car.pose(states[0]), runs)
+
+
+class DubinsShortcut:
+    """Shorten a plan by Dubins curves of the edges' cars wherever one is free and shorter.
+
+    The plan's pushes are halved, and between any two of the resulting waypoints on one edge
+    (no transit between them) the Dubins curve of that edge's car replaces the plan if it is
+    shorter (the centre of friction's path, by at least :data:`_GAIN`) and free; greedy, farthest
+    waypoint first, so the plan only gets shorter. A plan without transits may move to another edge's car (the first
+    push may be on any edge).
+
+    Parameters
+    ----------
+    scene : Scene
+    pushes : the allowed edges' pushes
+    model : CollisionModel
+        With a body for each of those edges.
+    margin : float
+        Clearance every push keeps.
+    """
+
+    def __init__(self, scene: Scene, pushes, model: CollisionModel, margin: float):
+        self.cf = scene.slider.cf
+        cars = (edge_car(p, self.cf) for p in pushes)
+        self.curves = {car.push.edge: DubinsCurves(scene, car, model, margin) for car in cars if car is not None}
+
+    def __call__(self, segments: list) -> list:
+        out, run = [], []
+        for s in [*segments, None]:
+            if s is not None and s.kind == "push":
+                run += _halves(s)
+                continue
+            if run:
+                alone = s is None and not out  # the whole plan is this run: any edge will do
+                out += _merge(self._shorten(run, list(self.curves) if alone else [run[0].edge]))
+                run = []
+            if s is not None:
+                out.append(s)
+        return _rechain(out)
+
+    def _shorten(self, run: list[Segment], edges: list[int]) -> list[Segment]:
+        waypoints = [s.start for s in run] + [run[-1].end]
+        travelled = np.concatenate([[0.0], np.cumsum([s.cf_path_length(self.cf) for s in run])])
+        out, i = [], 0
+        while i < len(run):
+            for j in range(len(run), i, -1):
+                found = self._curve(waypoints[i], waypoints[j], travelled[j] - travelled[i], edges)
+                if found is not None:
+                    out += found
+                    i = j
+                    break
+            else:
+                out.append(run[i])
+                i += 1
+        return out
+
+    def _curve(self, start: np.ndarray, end: np.ndarray, longest: float, edges: list[int]) -> list[Segment] | None:
+        """The shortest free Dubins curve among ``edges``' cars shorter than ``longest``, as pushes."""
+        options = []
+        for e in edges:
+            curves = self.curves.get(e)
+            if curves is None:
+                continue
+            curves.states(curves.car.state(start), curves.car.state(end))
+            if curves.length() < (1.0 - _GAIN) * longest:
+                options.append((curves.length(), e))
+        for _, e in sorted(options):
+            found = self.curves[e].connect(start, end)
+            if found is not None:
+                return found
+        return None
+
+
+def _rechain(segments: list) -> list:
+    """Each segment re-anchored where the one before it ends (a transit's path moving rigidly with
+    the part): the pushes of a Dubins curve end where OMPL's curve does only to about 1e-12, and a
+    plan's poses must chain exactly."""
+    out: list = []
+    for s in segments:
+        pose = out[-1].end if out else s.start
+        if s.kind == "push":
+            end = exp_twist(pose, s.twist, s.duration)
+            end[2] = wrap_angle(end[2])
+            out.append(replace(s, start=np.asarray(pose, dtype=float), end=end))
+        else:
+            local = relative_pose(s.pose, s.pusher_path)
+            path = np.column_stack([transform_points(local[:, :2], pose), wrap_angle(local[:, 2] + pose[2])])
+            out.append(replace(s, pose=np.asarray(pose, dtype=float), pusher_path=path))
+    return out
+
+
+def _halves(push: Segment) -> list[Segment]:
+    """``push`` as two pushes of half its duration: its middle becomes a waypoint."""
+    half = push.duration / 2
+    middle = exp_twist(push.start, push.twist, half)
+    middle[2] = wrap_angle(middle[2])
+    return [replace(push, duration=half, end=middle), replace(push, duration=half, start=middle)]
+
+
+def _merge(pushes: list[Segment]) -> list[Segment]:
+    """Consecutive pushes with the same edge and twist as one."""
+    out: list[Segment] = []
+    for s in pushes:
+        if out and out[-1].edge == s.edge and np.array_equal(out[-1].twist, s.twist):
+            out[-1] = replace(out[-1], duration=out[-1].duration + s.duration, end=s.end)
+        else:
+            out.append(s)
+    return out
