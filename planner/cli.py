@@ -4,6 +4,9 @@
 and prints a line per push and an overall line with the worst deviation; ``--verify N --plan
 FILE`` verifies a plan file instead of planning, and writes the same outputs (the plan as read,
 and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
+``--reach N`` (1 or 2) then maps the goal positions reachable from the start in at most N stable
+pushes (:func:`planner.reachable_set.reachable_set`, any heading): ``<name>-reach.png`` in the
+output folder and ``/world/reach`` in the recording.
 
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
 solved or certified unreachable (:func:`planner.certify_unreachable`, checked before planning; one
@@ -24,7 +27,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from .fields import shown
-from .plan_file import Plan, load_plan, write_atomic
+from .plan_file import Plan, atomic_path, load_plan, write_atomic
 from .reachability import certify_unreachable
 from .regions import cache_folder
 from .scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS,
@@ -81,6 +84,10 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--verify", type=int, metavar="N",
                    help="re-simulate the plan under N support distributions; exit 3 if a push slips")
     p.add_argument("--plan", metavar="FILE", help="with --verify: verify this plan file instead of planning")
+    p.add_argument("--reach", type=int, metavar="N",
+                   help="after planning, map the goal positions reachable from the start in at most N (1 or 2) "
+                        "stable pushes, at any heading: <name>-reach.png in the output folder and /world/reach "
+                        "in the recording (planner.reachable_set; seconds per map)")
     return p
 
 
@@ -96,6 +103,7 @@ class Inputs:
     verify: int | None  # --verify N
     plan_path: str | None  # --plan FILE
     given: Plan | None  # that file's plan, to verify instead of planning
+    reach: int | None = None  # --reach N: pushes of the reachable-set map
 
 
 def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
@@ -116,6 +124,8 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--verify", f"must be at least 1 distribution, got {args.verify}")
     if args.plan is not None and args.verify is None:
         raise SceneError("--plan", "needs --verify N: a plan file is only read to be verified")
+    if args.reach is not None and args.reach not in (1, 2):
+        raise SceneError("--reach", f"must be 1 or 2 pushes, got {args.reach}")
     scene = load_scene(args.scene)
     if args.regions:  # the search, the one-step check and the recording all read it from the scene
         scene = replace(scene, planner=replace(scene.planner, regions=args.regions))
@@ -130,7 +140,7 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--out", f"{shown(str(out))} exists and is not a folder")
     return Inputs(scene, args.planner or scene.planner.name, limit or scene.planner.time_limit,
                   seed or scene.planner.seed, out, args.verify, args.plan,
-                  None if args.plan is None else load_plan(args.plan))
+                  None if args.plan is None else load_plan(args.plan), args.reach)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -168,7 +178,12 @@ def _run(inputs: Inputs) -> int:
     # The planning seed also draws the random distributions, so a run is repeatable as a whole.
     check = (verify(scene, result, inputs.verify, seed)
              if inputs.verify and (result.solved or inputs.given is not None) else None)
-    _write_outputs(out, scene, result, check)
+    reach = None
+    if inputs.reach:  # after planning: the map is about the start, whatever the plan
+        from .reachable_set import reachable_set
+
+        reach = reachable_set(scene, inputs.reach)
+    _write_outputs(out, scene, result, check, reach)
     if unreachable:
         print(f"plan: unreachable: {unreachable}", file=sys.stderr)
         return 2
@@ -179,7 +194,7 @@ def _run(inputs: Inputs) -> int:
             if inputs.given is not None
             else f"solved: {result.contents()}, path length {result.path_length(scene.slider.cf):.3f} m, "
                  f"planning time {result.planning_time_s:.2f} s")
-    print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd")
+    print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{f', {scene.name}-reach.png' if reach else ''}")
     if check is None:
         return 0
     print("\n".join([*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]))
@@ -200,14 +215,20 @@ def _fresh_folder(base: Path) -> Path:
     return out
 
 
-def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None) -> None:
-    """Write the plan JSON and the recording (with ``check``'s ghost) into ``out``, creating it if need be."""
+def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None, reach=None) -> None:
+    """Write the plan JSON and the recording (with ``check``'s ghost and ``reach``'s map) into
+    ``out``, creating it if need be, and ``reach``'s PNG if given."""
     from .recording import write_recording  # rerun takes half a second to import
 
     try:
         out.mkdir(parents=True, exist_ok=True)
         write_atomic(out / f"{scene.name}.json", result.to_json())
-        write_recording(out / f"{scene.name}.rrd", scene, result, check)
+        write_recording(out / f"{scene.name}.rrd", scene, result, check, reach)
+        if reach is not None:
+            from .reachable_set import write_png
+
+            with atomic_path(out / f"{scene.name}-reach.png") as tmp:
+                write_png(reach, scene, str(tmp))
     except OSError as err:
         raise SceneError("--out", f"cannot write to {str(out)!r}: {err.strerror or err}") from None
 

@@ -58,6 +58,11 @@ With a :class:`~planner.verify.Verification` (``plan --verify``), also:
   hides under ``/world/slider`` wherever the push sticks;
 * ``/log/verify`` -- ``TextLog``, the verification's summary line (``WARN`` when it failed).
 
+With a reachable-set map (``plan --reach N``; :mod:`planner.reachable_set`), also:
+
+* ``/world/reach`` -- ``Points2D``, static, one point per reachable cell centre, green for one
+  push and amber for two.
+
 Styles (colours, line widths in UI points) are logged statically on the animated entities. The
 default blueprint shows ``/world`` in a 2-D view bounded by the workspace beside ``/analysis``,
 above the text log.
@@ -84,6 +89,7 @@ from .scene import Scene
 from .transit import contact_pose, transit_pieces, transit_poses
 
 if TYPE_CHECKING:  # the simulator behind it imports most of scipy: not needed to draw a plan
+    from .reachable_set import ReachableSet
     from .verify import Verification
 
 __all__ = ["ANALYSIS_RAYS", "FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS", "write_recording"]
@@ -338,7 +344,18 @@ def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> tuple[np.n
     return index, times
 
 
-def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Verification | None = None) -> None:
+def _log_reach(rec: rr.RecordingStream, reach: ReachableSet) -> None:
+    """The reachable-set map, static: a point per reachable cell, coloured by its fewest pushes."""
+    from .reachable_set import COLOURS, reach_points
+
+    centres, counts = reach_points(reach)
+    colours = {k: [int(c[i:i + 2], 16) for i in (1, 3, 5)] for k, c in COLOURS.items()}
+    rec.log("world/reach", rr.Points2D(centres, colors=[colours[int(k)] for k in counts],
+                                       radii=0.35 * min(reach.cell), draw_order=-2.0), static=True)
+
+
+def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Verification | None = None,
+                    reach: ReachableSet | None = None) -> None:
     """Write a rerun recording of ``plan`` for ``scene`` to ``path`` (layout: module docstring).
 
     The file is written atomically: a temporary file in the same folder is completed (footer
@@ -355,6 +372,8 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         The planner's result, solved or not (an unsolved plan gives the static scene only).
     verification : Verification, optional
         :func:`planner.verify` of ``plan``: adds the simulated ghost and the verdict.
+    reach : ReachableSet, optional
+        :func:`planner.reachable_set.reachable_set` from the scene's start: adds ``/world/reach``.
 
     Raises
     ------
@@ -382,5 +401,7 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
                     _log_analysis(rec, scene, plan)
                 if verification is not None:
                     _log_ghost(rec, plan, verification, index, times)
+            if reach is not None:
+                _log_reach(rec, reach)
         finally:
             rec.disconnect()  # flushes and writes the footer
