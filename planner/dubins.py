@@ -38,8 +38,9 @@ from .validity import CollisionModel
 
 __all__ = ["DubinsCurves", "DubinsSearch", "DubinsShortcut", "pieces"]
 
-#: Samples per turning radius of curve length when cutting a curve into pieces.
-_SAMPLES_PER_RADIUS = 200
+#: Starting intervals per turning radius of curve length when cutting a curve into pieces (the
+#: halving finds every joint; this only bounds its depth).
+_SAMPLES_PER_RADIUS = 4
 #: Least relative gain for which a shortcut replaces a stretch of plan: its pieces are pushes
 #: too, and a push is not worth adding for less.
 _GAIN = 0.01
@@ -51,8 +52,8 @@ def pieces(curve, length: float, radius: float, tol: float = 1e-12) -> list[tupl
     ``curve(t)`` gives the state ``(x, y, heading)`` at the fraction ``t`` of the curve's
     ``length`` (arc length is linear in ``t``). An interval is one piece when its end follows
     from its start by one of the three motions (left, straight or right at radius ``radius``) to
-    within ``tol``; otherwise it holds a joint and is halved, down to ``tol`` in length. A fine
-    grid first keeps whole pieces from hiding inside one interval.
+    within ``tol``; otherwise it holds a joint (or several: then it matches no single motion either)
+    and is halved, down to ``tol`` in length.
 
     >>> import numpy as np
     >>> def turn_then_straight(t):   # left through 1 rad at R = 1, then straight: 3 m in all
