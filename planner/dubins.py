@@ -1,32 +1,22 @@
-"""Near-shortest pushing paths: OMPL's optimizing planners on the Dubins space of an edge's car.
+"""Near-shortest pushing paths: Dubins curves of an edge's car, as chains of stable pushes.
 
 Each edge's stable pushes contain a Dubins car (:mod:`planner.car`): its centre of friction goes
 straight or turns left or right at radius ``R``, and every such motion is a stable push. Dubins
-curves are the shortest paths of that car (Lynch & Mason 1996 cite them for a forward-only car),
-so OMPL's :class:`ompl.base.DubinsStateSpace` with the path-length objective and an
-asymptotically optimal planner (``RRTstar``) searches among near-shortest chains of stable pushes.
-The OMPL objects know nothing of pushing: the space is the car's, the validity checker places the
-pushed body at the car's state, and the motion validator walks a Dubins curve by conservative
+curves are the shortest paths of that car (Lynch & Mason 1996 cite them for a forward-only car);
+OMPL's :class:`ompl.base.DubinsStateSpace` gives them. A curve is checked by conservative
 advancement (a body point moves at most ``1 + reach / R`` times the CF's speed, so from clearance
-``d`` the CF may travel ``d / (1 + reach / R)``: thin obstacles are not skipped).
-
-A solution path is a list of car states joined by Dubins curves; each curve is cut back into its
-(at most three) constant-curvature pieces (:func:`pieces`) and each piece is one push, re-checked
-for stability and collisions like any push.
-
-Searches are bounded by iterations as well as time, so that a seed gives one plan.
+``d`` the CF may travel ``d / (1 + reach / R)``: thin obstacles are not skipped), cut back into
+its (at most three) constant-curvature pieces (:func:`pieces`), and each piece is one push,
+re-checked for stability and collisions like any push. :class:`DubinsShortcut` uses them to
+shorten plans.
 """
-
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import replace
 
 import numpy as np
 from ompl import base as ob
-from ompl import geometric as og
-from ompl import util as ou
 
 from mechanics import exp_twist, relative_pose, wrap_angle
 
@@ -36,7 +26,7 @@ from .plan_file import Segment
 from .scene import Scene
 from .validity import CollisionModel
 
-__all__ = ["DubinsCurves", "DubinsSearch", "DubinsShortcut", "pieces"]
+__all__ = ["DubinsCurves", "DubinsShortcut", "pieces"]
 
 #: Starting intervals per turning radius of curve length when cutting a curve into pieces (the
 #: halving finds every joint; this only bounds its depth).
@@ -131,7 +121,7 @@ class DubinsCurves:
         self._a, self._b, self._probe = (self.space.allocState() for _ in range(3))
 
     def states(self, a: tuple[float, float, float], b: tuple[float, float, float]) -> None:
-        """Load car states ``a`` and ``b`` for :meth:`length`, :meth:`is_free` and :meth:`pushes`."""
+        """Load car states ``a`` and ``b`` for :meth:`length`, :meth:`is_free` and :meth:`pieces`."""
         for state, (x, y, psi) in ((self._a, a), (self._b, b)):
             state.setXY(x, y), state.setYaw(psi)
 
@@ -139,10 +129,10 @@ class DubinsCurves:
         """Length of the CF's path along the Dubins curve between the loaded states."""
         return self.space.distance(self._a, self._b)
 
-    def is_free(self, a=None, b=None) -> bool:
-        """Whether the curve (between the loaded states, or OMPL states ``a`` and ``b``) keeps the
-        margin, by conservative advancement (module docstring)."""
-        a, b = (self._a, self._b) if a is None else (a, b)
+    def is_free(self) -> bool:
+        """Whether the curve between the loaded states keeps the margin, by conservative
+        advancement (module docstring)."""
+        a, b = self._a, self._b
         length = self.space.distance(a, b)
         t = 0.0
         while True:
@@ -185,69 +175,8 @@ class DubinsCurves:
         return self.pushes(np.asarray(start, dtype=float), self.pieces()) if self.is_free() else None
 
 
-class _Advance(ob.MotionValidator):
-    """OMPL's hook for :meth:`DubinsCurves.is_free`."""
-
-    def __init__(self, si, curves: DubinsCurves):
-        super().__init__(si)
-        self.curves = curves
-
-    def checkMotion(self, a, b) -> bool:
-        return self.curves.is_free(a, b)
-
-
 def _xy_yaw(state) -> tuple[float, float, float]:
     return state.getX(), state.getY(), state.getYaw()
-
-
-class DubinsSearch:
-    """Shortest-path search for one edge's car among the scene's obstacles (``RRTstar``)."""
-
-    def __init__(self, curves: DubinsCurves):
-        self.curves = curves
-
-    def run(self, start: np.ndarray, goal: np.ndarray, seed: int, deadline: float,
-            iterations: int) -> list[Segment] | None:
-        """Pushes from slider pose ``start`` to ``goal`` (exactly), or None if none was found
-        within ``iterations`` (after the first solution, they keep shortening it) or by
-        ``deadline`` (perf_counter time)."""
-        ou.setLogLevel(ou.LOG_NONE)
-        ou.RNG.setSeed(seed)
-        curves, car = self.curves, self.curves.car
-        space = curves.space
-        ss = og.SimpleSetup(space)
-        si = ss.getSpaceInformation()
-        ss.setStateValidityChecker(lambda s: curves.model.clearance(car.pose(_xy_yaw(s)), car.push.edge)
-                                   >= curves.margin)
-        si.setMotionValidator(_Advance(si, curves))
-        ends = []
-        for pose in (start, goal):
-            s = space.allocState()
-            x, y, psi = car.state(pose)
-            s.setXY(x, y), s.setYaw(psi)
-            ends.append(s)
-        ss.setStartAndGoalStates(ends[0], ends[1], 1e-9)
-        ss.getProblemDefinition().setOptimizationObjective(ob.PathLengthOptimizationObjective(si))
-        ss.setPlanner(og.RRTstar(si))
-        count = [0]
-
-        def stop() -> bool:
-            count[0] += 1
-            return count[0] > iterations or time.perf_counter() >= deadline
-
-        ss.solve(ob.PlannerTerminationCondition(stop))
-        if not ss.haveExactSolutionPath():
-            return None
-        states = [_xy_yaw(s) for s in ss.getSolutionPath().getStates()]
-        runs: list[list[float]] = []
-        for p, q in zip(states, states[1:]):
-            curves.states(p, q)
-            for kappa, length in curves.pieces():
-                if runs and runs[-1][0] == kappa:
-                    runs[-1][1] += length
-                else:
-                    runs.append([kappa, length])
-        return curves.pushes(car.pose(states[0]), runs)
 
 
 class DubinsShortcut:
@@ -256,8 +185,8 @@ class DubinsShortcut:
     The plan's pushes are halved, and between any two of the resulting waypoints on one edge
     (no transit between them) the Dubins curve of that edge's car replaces the plan if it is
     shorter (the centre of friction's path, by at least :data:`_GAIN`) and free; greedy, farthest
-    waypoint first, so the plan only gets shorter. A plan without transits may move to another edge's car (the first
-    push may be on any edge).
+    waypoint first, so the plan only gets shorter. A plan without transits may move to another
+    edge's car (the first push may be on any edge).
 
     Parameters
     ----------

@@ -80,13 +80,13 @@ import shapely
 from numpy.typing import ArrayLike
 
 from mechanics import (ContactConfiguration, Slider, SupportModel, contact_wrench_cone, exp_twist,
-                       force_status_regions, twist_to_cor, wrap_angle)
+                       force_status_regions, twist_to_cor)
 
 from .bodies import pusher_frame_body
 from .plan_file import Plan, Segment, Transit, atomic_path
 from .regions import edge_region
 from .scene import Scene
-from .transit import contact_pose, transit_pieces, transit_poses
+from .transit import edge_contact_pose, transit_pieces, transit_poses
 
 if TYPE_CHECKING:  # the simulator behind it imports most of scipy: not needed to draw a plan
     from .reachable_set import ReachableSet
@@ -178,8 +178,7 @@ class _Frames(NamedTuple):
 def _pusher_on(slider: Slider, edge: int) -> np.ndarray:
     """The pusher frame's pose in the slider frame while it pushes ``edge``: face centred on the
     edge's midpoint (:func:`planner.bodies.pusher_polygon`), facing the part."""
-    a, b = slider.edge(edge)
-    return contact_pose(np.zeros(3), (a + b) / 2, -slider.inward_normal(edge))
+    return edge_contact_pose(slider, edge, np.zeros(3))
 
 
 def _sample(slider: Slider, body: np.ndarray, segment: Segment | Transit,

@@ -41,7 +41,7 @@ from mechanics import exp_twist, wrap_angle
 
 from .dubins import DubinsShortcut
 from .one_step import connect
-from .plan_file import Plan, Segment, Transit
+from .plan_file import Plan, Segment
 from .preimage import GoalPreimage
 from .pushes import EdgePush, RegionTimeout, clearance_margin, edge_pushes, resolution
 from .scene import Scene, SceneError, check_regions, check_switch_cost, check_transit

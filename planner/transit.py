@@ -32,7 +32,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import wrap_angle
+from mechanics import Slider, wrap_angle
 
 from .bodies import pusher_frame_body, transform_points
 from .plan_file import Transit
@@ -40,7 +40,8 @@ from .pushes import resolution
 from .scene import Scene
 from .validity import CollisionModel
 
-__all__ = ["AIRBORNE", "ARC_STEP", "TransitPlanner", "contact_pose", "path_duration", "transit_pieces", "transit_poses"]
+__all__ = ["AIRBORNE", "ARC_STEP", "TransitPlanner", "contact_pose", "edge_contact_pose", "path_duration",
+           "transit_pieces", "transit_poses"]
 
 #: Largest turn of the pusher between two poses of a walk round a corner of the part.
 ARC_STEP = math.radians(10.0)
@@ -81,6 +82,18 @@ def contact_pose(part_pose: ArrayLike, point: ArrayLike, normal: ArrayLike, gap:
     local = np.asarray(point, dtype=float) + gap * np.asarray(normal, dtype=float)
     x, y = transform_points(local[None], part_pose)[0]
     return np.array([x, y, float(wrap_angle(math.atan2(-normal[1], -normal[0]) + part_pose[2]))])
+
+
+def edge_contact_pose(slider: Slider, edge: int, part_pose: ArrayLike) -> np.ndarray:
+    """World pose of the pusher frame pushing ``edge``: face centred on the edge's midpoint, flush,
+    facing the part (:func:`planner.bodies.pusher_polygon`), with the part at ``part_pose``.
+
+    >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+    >>> edge_contact_pose(block, 0, [0.0, 0.0, 0.0]).round(12).tolist()
+    [0.0, 0.0, 1.570796326795]
+    """
+    a, b = slider.edge(edge)
+    return contact_pose(part_pose, (a + b) / 2, -slider.inward_normal(edge))
 
 
 def transit_pieces(transit: Transit) -> list[tuple[np.ndarray, bool]]:

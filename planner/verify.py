@@ -57,7 +57,7 @@ from .bodies import transform_points
 from .fields import SceneError
 from .plan_file import Plan, Segment, Transit
 from .scene import Scene
-from .transit import contact_pose
+from .transit import edge_contact_pose
 
 __all__ = ["TOLERANCE", "PushCheck", "Verification", "distributions", "verify"]
 
@@ -278,8 +278,7 @@ def _check_transit(scene: Scene, transit: Transit, edge: int | None, name: str) 
             ("to_edge", "ends", transit.to_edge, transit.pusher_path[-1]))
     for field, verb, e, pose in ends:
         _allowed_edge(scene, e, f"{name}.{field}")
-        a, b = scene.slider.edge(e)
-        flush = contact_pose(transit.pose, (a + b) / 2, -scene.slider.inward_normal(e))
+        flush = edge_contact_pose(scene.slider, e, transit.pose)
         if _off(scene, pose, flush):
             raise SceneError(f"{name}.pusher_path", f"{verb} at {np.round(pose, 6).tolist()}, not at the contact "
                                                     f"pose on edge {e}: {np.round(flush, 6).tolist()}")

@@ -21,7 +21,7 @@ import pytest
 import shapely
 import yaml
 
-from oracle import LPOracle, Reference, support_samples
+from oracle import Reference, guaranteed_stable
 from replay import advance, angle_diff, flush_pose, interpolate, max_point_speed, place, pusher_body, pusher_rectangle
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -129,12 +129,8 @@ def test_plan_replays(planned):
         # turn's centre beyond the part along the edge (Theorem 4).
         ref = Reference(verts, cf, edge, pusher["mu"], width=pusher["width"])
         np.testing.assert_allclose(sorted(map(tuple, seg["contact"])), sorted(map(tuple, [ref.eL, ref.eR])), atol=1e-12)
-        v = np.asarray(seg["twist"])
-        assert LPOracle(ref, support_samples(verts, 12)).max_violation(v) <= 1e-9, f"push {seg} is not stable"
-        if v[2] != 0:
-            along = verts @ ref.t
-            c_t = np.array([-v[1], v[0]]) / v[2] @ ref.t
-            assert (c_t <= along.min()) if v[2] > 0 else (c_t >= along.max()), f"push {seg} may pivot"
+        assert guaranteed_stable(verts, cf, edge, pusher["mu"], pusher["width"], seg["twist"]), \
+            f"push {seg} is not stable for every support distribution, or may pivot"
         # Motion: the end is start * exp(twist * duration); sample it densely against obstacles.
         body = [verts, pusher_body(verts, edge, pusher["width"], pusher["depth"])]
         speed = max(max_point_speed(b, seg["twist"]) for b in body)

@@ -134,7 +134,7 @@ def test_the_plan_command_honours_its_time_limit_on_a_200_gon(empty_cache, tmp_p
 
 
 def test_no_room_for_the_pusher_is_found_before_any_region(monkeypatch):
-    from planner import load_scene, plan
+    from planner import plan
 
     def never(*args, **kwargs):
         raise AssertionError("an exact region was computed")
