@@ -10,8 +10,9 @@ the stored one. Then the goal ratios of issue 10: median and largest per-edge ex
 region cache against a warm one (goal <= 1.5) and the warm run against importing the
 dependencies, ``python -c "import ompl, fcl, rerun, scipy"`` (goal <= 1.5).
 
-``--record FILE`` also writes the same cases with the current algorithm's regions and times (and
-the plan timings): the reference for the next change of the construction.
+``--plan-only`` skips the cases and prints the plan timings alone. ``--record FILE`` also writes
+the same cases with the current algorithm's regions and times (and the plan timings): the
+reference for the next change of the construction.
 """
 
 from __future__ import annotations
@@ -88,15 +89,11 @@ def _area_ratio(polygon: shapely.Geometry, stored: list) -> float:
     return float(polygon.area / old.area)
 
 
-def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="python -m mechanics.bench", description=__doc__.splitlines()[0])
-    p.add_argument("--reference", type=Path, default=REFERENCE, help="stored regions (default: %(default)s)")
-    p.add_argument("--runs", type=int, default=3, help="plan runs of each kind (median; 0: skip the plan timings)")
-    p.add_argument("--record", type=Path, metavar="FILE", help="write the current regions and times to FILE")
-    args = p.parse_args(argv)
-    reference = json.loads(args.reference.read_text())
-    cases = reference["cases"]
+def _regions(cases: list[dict], record: bool) -> None:
+    """Print the table of the stored cases and the per-edge goals; with ``record``, store the
+    current regions and times into ``cases``."""
     print(f"{'case':<22}{'STABLE[us]':>11}{'exact before[s]':>16}{'exact now[s]':>13}{'area new/old':>13}  also")
+    before = [c["exact_seconds"] for c in cases]
     now, ratios = [], []
     for case in cases:
         stable, exact, polygon, centre = measure(case)
@@ -105,13 +102,26 @@ def main(argv: list[str] | None = None) -> int:
         ratios.append(ratio)
         print(f"{case['name']:<22}{stable * 1e6:>11.0f}{case['exact_seconds']:>16.2f}{exact:>13.3f}{ratio:>13.4f}  "
               f"{' '.join(case['also'])}", flush=True)
-        if args.record:
+        if record:
             case.update(stable_seconds=stable, exact_seconds=exact, centre=centre.tolist(),
                         polygon=np.asarray(polygon.exterior.coords).tolist() if polygon.area > 0 else [])
-    before = [c["exact_seconds"] for c in cases]
     print(f"\nexact per edge, cold: median {statistics.median(now):.3f} s (goal <= {GOALS['median']}; before "
           f"{statistics.median(before):.2f} s), max {max(now):.3f} s (goal <= {GOALS['max']}; before {max(before):.2f} s)")
     print(f"area new/old: min {min(ratios):.4f} (goal >= 0.99), median {statistics.median(ratios):.4f}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m mechanics.bench", description=__doc__.splitlines()[0])
+    p.add_argument("--reference", type=Path, default=REFERENCE, help="stored regions (default: %(default)s)")
+    p.add_argument("--runs", type=int, default=3, help="plan runs of each kind (median; 0: skip the plan timings)")
+    p.add_argument("--record", type=Path, metavar="FILE", help="write the current regions and times to FILE")
+    p.add_argument("--plan-only", action="store_true", help="only the plan timings (not with --record)")
+    args = p.parse_args(argv)
+    if args.plan_only and args.record:
+        p.error("--record needs the regions too: drop --plan-only")
+    reference = json.loads(args.reference.read_text())
+    if not args.plan_only:
+        _regions(reference["cases"], args.record is not None)
     if args.runs > 0:
         was = reference["plan_seconds"]
         print(f"plan scenes/parking.yaml, wall medians of {args.runs} (before: {was['cold']:.2f} s, {was['warm']:.2f} s, "

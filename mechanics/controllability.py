@@ -25,7 +25,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import linprog
 
 __all__ = ["Controllability", "controllability"]
 
@@ -164,6 +163,9 @@ def _best_pair(unit: np.ndarray, tol: float) -> tuple[int, int] | None:
 def _in_cone(unit: np.ndarray, target: np.ndarray) -> np.ndarray | None:
     """Nonnegative weights of the rows of ``unit`` summing to ``target`` (a vertex of the LP, so
     at most three are nonzero), or ``None`` if there are none."""
+    # scipy.optimize takes a third of a second to import, and planning never asks for controllability.
+    from scipy.optimize import linprog
+
     res = linprog(np.zeros(len(unit)), A_eq=unit.T, b_eq=target, bounds=(0, None), method="highs")
     return res.x if res.status == 0 else None
 

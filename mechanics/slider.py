@@ -122,6 +122,32 @@ class Slider:
         """Indices of the edges on the convex hull."""
         return tuple(i for i in range(self.n) if self.is_pushable(i))
 
+    @cached_property
+    def turns(self) -> tuple[int, ...]:
+        """The part's rotational symmetries about its CF, as vertex shifts: each ``r`` in
+        ``1..n-1`` such that a rotation about the CF carries every vertex ``k`` onto vertex
+        ``k + r`` (mod ``n``), within ``1e-10`` of the radius. It carries edge ``k`` onto edge
+        ``k + r`` with everything that acts on it (part, CF, a pusher centred on the edge), so
+        the two edges' pushes are the same in each edge's own frame.
+
+        >>> Slider([[-2, -1], [2, -1], [2, 1], [-2, 1]]).turns   # a rectangle: the half turn
+        (2,)
+        >>> Slider([[-1, -1], [1, -1], [1, 1], [-1, 1]]).turns   # a square: quarter turns too
+        (1, 2, 3)
+        >>> Slider([[-2, -1], [2, -1], [2, 1], [-2, 1]], cf=[0.5, 0]).turns  # the CF off the centre
+        ()
+        """
+        rel = self.vertices - self.cf
+        angles = np.arctan2(rel[:, 1], rel[:, 0])
+        found = []
+        for r in range(1, self.n):
+            phi = angles[r] - angles[0]
+            c, s = np.cos(phi), np.sin(phi)
+            turned = rel @ np.array([[c, s], [-s, c]])  # each row rotated by phi
+            if np.all(np.linalg.norm(turned - np.roll(rel, -r, axis=0), axis=1) <= 1e-10 * self.radius):
+                found.append(r)
+        return tuple(found)
+
     def contact(self, i: int, width: float | None = None) -> np.ndarray:
         """The central part of edge ``i`` of length ``min(width, edge length)`` a flat face touches.
 

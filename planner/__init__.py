@@ -7,7 +7,9 @@ unknown for many goals, :func:`controllability` says what the stable pushes can 
 under many support distributions. Modules: :mod:`.scene` (file format), :mod:`.bodies` (slider +
 pusher geometry), :mod:`.validity` (fcl collision rule), :mod:`.pushes` (stable pushes per edge),
 :mod:`.one_step`, :mod:`.search` (OMPL), :mod:`.plan_file` (JSON), :mod:`.verify` (re-simulation),
-:mod:`.recording` (rerun), :mod:`.cli` (the ``plan`` command), :mod:`.bench`.
+:mod:`.recording` (rerun) and :mod:`.recorder` (written beside the search), :mod:`.cli` (the ``plan``
+command), :mod:`.geodesic` (a lower bound on any plan's length), and the benchmarks :mod:`.bench`,
+:mod:`.quality` and :mod:`.reach_bench`.
 """
 
 from .controllability import SceneControllability, controllability

@@ -142,46 +142,52 @@ def edge_car(push: EdgePush, cf: ArrayLike) -> EdgeCar | None:
 
 
 def _tightest(push: EdgePush, cf: np.ndarray) -> EdgeCar | None:
-    """The search behind :func:`edge_car`."""
+    """The search behind :func:`edge_car`, all headings of a sweep at once."""
     region = push.region
     span = region.translation_range
     if span is None:
         return None
     polygon, _ = region.section()
     inner = polygon.buffer(-_MARGIN)
+    shapely.prepare(inner)
     n = region.normal
     t = np.array([n[1], -n[0]])
-    def radius(angle: float) -> float:
-        """The least radius of the car heading at ``angle`` from the normal (inf if none)."""
-        heading = math.cos(angle) * n - math.sin(angle) * t
-        car = EdgeCar(push, cf, heading, math.inf)
+    arm = np.array([cf[1], -cf[0]])  # EdgeCar.twist: V(kappa) = (h + kappa arm, kappa)
 
-        def covered(kappa: float) -> bool:
-            ends = region.plane.points(car.twist([-kappa, kappa]))
-            return bool(np.all(np.isfinite(ends))) and inner.covers(shapely.LineString(ends))
+    def covered(h: np.ndarray, kappa: np.ndarray) -> np.ndarray:
+        """Whether each heading's segment of twists from -kappa to kappa lies in the region."""
+        k = kappa[:, None]
+        ends = region.plane.points(np.stack([np.c_[h - k * arm, -k], np.c_[h + k * arm, k]], axis=1))
+        finite = np.isfinite(ends).all(axis=(1, 2))
+        return finite & shapely.covers(inner, shapely.linestrings(np.where(finite[:, None, None], ends, 0.0)))
 
-        if not covered(0.0):
-            return math.inf
-        low, high = 0.0, 1.0 / push.region.scale
-        while covered(high):
-            low, high = high, 2.0 * high
+    def radii(angles: np.ndarray) -> np.ndarray:
+        """The least radius of the car heading at each angle from the normal (inf if none)."""
+        h = np.cos(angles)[:, None] * n - np.sin(angles)[:, None] * t
+        straight = covered(h, np.zeros(len(angles)))
+        low, high = np.zeros(len(angles)), np.full(len(angles), 1.0 / push.region.scale)
+        growing = np.flatnonzero(straight)
+        while growing.size:  # double until a curvature is not covered
+            more = covered(h[growing], high[growing])
+            growing = growing[more]
+            low[growing], high[growing] = high[growing], 2.0 * high[growing]
         for _ in range(_BISECTIONS):
             mid = 0.5 * (low + high)
-            low, high = (mid, high) if covered(mid) else (low, mid)
-        return 1.0 / low if low > 0 else math.inf
+            ok = covered(h, mid)
+            low, high = np.where(ok, mid, low), np.where(ok, high, mid)
+        with np.errstate(divide="ignore"):
+            return np.where(straight & (low > 0), 1.0 / low, math.inf)
 
     # A coarse sweep of the headings, then a finer one about the best: the radius varies smoothly
     # with the heading, and this costs a fifth of a fine sweep.
     grid = np.linspace(span[0], span[1], _HEADINGS)[1:-1]  # the ends lie on the boundary
-    radii = [radius(a) for a in grid]
-    k = int(np.argmin(radii))
+    k = int(np.argmin(radii(grid)))
     step = grid[1] - grid[0] if len(grid) > 1 else 0.0
     fine = np.linspace(grid[k] - step, grid[k] + step, 2 * _REFINE + 1)
     fine = fine[(fine > span[0]) & (fine < span[1])]
-    radii_fine = [radius(a) for a in fine]
+    radii_fine = radii(fine)
     j = int(np.argmin(radii_fine))
     if not math.isfinite(radii_fine[j]):
         return None
     angle = fine[j]
-    best = EdgeCar(push, cf, math.cos(angle) * n - math.sin(angle) * t, radii_fine[j])
-    return best
+    return EdgeCar(push, cf, math.cos(angle) * n - math.sin(angle) * t, float(radii_fine[j]))

@@ -22,16 +22,18 @@ import atexit
 import os
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 from .fields import shown
 from .plan_file import Plan, atomic_path, load_plan, write_atomic
 from .reachability import certify_unreachable
+from .recorder import recorder
 from .regions import cache_folder
-from .scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS,
-                    TRANSITS, PlannerOptions, Scene, SceneError, check_seed, check_time_limit, load_scene)
+from .scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_OPTIMIZE, MAX_SEED, MAX_TIME_LIMIT, PLANNERS,
+                    REGIONS, TRANSITS, PlannerOptions, Scene, SceneError, check_optimize, check_seed, check_time_limit,
+                    load_scene)
 from .search import plan
 from .verify import Verification, verify
 
@@ -50,9 +52,9 @@ exit codes:
 Defaults: a scene's planner: mapping (and pusher.transit) sets its own, which these options
 override; without them --planner {DEFAULT_PLANNER}, --time-limit {PlannerOptions.time_limit:g}, \
 --seed {PlannerOptions.seed}, --regions {DEFAULT_REGIONS}, --transit {DEFAULT_TRANSIT}.
-Exact regions are computed once per part (about 0.1-0.25 s an edge; the time limit bounds them
-and the search together, and they may take half of it) and cached in $STABLEPUSH_CACHE, else
-$XDG_CACHE_HOME/stablepush or ~/.cache/stablepush (here: {{cache}})."""
+Exact regions are computed once per part (about 0.1-0.25 s an edge, one per core at a time;
+the time limit bounds them and the search together, and they may take half of it) and cached in
+$STABLEPUSH_CACHE, else $XDG_CACHE_HOME/stablepush or ~/.cache/stablepush (here: {{cache}})."""
 
 
 def _silence_nanobind_leak_report() -> None:
@@ -80,6 +82,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--transit", choices=TRANSITS,
                    help=f"how the pusher may change edges: walk round the part, be lifted, or never "
                         f"(default: the scene's pusher.transit, else {DEFAULT_TRANSIT})")
+    p.add_argument("--optimize", type=int, metavar="N",
+                   help=f"after the first plan, N more searches (0..{MAX_OPTIMIZE}, each with its own seed drawn "
+                        "from --seed), keeping the cheapest plan (default: the scene's planner.optimize, else 0)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: logs/<name>-<timestamp>/)")
     p.add_argument("--verify", type=int, metavar="N",
                    help="re-simulate the plan under N support distributions; exit 3 if a push slips")
@@ -131,6 +136,8 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         scene = replace(scene, planner=replace(scene.planner, regions=args.regions))
     if args.transit:  # and verify checks a plan's lifts against it
         scene = replace(scene, pusher=replace(scene.pusher, transit=args.transit))
+    if args.optimize is not None:
+        scene = replace(scene, planner=replace(scene.planner, optimize=check_optimize(args.optimize, "--optimize")))
     out = Path(args.out) if args.out else _fresh_folder(Path("logs") / f"{scene.name}-{time.strftime('%Y%m%d-%H%M%S')}")
     try:
         taken = out.exists() and not out.is_dir()
@@ -156,6 +163,11 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _run(inputs: Inputs) -> int:
+    with recorder(inputs.scene) as write:  # rerun is imported beside the search, where it can be
+        return _plan_and_write(inputs, write)
+
+
+def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int:
     scene, out, name, seed, limit = inputs.scene, inputs.out, inputs.planner, inputs.seed, inputs.time_limit
     unreachable = None
     if inputs.given is not None:
@@ -183,7 +195,7 @@ def _run(inputs: Inputs) -> int:
         from .reachable_set import reachable_set
 
         reach = reachable_set(scene, inputs.reach)
-    _write_outputs(out, scene, result, check, reach)
+    _write_outputs(out, scene, result, check, reach, write_recording)
     if unreachable:
         print(f"plan: unreachable: {unreachable}", file=sys.stderr)
         return 2
@@ -192,13 +204,19 @@ def _run(inputs: Inputs) -> int:
         return 2
     head = (f"loaded {inputs.plan_path}: {result.contents()}{'' if result.solved else ' (not solved)'}"
             if inputs.given is not None
-            else f"solved: {result.contents()}, path length {result.path_length(scene.slider.cf):.3f} m, "
-                 f"planning time {result.planning_time_s:.2f} s")
+            else f"solved: {result.contents()}, path length {result.path_length(scene.slider.cf):.3f} m"
+                 f"{_first_found(scene, result)}, planning time {result.planning_time_s:.2f} s")
     print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{f', {scene.name}-reach.png' if reach else ''}")
     if check is None:
         return 0
     print("\n".join([*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]))
     return 0 if check.passed else 3
+
+
+def _first_found(scene: Scene, result: Plan) -> str:
+    """`` (first found 1.234 m)`` when improvement rounds shortened the plan, else nothing."""
+    improved = result.first_length is not None and result.first_length > result.path_length(scene.slider.cf)
+    return f" (first found {result.first_length:.3f} m)" if scene.planner.optimize and improved else ""
 
 
 def _progress(k: int, n: int) -> None:
@@ -215,11 +233,10 @@ def _fresh_folder(base: Path) -> Path:
     return out
 
 
-def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None, reach=None) -> None:
-    """Write the plan JSON and the recording (with ``check``'s ghost and ``reach``'s map) into
-    ``out``, creating it if need be, and ``reach``'s PNG if given."""
-    from .recording import write_recording  # rerun takes half a second to import
-
+def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None, reach,
+                   write_recording: Callable[..., None]) -> None:
+    """Write the plan JSON and the recording (with ``check``'s ghost and ``reach``'s map, by
+    ``write_recording``) into ``out``, creating it if need be, and ``reach``'s PNG if given."""
     try:
         out.mkdir(parents=True, exist_ok=True)
         write_atomic(out / f"{scene.name}.json", result.to_json())

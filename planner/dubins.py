@@ -210,19 +210,22 @@ class DubinsShortcut:
                 run += _halves(s)
                 continue
             if run:
-                alone = s is None and not out  # the whole plan is this run: any edge will do
-                out += _merge(self._shorten(run, list(self.curves) if alone else [run[0].edge]))
+                out += _merge(self._shorten(run, alone=s is None and not out))
                 run = []
             if s is not None:
                 out.append(s)
         return _rechain(out)
 
-    def _shorten(self, run: list[Segment], edges: list[int]) -> list[Segment]:
+    def _shorten(self, run: list[Segment], alone: bool) -> list[Segment]:
+        """``run`` (pushes on one edge) shortened; if it is the whole plan (``alone``), one curve
+        for all of it may be on any edge's car, since the pusher may start on any edge, but a
+        curve for part of it only on the run's edge: the pusher cannot change edges unseen."""
         waypoints = [s.start for s in run] + [run[-1].end]
         travelled = np.concatenate([[0.0], np.cumsum([s.cf_path_length(self.cf) for s in run])])
         out, i = [], 0
         while i < len(run):
             for j in range(len(run), i, -1):
+                edges = list(self.curves) if alone and (i, j) == (0, len(run)) else [run[0].edge]
                 found = self._curve(waypoints[i], waypoints[j], travelled[j] - travelled[i], edges)
                 if found is not None:
                     out += found

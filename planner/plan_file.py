@@ -180,6 +180,7 @@ class Plan:
     segments: list[Segment | Transit] = field(default_factory=list)
     reason: str = ""  # why it is not solved
     note: str = ""  # what the user should know of a plan made with less than asked (not in the file)
+    first_length: float | None = None  # CF path length of the first plan found, before improvement (not in the file)
     tree: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)), repr=False)  # search tree, world xy
 
     @property

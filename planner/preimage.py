@@ -15,6 +15,8 @@ nearest that pass, and each waypoint-to-goal push is checked once.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -34,60 +36,83 @@ _TRIES = 4  # waypoints collision-checked per state: this test runs on every new
 
 
 class GoalPreimage:
-    """Pushes from a pose to ``goal``: one push, or two through a waypoint.
+    """Pushes from a pose to a goal: one push, or two through a waypoint; for one goal or many.
+
+    Many goals share the work: their waypoints are screened in one vectorised pass, so a search
+    tree grown towards a batch of goals (:func:`planner.reachability`) tests each new state
+    against all of them at about the cost of one.
 
     Parameters
     ----------
-    goal : (3,) pose
+    goals : (3,) pose, or (m, 3) poses
     pushes : the allowed edges' pushes
     model : collision model with a body for each of those edges
     margin : clearance every push must keep
     radius : the part's radius, the unit of waypoint push lengths
     """
 
-    def __init__(self, goal: ArrayLike, pushes: list[EdgePush], model: CollisionModel, margin: float, radius: float):
-        self.goal = np.array([goal[0], goal[1], wrap_angle(goal[2])], dtype=float)
+    def __init__(self, goals: ArrayLike, pushes: list[EdgePush], model: CollisionModel, margin: float,
+                 radius: float):
+        self.goals = np.array(goals, dtype=float).reshape(-1, 3)
+        self.goals[:, 2] = wrap_angle(self.goals[:, 2])
         self.pushes, self.model, self.margin = pushes, model, margin
         controls = np.array([(0.5, 0.0)] + [(a, b) for a in _U1 for b in _U2])
+        legs = np.array(_LEGS) * radius
+        # Per edge: the waypoint pushes (unit speed: duration = distance) and, per goal, the
+        # waypoints themselves, back along each push from the goal, shape (m, n, 3).
         self._waypoints = []
         for push in pushes:
-            twists = push.control_twist(controls)  # unit speed: duration = distance
-            legs = np.array(_LEGS) * radius
-            w = np.repeat(twists, len(legs), axis=0)
-            tau = np.tile(legs, len(twists))
-            poses = exp_twist(self.goal, -w, tau)  # back along each push from the goal
-            self._waypoints.append((poses, w, tau))
-        self._last_leg: dict[tuple[int, int], Segment | None] = {}
+            w = np.repeat(push.control_twist(controls), len(legs), axis=0)
+            tau = np.tile(legs, len(controls))
+            self._waypoints.append((exp_twist(self.goals[:, None, :], -w, tau), w, tau))
+        self._last_leg: dict[tuple[int, int, int], Segment | None] = {}
+
+    @property
+    def goal(self) -> np.ndarray:
+        """The first (for one goal, the) goal."""
+        return self.goals[0]
 
     def connect(self, pose: ArrayLike, k: int) -> list[Segment] | None:
-        """Pushes of ``self.pushes[k]`` from ``pose`` to the goal (one or two), or None."""
-        push = self.pushes[k]
-        one = connect(pose, self.goal, push, self.model, self.margin)
-        if isinstance(one, Segment):
-            return [one]
-        poses, w, tau = self._waypoints[k]
-        first = log_pose(pose, poses)
-        ok = np.flatnonzero(push.region.contains(first))
-        if ok.size == 0:
-            return None
-        total = push.speed(first[ok]) + tau[ok]
-        for i in ok[np.argsort(total, kind="stable")][:_TRIES]:
-            last = self._final_push(k, int(i))
-            if last is None:
-                continue
-            lead = connect(pose, poses[i], push, self.model, self.margin)
-            if isinstance(lead, Segment):
-                return [lead, Segment(last.edge, last.contact, last.twist, last.duration, lead.end, last.end)]
-        return None
+        """Pushes of ``self.pushes[k]`` from ``pose`` to the first goal (one or two), or None."""
+        return self.connect_all(pose, k, [0]).get(0)
 
-    def _final_push(self, k: int, i: int) -> Segment | None:
-        """The push from waypoint ``i`` of edge ``k`` to the goal, if collision-free (cached)."""
-        if (k, i) not in self._last_leg:
+    def connect_all(self, pose: ArrayLike, k: int, goals: Sequence[int]) -> dict[int, list[Segment]]:
+        """Pushes of ``self.pushes[k]`` from ``pose`` to each of ``goals`` (indices) it can
+        reach by one or two pushes, by goal index."""
+        push = self.pushes[k]
+        goals = np.asarray(goals, dtype=int)
+        found: dict[int, list[Segment]] = {}
+        if goals.size == 0:
+            return found
+        poses, w, tau = self._waypoints[k]
+        # One screen for all: COR_total to each goal (column 0) and to each of its waypoints.
+        total = log_pose(pose, np.concatenate([self.goals[goals, None], poses[goals]], axis=1))
+        ok = push.region.contains(total.reshape(-1, 3)).reshape(total.shape[:2])
+        for row, g in enumerate(goals.tolist()):
+            if ok[row, 0] and isinstance(one := connect(pose, self.goals[g], push, self.model, self.margin), Segment):
+                found[g] = [one]
+                continue
+            candidates = np.flatnonzero(ok[row, 1:])
+            length = push.speed(total[row, 1 + candidates]) + tau[candidates]
+            for i in candidates[np.argsort(length, kind="stable")][:_TRIES]:
+                last = self._final_push(k, g, int(i))
+                if last is None:
+                    continue
+                lead = connect(pose, poses[g, i], push, self.model, self.margin)
+                if isinstance(lead, Segment):
+                    found[g] = [lead, Segment(last.edge, last.contact, last.twist, last.duration, lead.end, last.end)]
+                    break
+        return found
+
+    def _final_push(self, k: int, g: int, i: int) -> Segment | None:
+        """The push from waypoint ``i`` of edge ``k`` to goal ``g``, if collision-free (cached)."""
+        if (k, g, i) not in self._last_leg:
             poses, w, tau = self._waypoints[k]
             push = self.pushes[k]
-            free = self.model.push_is_free(poses[i], w[i], tau[i], push.edge, self.margin)
-            start = poses[i].copy()
+            free = self.model.push_is_free(poses[g, i], w[i], tau[i], push.edge, self.margin)
+            start = poses[g, i].copy()
             start[2] = wrap_angle(start[2])
-            self._last_leg[(k, i)] = (
-                Segment(push.edge, push.region.contact, w[i], float(tau[i]), start, self.goal.copy()) if free else None)
-        return self._last_leg[(k, i)]
+            self._last_leg[(k, g, i)] = (
+                Segment(push.edge, push.region.contact, w[i], float(tau[i]), start, self.goals[g].copy())
+                if free else None)
+        return self._last_leg[(k, g, i)]

@@ -10,7 +10,6 @@ that no point of the slider or pusher moves faster than 1 m/s. With that scale, 
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -20,7 +19,7 @@ from numpy.typing import ArrayLike
 from mechanics import DeadlineExceeded, ExactRegion, StableRegion, StableSteering, point_velocity, stable_region
 
 from .bodies import body_outline
-from .regions import edge_region, is_cached
+from .regions import compute_regions, edge_region, is_cached
 from .scene import Scene, SceneError
 
 __all__ = ["EdgePush", "RegionTimeout", "clearance_margin", "edge_pushes", "resolution"]
@@ -80,9 +79,9 @@ def edge_pushes(scene: Scene, deadline: float | None = None,
     ----------
     scene : Scene
     deadline : float, optional
-        A :func:`time.perf_counter` time by which the regions must be done: edges are computed in
-        order, the one running at the deadline is abandoned and those not begun are skipped, but
-        cached ones are still read.
+        A :func:`time.perf_counter` time by which the regions must be done: edges are begun in
+        order, one per core at a time (:func:`~planner.regions.compute_regions`), those running at
+        the deadline are abandoned and those not begun are skipped, but cached ones are still read.
     progress : callable, optional
         ``progress(k, n)`` is called before computing the ``k``-th (from 1) of the ``n`` regions
         that are not cached; regions read from the cache are not reported.
@@ -100,15 +99,13 @@ def edge_pushes(scene: Scene, deadline: float | None = None,
     p, slider = scene.pusher, scene.slider
     method, rho = scene.planner.regions, scene.cf_uncertainty
     todo = [e for e in p.edges if not is_cached(slider, e, p.mu, p.width, method, rho)]
+    computed = compute_regions(slider, todo, p.mu, p.width, rho, deadline, progress)
     out, pending = [], []
     for e in p.edges:
-        if e in todo:
-            if deadline is not None and time.perf_counter() > deadline:
-                pending.append(e)  # a cached edge after it still costs nothing
-                continue
-            if progress is not None:
-                progress(todo.index(e) + 1, len(todo))
-        try:
+        if e in todo and e not in computed:
+            pending.append(e)
+            continue
+        try:  # read from the cache, or computed again if its file turned out unreadable
             region = edge_region(slider, e, p.mu, p.width, method, rho, deadline)
         except DeadlineExceeded:
             pending.append(e)

@@ -6,10 +6,17 @@ behind turned round, 0.3 m behind) and the scene itself, for seeds ``1..runs``, 
 task the median length of the centre of friction's path, the lower bound, the Dubins length at
 the tightest car of the part's edges (:mod:`planner.car`) and their ratios.
 
-Lower bound: the straight-line distance between the start and goal positions of the centre of
-friction. It holds for any motion whatever (crab translations, switches), so it is sound; it is
-weak for tasks that must turn. The Dubins length is the shortest path of the best edge's car: a
-bound for plans that stay on one edge's car, not for plans that crab or switch.
+Lower bound (:func:`planner.geodesic.geodesic_bound`): the length of the shortest path the centre
+of friction can take at all. The disk of radius ``rho`` about the CF (``rho`` its distance to the
+part's boundary) lies inside the part, which never overlaps an obstacle nor leaves the workspace,
+so the CF stays in the workspace shrunk by ``rho`` outside the obstacles grown by ``rho``; the
+shortest path there (a visibility graph of that region's vertices), less how far the goal
+tolerance lets the CF end from its goal position, is at most the CF's path length of any plan
+whatever (any pushes, switches, crabbing). It is sound: the grown obstacles' round corners are
+polygons inside the true circles, which only enlarges the region and shortens its paths. On an
+empty table it is the straight line less that slack; it is weak for tasks that must turn. The
+Dubins length is the shortest path of the best edge's car: a bound for plans that stay on one
+edge's car, not for plans that crab or switch.
 """
 
 from __future__ import annotations
@@ -26,11 +33,12 @@ import numpy as np
 from ompl import base as ob
 
 from .car import edge_car
+from .geodesic import geodesic_bound
 from .pushes import edge_pushes
 from .scene import Scene, load_scene
 from .search import plan
 
-__all__ = ["TASKS", "dubins_length", "lower_bound", "open_task", "main"]
+__all__ = ["TASKS", "dubins_length", "open_task", "main"]
 
 #: Obstacle-free tasks: where the CF goes (metres, in the part's start frame) and the turn (degrees).
 TASKS = {"ahead+90": ((1.0, 0.0), 90.0), "side": ((0.0, 0.5), 0.0), "behind+180": ((-0.5, 0.0), 180.0),
@@ -49,17 +57,6 @@ def open_task(scene: Scene, task: str) -> Scene:
     return replace(scene, name=f"{scene.name}:{task}", obstacles=(), workspace=(-2.0, -2.0, 2.0, 2.0),
                    start=_pose_with_cf_at(scene, (0.0, 0.0), 0.0),
                    goal=_pose_with_cf_at(scene, target, math.radians(turn)), path=None)
-
-
-def lower_bound(scene: Scene) -> float:
-    """Straight-line distance the CF must at least travel (sound for every motion)."""
-    c = scene.slider.cf
-
-    def cf(pose):
-        co, si = math.cos(pose[2]), math.sin(pose[2])
-        return np.array([pose[0] + co * c[0] - si * c[1], pose[1] + si * c[0] + co * c[1]])
-
-    return float(np.linalg.norm(cf(scene.goal) - cf(scene.start)))
 
 
 def dubins_length(scene: Scene) -> float:
@@ -85,7 +82,7 @@ def _run(job: tuple[str, str, int, float]) -> tuple[str, str, bool, float, int, 
         scene = open_task(scene, task)
     result = plan(scene, seed=seed, time_limit=limit)
     return (path, task, result.solved, result.path_length(scene.slider.cf), result.pushes, result.switches,
-            result.planning_time_s, lower_bound(scene), dubins_length(scene))
+            result.planning_time_s, geodesic_bound(scene), dubins_length(scene))
 
 
 def main(argv: list[str] | None = None) -> int:

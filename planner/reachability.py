@@ -31,8 +31,9 @@ A start within tolerance of the goal is reachable by no push at all, and no cert
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
@@ -41,18 +42,21 @@ from numpy.typing import ArrayLike
 from mechanics import wrap_angle
 
 from .bodies import pusher_polygon, slider_at, transform_points
+from .geodesic import disk_free_space
 from .one_step import goal_verdicts
 from .plan_file import Plan
 from .pushes import EdgePush, edge_pushes
 from .scene import Scene, SceneError
-from .search import _within_tolerance, plan
+from .search import _within_tolerance, plan_batch
 from .validity import CollisionModel
+
+if TYPE_CHECKING:
+    from .controllability import SceneControllability
 
 __all__ = ["Reach", "certify_unreachable", "reachability"]
 
-#: Segments per quarter circle of shapely's round buffers. Their vertices lie on the true circle,
-#: so the polygon lies inside it; radii are divided by cos(pi / (4 QUAD_SEGS)) where the polygon
-#: must cover the circle instead.
+#: Segments per quarter circle of the free space grown by the tolerance's slack. The vertices lie
+#: on the true circle, so radii are divided by cos(pi / (4 QUAD_SEGS)) for the polygon to cover it.
 QUAD_SEGS = 16
 _COVER = 1.0 / math.cos(math.pi / (4 * QUAD_SEGS))
 #: The inscribed disk is taken this much smaller (relative), so that rounding never closes a gap
@@ -66,9 +70,10 @@ class Reach:
 
     ``status`` is ``'reachable'`` (``plan`` reaches the goal; ``pushes`` is its number of
     pushes, 1 when one push does), ``'unreachable'`` (``reason`` names the certificate) or
-    ``'unknown'`` (``reason`` says what ran out). ``verdicts`` is the one-step Goal1/2/3 label
-    per allowed edge (:func:`planner.one_step.goal_verdicts`), computed when first read: it costs
-    about 0.1 s, as much as finding most plans.
+    ``'unknown'`` (``reason`` says what ran out). ``verdicts`` (the one-step Goal1/2/3 label per
+    allowed edge, :func:`planner.one_step.goal_verdicts`) and ``controllability`` (the scene's,
+    :func:`planner.controllability`) are computed when first read: each costs about 0.1 s, as
+    much as finding most plans.
     """
 
     status: str
@@ -82,25 +87,33 @@ class Reach:
     def verdicts(self) -> dict[int, str]:
         return goal_verdicts(self.scene, self.scene.start, self.goal)
 
+    @cached_property
+    def controllability(self) -> SceneControllability:
+        """What the scene's edges can do anywhere on an empty table (Lynch & Mason 1996, Props
+        1-4): why an 'unknown' answer may still be reachable, or why a part goes nowhere.
+
+        >>> from planner import load_scene
+        >>> [answer] = reachability(load_scene("scenes/battery.yaml"))
+        >>> answer.controllability.summary().split(";")[0]
+        'controllable (edge 3)'
+        """
+        from .controllability import controllability  # its scipy is not needed for the answer
+
+        return controllability(self.scene)
+
 
 class _Certificates:
     """The geometric certificates 1-3 for one scene, its free space computed once for many goals."""
 
     def __init__(self, scene: Scene):
         self.scene = scene
-        workspace = shapely.box(*scene.workspace)
-        obstacles = shapely.union_all(scene.obstacles)
-        self.free = workspace.difference(obstacles)
+        self.free = shapely.box(*scene.workspace).difference(shapely.union_all(scene.obstacles))
         self._grown: dict[float, shapely.Geometry] = {}
         circle = shapely.maximum_inscribed_circle(scene.slider.polygon)
         self.centre, self.radius = np.asarray(circle.coords[0]), circle.length
-        r = self.radius * (1.0 - DISK_SHRINK)
-        xmin, ymin, xmax, ymax = scene.workspace
-        # The grown obstacles' polygons lie inside the true ones, so this region only gets larger
-        # (more connected) than the true one: sound.
-        room = shapely.box(xmin + r, ymin + r, xmax - r, ymax - r) if 2 * r < min(xmax - xmin, ymax - ymin) \
-            else shapely.Polygon()
-        disk_free = room.difference(obstacles.buffer(r, quad_segs=QUAD_SEGS))
+        # It contains the true free space of the disk (inscribed round corners), so it is only more
+        # connected than the true one: sound.
+        disk_free = disk_free_space(scene, self.radius * (1.0 - DISK_SHRINK))
         self.pieces = list(getattr(disk_free, "geoms", [disk_free]))
 
     def _slack(self, points: ArrayLike) -> float:
@@ -116,7 +129,7 @@ class _Certificates:
 
     def __call__(self, goal: np.ndarray) -> str | None:
         scene = self.scene
-        if _within_tolerance(replace(scene, goal=goal), scene.start):
+        if _within_tolerance(scene, scene.start, goal):
             return None
         part = scene.slider.polygon
         if self._stuck(slider_at(part, goal), self._slack(scene.slider.vertices)):
@@ -159,7 +172,7 @@ def certify_unreachable(scene: Scene, goal: ArrayLike | None = None, *, regions:
     """
     goal = _goal(scene.goal if goal is None else goal)
     reason = _Certificates(scene)(goal)
-    if reason is None and regions and not _within_tolerance(replace(scene, goal=goal), scene.start):
+    if reason is None and regions and not _within_tolerance(scene, scene.start, goal):
         reason = _no_stable_push(scene)[1]
     return reason
 
@@ -174,11 +187,14 @@ def reachability(scene: Scene, goals: ArrayLike | None = None, *, pushes: int | 
                  time_limit: float | None = None, seed: int | None = None) -> list[Reach]:
     """One :class:`Reach` per goal (rows ``(x, y, theta)``, radians; default: the scene's goal).
 
-    Each goal gets the certificates, then :func:`planner.plan` (whose first step is the one- and
-    two-push connection, so one stable push, when there is one, gives a 1-push plan) with
-    ``time_limit`` and ``seed`` (default: the scene's). ``pushes`` is a budget: a plan with more
-    pushes is answered ``'unknown'``. The goals share the stable regions (computed in full first,
-    and cached per part), the collision model and the free-space geometry.
+    Each goal gets the certificates; the goals left get :func:`planner.search.plan_batch`: first
+    the one- and two-push connection from the start (so one stable push, when there is one, gives
+    a 1-push plan), then one search tree grown towards all of them at once, for at most
+    ``time_limit`` seconds in all (default: the scene's), seeded by ``seed`` (default: the
+    scene's). ``pushes`` is a budget: a plan with more pushes is answered ``'unknown'``. The goals
+    share the stable regions (computed in full first, and cached per part), the collision model,
+    the free-space geometry and the search tree, so a batch costs far less than a :func:`plan`
+    per goal (``python -m planner.reach_bench`` measures it).
 
     >>> from planner import load_scene
     >>> scene = load_scene("scenes/battery.yaml")
@@ -195,21 +211,25 @@ def reachability(scene: Scene, goals: ArrayLike | None = None, *, pushes: int | 
         raise SceneError("goals", f"must be finite (x, y, theta) rows, got an array of shape {rows.shape}")
     certificates = _Certificates(scene)
     edge_set, no_push = _no_stable_push(scene)
-    model = CollisionModel(scene, scene.pusher.edges)
+    goals = [_goal(row) for row in rows]
+    reasons = [certificates(goal) or (no_push if not _within_tolerance(scene, scene.start, goal) else None)
+               for goal in goals]
+    open_goals = [i for i, reason in enumerate(reasons) if reason is None]
+    plans: dict[int, Plan] = {}
+    if edge_set is None:  # every open goal is the start, and nothing can be pushed: no push needed
+        plans = {i: Plan(scene.path, True, scene.planner.name, scene.planner.seed if seed is None else seed, 0.0,
+                         scene.start.copy(), goals[i]) for i in open_goals}
+    elif open_goals:
+        model = CollisionModel(scene, scene.pusher.edges)
+        found = plan_batch(scene, [goals[i] for i in open_goals], seed=seed, time_limit=time_limit,
+                           prebuilt=(edge_set, model))
+        plans = dict(zip(open_goals, found))
     answers = []
-    for row in rows:
-        goal = _goal(row)
-        at = replace(scene, goal=goal)
-        reason = certificates(goal) or (no_push if not _within_tolerance(at, scene.start) else None)
-        if reason is not None:
-            answers.append(Reach("unreachable", None, reason, None, scene, goal))
-            continue
-        if edge_set is None:  # the start is the goal, and nothing can be pushed: no push needed
-            found = Plan(scene.path, True, scene.planner.name, scene.planner.seed if seed is None else seed, 0.0,
-                         scene.start.copy(), goal)
-        else:
-            found = plan(at, seed=seed, time_limit=time_limit, prebuilt=(edge_set, model))
-        if not found.solved:
+    for i, goal in enumerate(goals):
+        found = plans.get(i)
+        if found is None:
+            answers.append(Reach("unreachable", None, reasons[i], None, scene, goal))
+        elif not found.solved:
             answers.append(Reach("unknown", found, found.reason, None, scene, goal))
         elif pushes is not None and found.pushes > pushes:
             answers.append(Reach("unknown", found, f"the plan found has {found.pushes} pushes, more than the budget "

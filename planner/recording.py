@@ -70,6 +70,8 @@ above the text log.
 
 from __future__ import annotations
 
+import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -83,8 +85,8 @@ from mechanics import (ContactConfiguration, Slider, SupportModel, contact_wrenc
                        force_status_regions, twist_to_cor)
 
 from .bodies import pusher_frame_body
-from .plan_file import Plan, Segment, Transit, atomic_path
-from .regions import edge_region
+from .plan_file import Plan, Segment, Transit, atomic_path, write_atomic
+from .regions import cache_folder, cache_key, edge_region, is_cached
 from .scene import Scene
 from .transit import edge_contact_pose, transit_pieces, transit_poses
 
@@ -92,7 +94,8 @@ if TYPE_CHECKING:  # the simulator behind it imports most of scipy: not needed t
     from .reachable_set import ReachableSet
     from .verify import Verification
 
-__all__ = ["ANALYSIS_RAYS", "FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS", "write_recording"]
+__all__ = ["ANALYSIS_RAYS", "FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS", "prepare",
+           "write_recording"]
 
 #: Animation frames while a body point travels one slider radius (fewer if that exceeds MAX_FRAMES).
 FRAMES_PER_RADIUS = 20
@@ -245,28 +248,88 @@ def _rings(geometry: shapely.Geometry) -> list[np.ndarray]:
     return [np.asarray(g.exterior.coords) for g in parts if isinstance(g, shapely.Polygon) and g.area > 0]
 
 
-def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
-    """``/analysis``: the first pushed edge's regions in the slider frame (module docstring)."""
+class _Analysis(NamedTuple):
+    """What ``/analysis`` shows of one edge, in the slider frame: the window, the contact
+    segment, and polygons by name ('stable', 'exact': COR regions; 'P', 'U', 'I': force status
+    of sticking) and sense (1 CCW, -1 CW)."""
+
+    window: tuple[float, float, float, float]
+    contact: np.ndarray
+    polygons: dict[str, dict[int, shapely.Geometry]]
+
+
+#: Analyses computed in this process, by part, edge and pusher (see :func:`prepare`).
+_analyses: dict[str, _Analysis] = {}
+
+
+def _analysis(scene: Scene, edge: int) -> _Analysis:
+    """The analysis of ``edge``: from this process's memory, else from the disk cache beside the
+    stable regions (:mod:`planner.regions`, as WKB), else computed (0.1 s) and kept in both."""
     slider, p = scene.slider, scene.pusher
-    pushes = [s for s in plan.segments if s.kind == "push"]
-    edge = pushes[0].edge
-    window = (*(slider.cf - 4 * slider.radius), *(slider.cf + 4 * slider.radius))
+    key = cache_key("analysis", slider, edge, p.mu, p.width, scene.cf_uncertainty, rays=ANALYSIS_RAYS)
+    if key in _analyses:
+        return _analyses[key]
+    path = cache_folder() / f"analysis-{key}.json"
+    try:
+        data = json.loads(path.read_text())
+        found = _Analysis(tuple(data["window"]), np.asarray(data["contact"], dtype=float),
+                          {name: {int(sense): shapely.from_wkb(bytes.fromhex(wkb)) for sense, wkb in by.items()}
+                           for name, by in data["polygons"].items()})
+    except (OSError, ValueError, KeyError, TypeError, shapely.errors.GEOSException):
+        found = _compute_analysis(scene, edge)
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write_atomic(path, json.dumps({
+                "window": list(found.window), "contact": found.contact.tolist(),
+                "polygons": {name: {str(sense): shapely.to_wkb(g, hex=True) for sense, g in by.items()}
+                             for name, by in found.polygons.items()}}))
+        except OSError:
+            pass  # a read-only home: compute again next time
+    _analyses[key] = found
+    return found
+
+
+def _compute_analysis(scene: Scene, edge: int) -> _Analysis:
+    slider, p = scene.slider, scene.pusher
+    window = (*(slider.cf - 4 * slider.radius).tolist(), *(slider.cf + 4 * slider.radius).tolist())
     # The exact region whatever the plan used (cached): the view compares it with STABLE's.
-    regions = {"stable": edge_region(slider, edge, p.mu, p.width, "stable").cor_polygons(window),
-               "exact": edge_region(slider, edge, p.mu, p.width, "exact", scene.cf_uncertainty).cor_polygons(window)}
+    polygons = {"stable": edge_region(slider, edge, p.mu, p.width, "stable").cor_polygons(window),
+                "exact": edge_region(slider, edge, p.mu, p.width, "exact", scene.cf_uncertainty).cor_polygons(window)}
     config = ContactConfiguration.slider_edge(slider, edge, p.mu, p.width)
     support = SupportModel.of_slider(slider, cf_radius=scene.cf_uncertainty)  # as the plan's regions
     status = force_status_regions(contact_wrench_cone(config, "ss"), support, window,
                                   rays=ANALYSIS_RAYS, steps=6, refinements=0)
-    rec.log("analysis/part", rr.LineStrips2D([_closed(slider.vertices)], colors=_SLIDER, radii=_BOLD), static=True)
-    rec.log("analysis/contact", rr.LineStrips2D([config.points], colors=_DARK, radii=_BOLD), static=True)
+    polygons |= {label: {sense: status[sense][label] for sense in (1, -1)} for label in _STATUS}
+    return _Analysis(window, np.asarray(config.points, dtype=float), polygons)
+
+
+def prepare(scene: Scene, stop: Callable[[], bool]) -> None:
+    """Compute ahead of :func:`write_recording`, in this process, the analysis of each allowed
+    edge whose stable region is cached, one after another until ``stop()`` says a plan has come
+    (the first pushed edge is one of them; :mod:`planner.recorder` runs this beside the search)."""
+    p = scene.pusher
+    for edge in p.edges:
+        if stop():
+            return
+        if is_cached(scene.slider, edge, p.mu, p.width, "exact", scene.cf_uncertainty):
+            _analysis(scene, edge)
+
+
+def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
+    """``/analysis``: the first pushed edge's regions in the slider frame (module docstring)."""
+    pushes = [s for s in plan.segments if s.kind == "push"]
+    edge = pushes[0].edge
+    window, contact, polygons = _analysis(scene, edge)
+    rec.log("analysis/part", rr.LineStrips2D([_closed(scene.slider.vertices)], colors=_SLIDER, radii=_BOLD),
+            static=True)
+    rec.log("analysis/contact", rr.LineStrips2D([contact], colors=_DARK, radii=_BOLD), static=True)
     for name, width in (("stable", _BOLD), ("exact", _LINE)):
         for side, colour in (("ccw", _CCW), ("cw", _CW)):
-            rings = _rings(regions[name][1 if side == "ccw" else -1])
+            rings = _rings(polygons[name][1 if side == "ccw" else -1])
             rec.log(f"analysis/{name}/{side}", rr.LineStrips2D(rings, colors=colour, radii=width), static=True)
     for side, sense in (("ccw", 1), ("cw", -1)):
         for label, colour in _STATUS.items():
-            rings = _rings(status[sense][label])
+            rings = _rings(polygons[label][sense])
             rec.log(f"analysis/sticking/{side}/{label}", rr.LineStrips2D(rings, colors=colour, radii=_THIN), static=True)
     cors = [c for c, sense in map(twist_to_cor, (s.twist for s in pushes if s.edge == edge)) if sense != 0]
     inside = [c for c in cors if shapely.box(*window).contains(shapely.Point(c))]  # far ones would zoom the view out

@@ -23,7 +23,7 @@ from .fields import Limit, SceneError, integer, keys, member, number, shown, vec
 
 __all__ = ["ANGLE", "LENGTH", "MAX_NODES", "MAX_SCENE_BYTES", "MIN_SIZE", "MU_RANGE",
            "DEFAULT_PLANNER", "DEFAULT_REGIONS", "DEFAULT_SWITCH_COST", "DEFAULT_TRANSIT", "REGIONS", "TRANSITS",
-           "check_switch_cost", "check_transit", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
+           "check_optimize", "check_switch_cost", "check_transit", "MAX_OPTIMIZE", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
            "check_regions", "check_seed", "check_time_limit", "load_scene", "parse_scene", "PLANNERS"]
 
 PLANNERS = ("rrt", "kpiece", "est")
@@ -43,6 +43,8 @@ DEFAULT_SWITCH_COST = 0.25
 DEFAULT_PLANNER = "rrt"
 #: Seeds are OMPL's ``std::uint_fast32_t``: 32 bits is the most every platform takes.
 MAX_SEED = 2**32 - 1
+#: Most improvement rounds (``planner.optimize``): each is a search as long as the first.
+MAX_OPTIMIZE = 100
 #: One day. OMPL's deadline (now + limit) overflows for limits of some years and then ends the
 #: search at once, so a huge or infinite limit would report failure without having searched.
 MAX_TIME_LIMIT = 86400.0
@@ -91,6 +93,7 @@ class PlannerOptions:
     seed: int = 1
     regions: str = DEFAULT_REGIONS
     switch_cost: float = DEFAULT_SWITCH_COST
+    optimize: int = 0  # improvement rounds after the first plan (planner.search.plan)
 
 
 @dataclass(frozen=True)
@@ -446,13 +449,15 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     tol = keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
     tol_pos = number(tol.get("position", 0.01), "tolerance.position", positive=True, limit=LENGTH)
     tol_ang = math.radians(number(tol.get("angle", 2.0), "tolerance.angle", positive=True, limit=ANGLE))
-    opts = keys(spec.get("planner", {}), "planner", (), ("name", "time_limit", "seed", "regions", "switch_cost"))
+    opts = keys(spec.get("planner", {}), "planner", (),
+                ("name", "time_limit", "seed", "regions", "switch_cost", "optimize"))
     planner = PlannerOptions(
         name=_one_of(opts.get("name", DEFAULT_PLANNER), PLANNERS, "planner.name"),
         time_limit=check_time_limit(opts.get("time_limit", PlannerOptions.time_limit), "planner.time_limit"),
         seed=check_seed(opts.get("seed", PlannerOptions.seed), "planner.seed"),
         regions=check_regions(opts.get("regions", DEFAULT_REGIONS), "planner.regions"),
         switch_cost=check_switch_cost(opts.get("switch_cost", DEFAULT_SWITCH_COST), "planner.switch_cost"),
+        optimize=check_optimize(opts.get("optimize", PlannerOptions.optimize), "planner.optimize"),
     )
     return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path,
                  cf_uncertainty)
@@ -507,6 +512,23 @@ def check_switch_cost(value: Any, name: str) -> float:
     if cost < 0:
         raise SceneError(name, f"must be >= 0, got {shown(value)}")
     return cost
+
+
+def check_optimize(value: Any, name: str) -> int:
+    """``value`` as a number of improvement rounds (0..:data:`MAX_OPTIMIZE`); else a
+    :class:`SceneError` naming ``name``.
+
+    >>> check_optimize(3, "planner.optimize")
+    3
+    >>> check_optimize(-1, "--optimize")
+    Traceback (most recent call last):
+    ...
+    planner.fields.SceneError: --optimize: must be an integer in 0..100, got -1
+    """
+    rounds = integer(value, name)
+    if not 0 <= rounds <= MAX_OPTIMIZE:
+        raise SceneError(name, f"must be an integer in 0..{MAX_OPTIMIZE}, got {rounds}")
+    return rounds
 
 
 def check_seed(value: Any, name: str) -> int:

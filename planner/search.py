@@ -30,9 +30,11 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import replace
+from collections.abc import Iterator
 from typing import Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 from ompl import base as ob
 from ompl import control as oc
 from ompl import util as ou
@@ -44,11 +46,12 @@ from .one_step import connect
 from .plan_file import Plan, Segment
 from .preimage import GoalPreimage
 from .pushes import EdgePush, RegionTimeout, clearance_margin, edge_pushes, resolution
-from .scene import Scene, SceneError, check_regions, check_switch_cost, check_transit
+from .scene import MAX_SEED, Scene, SceneError, check_optimize, check_regions, check_switch_cost, check_transit
 from .transit import TransitPlanner
-from .validity import CollisionModel
+from .validity import CollisionModel, pose_along
 
-__all__ = ["plan", "MAX_CONTROL_STEPS", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS", "SWITCH_SHARE"]
+__all__ = ["plan", "plan_batch", "MAX_CONTROL_STEPS", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
+           "ROUND_ITERATIONS", "SWITCH_SHARE"]
 #: Longest constant push the planners sample, in collision-check steps.
 MAX_CONTROL_STEPS = 30
 #: Share of sampled controls that switch edges, when switching is allowed.
@@ -57,7 +60,12 @@ SWITCH_SHARE = 0.1
 #: iterations the first search used (at least ``ONE_EDGE_MIN_ITERATIONS``): its iterations cost
 #: about a fifth as much (no transits to find), but one edge alone usually needs more of them.
 ONE_EDGE_ITERATIONS, ONE_EDGE_MIN_ITERATIONS = 4, 1000
+#: An improvement round (``optimize``) gets this many times the first search's iterations (and
+#: at least ``ONE_EDGE_MIN_ITERATIONS``).
+ROUND_ITERATIONS = 2
 
+_ROUND_SEEDS = 1_000_003
+_RECHECK = "the final push failed its re-check after rounding"
 _PLANNERS: dict[str, Callable] = {"rrt": oc.RRT, "kpiece": oc.KPIECE1, "est": oc.EST}
 
 
@@ -91,33 +99,53 @@ class _PoseProjection(ob.ProjectionEvaluator):
         out[0], out[1], out[2] = p.getX(), p.getY(), p.getYaw() * self.radius
 
 
-def _within_tolerance(scene: Scene, pose: np.ndarray) -> bool:
-    g = scene.goal
+def _within_tolerance(scene: Scene, pose: np.ndarray, goal: np.ndarray | None = None) -> bool:
+    g = scene.goal if goal is None else goal
     return (math.hypot(pose[0] - g[0], pose[1] - g[1]) <= scene.tolerance_position
             and abs(float(wrap_angle(pose[2] - g[2]))) <= scene.tolerance_angle)
 
 
-def _to_goal(preimage: GoalPreimage, transits: TransitPlanner | None, pose: np.ndarray, k: int) -> list | None:
-    """One or two pushes on edge index ``k`` from ``pose`` to the goal, or else (with ``transits``)
-    a switch to another edge and one or two pushes on it; None if neither."""
-    last = preimage.connect(pose, k)
-    if last is not None or transits is None:
-        return last
+def _to_goals(preimage: GoalPreimage, transits: TransitPlanner | None, pose: np.ndarray, k: int,
+              goals: list[int]) -> dict[int, list]:
+    """Per goal index of ``goals`` that one or two pushes on edge index ``k`` reach from
+    ``pose``, those pushes; for the others (with ``transits``) a switch to another edge and one or
+    two pushes on it, where there is one."""
+    found = preimage.connect_all(pose, k, goals)
+    if transits is None:
+        return found
     for other, push in enumerate(preimage.pushes):
-        if other != k and (last := preimage.connect(pose, other)) is not None:
-            transit = transits.find(pose, preimage.pushes[k].edge, push.edge)
-            if transit is not None:
-                return [transit, *last]
-    return None
+        rest = [g for g in goals if g not in found]
+        if not rest:
+            break
+        if other == k or not (lasts := preimage.connect_all(pose, other, rest)):
+            continue
+        transit = transits.find(pose, preimage.pushes[k].edge, push.edge)
+        if transit is not None:
+            found.update({g: [transit, *last] for g, last in lasts.items()})
+    return found
+
+
+def _to_goal(preimage: GoalPreimage, transits: TransitPlanner | None, pose: np.ndarray, k: int,
+             goal: int = 0) -> list | None:
+    """:func:`_to_goals` for one goal: its pushes (and switch), or None."""
+    return _to_goals(preimage, transits, pose, k, [goal]).get(goal)
 
 
 class _PushGoal(ob.GoalSampleableRegion):
-    """Within the scene tolerance of the goal, or in its preimage under one or two stable pushes
-    (after a switch of edge, when switching is allowed)."""
+    """Within the scene tolerance of a goal, or in its preimage under one or two stable pushes
+    (after a switch of edge, when switching is allowed).
+
+    The goals are the preimage's; ``active`` (indices) are those still sought. A state that
+    reaches some of them is satisfied, and what it reaches is kept in ``hits``, keyed by the
+    state, so that the search that stops there knows which goals its path serves (their pushes
+    are found again from the path's re-composed end).
+    """
 
     def __init__(self, si, scene: Scene, preimage: GoalPreimage, transits: TransitPlanner | None):
         super().__init__(si)
         self.scene, self.preimage, self.transits = scene, preimage, transits
+        self.active = list(range(len(preimage.goals)))
+        self.hits: dict[tuple, list[int]] = {}
         self._samples = 0
         self.setThreshold(1e-9)  # OMPL accepts distances strictly below the threshold
 
@@ -126,26 +154,102 @@ class _PushGoal(ob.GoalSampleableRegion):
         pose = np.array([p.getX(), p.getY(), p.getYaw()])
         if k >= len(self.preimage.pushes):  # the marker of a blocked switch
             return math.inf
-        if _within_tolerance(self.scene, pose) or _to_goal(self.preimage, self.transits, pose, k) is not None:
+        goals = self.preimage.goals[self.active]
+        # Within tolerance needs no pushes (None); the others get theirs, if any.
+        hits: dict[int, list | None] = {g: None for g, goal in zip(self.active, goals)
+                                        if _within_tolerance(self.scene, pose, goal)}
+        hits |= _to_goals(self.preimage, self.transits, pose, k, [g for g in self.active if g not in hits])
+        if hits:
+            self.hits[(*pose, k)] = list(hits)
             return 0.0
-        g = self.scene.goal
-        return math.hypot(pose[0] - g[0], pose[1] - g[1]) + self.scene.slider.radius * abs(
-            float(wrap_angle(pose[2] - g[2])))
+        return float(np.min(np.hypot(goals[:, 0] - pose[0], goals[:, 1] - pose[1])
+                            + self.scene.slider.radius * np.abs(wrap_angle(goals[:, 2] - pose[2]))))
 
     def sampleGoal(self, state) -> None:
-        state[0].setXY(float(self.scene.goal[0]), float(self.scene.goal[1]))
-        state[0].setYaw(float(wrap_angle(self.scene.goal[2])))
-        # Goal samples take turns among the edges, so goal bias pulls every edge's tree.
+        # Goal samples take turns among the edges (and the goals), so goal bias pulls every
+        # edge's tree towards every goal.
         self._samples += 1
-        state[1].value = self._samples % len(self.preimage.pushes)
+        n = len(self.preimage.pushes)
+        goal = self.preimage.goals[self.active[(self._samples // n) % len(self.active)]]
+        state[0].setXY(float(goal[0]), float(goal[1]))
+        state[0].setYaw(float(goal[2]))
+        state[1].value = self._samples % n
 
     def maxSampleCount(self) -> int:
         return 1
 
 
+class _Problem:
+    """What :func:`plan` and :func:`plan_batch` share for one scene: the options, the edges'
+    pushes, the collision model, the start edges, the transits and the shortcuts."""
+
+    def __init__(self, scene: Scene, seed: int | None, time_limit: float | None, planner: str | None,
+                 regions: str | None, transit: str | None, switch_cost: float | None,
+                 progress: Callable[[int, int], None] | None, prebuilt: tuple[list[EdgePush], CollisionModel] | None):
+        opts = scene.planner
+        if regions is not None:
+            opts = replace(opts, regions=check_regions(regions, "regions"))
+        if switch_cost is not None:
+            opts = replace(opts, switch_cost=check_switch_cost(switch_cost, "switch_cost"))
+        pusher = scene.pusher if transit is None else replace(scene.pusher, transit=check_transit(transit, "transit"))
+        self.scene = scene = replace(scene, planner=opts, pusher=pusher)
+        self.seed = opts.seed if seed is None else seed
+        self.time_limit = float(opts.time_limit if time_limit is None else time_limit)
+        self.name = opts.name if planner is None else planner
+        if self.name not in _PLANNERS:
+            raise SceneError("planner", f"must be one of {', '.join(_PLANNERS)}, got {self.name!r}")
+        self.clock = time.perf_counter()
+        self.deadline = self.clock + self.time_limit  # for the regions and the search alike
+        self.step, self.margin = resolution(scene), clearance_margin(scene)
+        self.note = self.failure = ""  # what the regions' time-out left out, or that it left nothing
+        self.pushes: list[EdgePush] | None = None
+        # Found before any region is computed: the pusher has no room at the start on any edge.
+        pushes, self.model = prebuilt or (None, CollisionModel(scene, scene.pusher.edges))
+        if not any(self.model.clearance(scene.start, e) > self.step / 2 for e in scene.pusher.edges):
+            raise SceneError("start", f"the pusher has no room on any allowed edge (needs {self.step / 2:.4g} m "
+                                      "clearance)")
+        try:  # regions are cached per part (planner.regions); they may take half the time, not all
+            self.pushes = pushes or edge_pushes(scene, self.clock + self.time_limit / 2, progress)
+        except RegionTimeout as timeout:
+            if not timeout.pushes:
+                self.failure = str(timeout)
+                return
+            self.pushes, self.note = timeout.pushes, str(timeout)
+        self.starts = [k for k, p in enumerate(self.pushes) if self.model.clearance(scene.start, p.edge) > self.step / 2]
+        if not self.starts:
+            raise SceneError("start", "the pusher has room only on edges with no stable push")
+        switching = scene.pusher.transit != "none" and len(self.pushes) > 1
+        self.transits = TransitPlanner(scene, [p.edge for p in self.pushes], self.model,
+                                       self.margin) if switching else None
+        self._joined = _Shortcut(self.pushes, self.model, self.margin, self.transits)
+        self._dubins = DubinsShortcut(scene, self.pushes, self.model, self.margin)
+
+    def result(self, goal: np.ndarray, segments: list, reason: str = "", tree=None) -> Plan:
+        """The plan for ``goal`` (solved if no ``reason``), timed from the start of the problem."""
+        found = Plan(self.scene.path, not reason, self.name, self.seed, 0.0, self.scene.start.copy(), goal.copy(),
+                     segments, f"{reason}; {self.note}" if reason and self.note else reason, self.note)
+        if tree is not None:
+            found.tree = tree
+        found.planning_time_s = time.perf_counter() - self.clock
+        return found
+
+    def preimage(self, goals: np.ndarray) -> GoalPreimage:
+        return GoalPreimage(goals, self.pushes, self.model, self.margin, self.scene.slider.radius)
+
+    def shortcut(self, segments: list) -> list:
+        """Fewer pushes where one joins several, then shorter Dubins curves where they are free."""
+        return self._dubins(self._joined(segments))
+
+    def direct(self, preimage: GoalPreimage, goal: int = 0) -> list | None:
+        """The cheapest plan of one or two pushes on a start edge, as in the paper's one-step
+        planning, or None."""
+        found = [d for k in self.starts if (d := preimage.connect_all(self.scene.start, k, [goal]).get(goal))]
+        return min((self.shortcut(d) for d in found), key=lambda d: _cost(self.scene, d)) if found else None
+
+
 def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
          regions: str | None = None, transit: str | None = None, switch_cost: float | None = None,
-         progress: Callable[[int, int], None] | None = None, *,
+         progress: Callable[[int, int], None] | None = None, *, optimize: int | None = None,
          prebuilt: tuple[list[EdgePush], CollisionModel] | None = None) -> Plan:
     """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``.
 
@@ -159,6 +263,13 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     ``Plan.note``, or ends unsolved if none is) and the search together; ``progress(k, n)`` hears of the ``k``-th of the ``n``
     regions that must be computed.
 
+    ``optimize`` (default: ``planner.optimize``) is a number of improvement rounds: after the
+    first plan, each round searches again with a seed of its own (drawn from ``seed``) and twice
+    the first search's iterations, and its plan, shortened like the first, replaces the plan if it
+    costs less. Rounds are counted, not timed, so a seed still gives one plan; they stop early at
+    the time limit. ``Plan.first_length`` is the first plan's length. A plan of one or two pushes
+    from the start (found before any search) is not searched again.
+
     ``prebuilt`` is the edges' pushes and the collision model (built with ``scene.pusher.edges``)
     for this scene's part, pusher and options, as :func:`planner.reachability` shares them between
     goals; they are then not rebuilt, and the time limit is the search's alone.
@@ -168,72 +279,79 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     SceneError
         If an option is invalid or no allowed edge can start pushing.
     """
-    opts = scene.planner
-    if regions is not None:
-        opts = replace(opts, regions=check_regions(regions, "regions"))
-    if switch_cost is not None:
-        opts = replace(opts, switch_cost=check_switch_cost(switch_cost, "switch_cost"))
-    pusher = scene.pusher if transit is None else replace(scene.pusher, transit=check_transit(transit, "transit"))
-    scene = replace(scene, planner=opts, pusher=pusher)
-    seed = opts.seed if seed is None else seed
-    time_limit = opts.time_limit if time_limit is None else time_limit
-    name = opts.name if planner is None else planner
-    if name not in _PLANNERS:
-        raise SceneError("planner", f"must be one of {', '.join(_PLANNERS)}, got {name!r}")
-    clock = time.perf_counter()
-    deadline = clock + float(time_limit)  # for the regions and the search alike
-    step, margin = resolution(scene), clearance_margin(scene)
-    result = Plan(scene.path, False, name, seed, 0.0, scene.start.copy(), scene.goal.copy())
-
-    def done(segments: list, reason: str = "", tree=None) -> Plan:
-        result.solved = not reason
-        result.segments = segments
-        result.reason = f"{reason}; {result.note}" if reason and result.note else reason
-        if tree is not None:
-            result.tree = tree
-        result.planning_time_s = time.perf_counter() - clock
-        return result
-
-    # Found before any region is computed: the pusher has no room at the start on any edge.
-    pushes, model = prebuilt or (None, CollisionModel(scene, scene.pusher.edges))
-    if not any(model.clearance(scene.start, e) > step / 2 for e in scene.pusher.edges):
-        raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
-    try:  # regions are cached per part (planner.regions); they may take half the time, not all
-        pushes = pushes or edge_pushes(scene, clock + float(time_limit) / 2, progress)
-    except RegionTimeout as timeout:
-        if not timeout.pushes:
-            return done([], str(timeout))
-        pushes, result.note = timeout.pushes, str(timeout)
-    starts = [k for k, p in enumerate(pushes) if model.clearance(scene.start, p.edge) > step / 2]
-    if not starts:
-        raise SceneError("start", "the pusher has room only on edges with no stable push")
+    problem = _Problem(scene, seed, time_limit, planner, regions, transit, switch_cost, progress, prebuilt)
+    scene = problem.scene
+    if problem.failure:
+        return problem.result(scene.goal, [], problem.failure)
     if _within_tolerance(scene, scene.start):
-        return done([])
-    preimage = GoalPreimage(scene.goal, pushes, model, margin, scene.slider.radius)
-    switching = scene.pusher.transit != "none" and len(pushes) > 1
-    transits = TransitPlanner(scene, [p.edge for p in pushes], model, margin) if switching else None
-    joined, dubins = _Shortcut(pushes, model, margin, transits), DubinsShortcut(scene, pushes, model, margin)
-
-    def shortcut(segments: list) -> list:
-        """Fewer pushes where one joins several, then shorter Dubins curves where they are free."""
-        return dubins(joined(segments))
-    # One or two pushes may do, as in the paper's one-step planning: the cheapest over the edges.
-    direct = [found for k in starts if (found := preimage.connect(scene.start, k)) is not None]
+        return problem.result(scene.goal, [])
+    preimage = problem.preimage(scene.goal)
+    direct = problem.direct(preimage)
     if direct:
-        return done(min((shortcut(d) for d in direct), key=lambda d: _cost(scene, d)))
-    search = _Search(scene, pushes, model, preimage, name, seed, step)
-    segments, tree, iterations = search.run(starts, deadline, transits)
+        return problem.result(scene.goal, direct)
+    search = _Search(problem, preimage)
+    segments, tree, iterations = search.run(problem.deadline, problem.transits)
     if segments is None:
-        reason = ("the final push failed its re-check after rounding" if tree is None
-                  else f"no plan found within the time limit of {time_limit:g} s")
-        return done([], reason, tree)
-    segments = shortcut(segments)
+        reason = (_RECHECK if tree is None
+                  else f"no plan found within the time limit of {problem.time_limit:g} s")
+        return problem.result(scene.goal, [], reason, tree)
+    segments = problem.shortcut(segments)
     if any(s.kind == "transit" for s in segments):
         budget = max(ONE_EDGE_ITERATIONS * iterations, ONE_EDGE_MIN_ITERATIONS)
-        plain, _, _ = search.run(starts, deadline, None, budget)
-        if plain is not None and _cost(scene, plain := shortcut(plain)) <= _cost(scene, segments):
+        plain, _, _ = search.run(problem.deadline, None, budget)
+        if plain is not None and _cost(scene, plain := problem.shortcut(plain)) <= _cost(scene, segments):
             segments = plain
-    return done(segments, tree=tree)
+    first = segments
+    rounds = scene.planner.optimize if optimize is None else check_optimize(optimize, "optimize")
+    budget = max(ROUND_ITERATIONS * iterations, ONE_EDGE_MIN_ITERATIONS)
+    for r in range(1, rounds + 1):
+        seed = (problem.seed + r * _ROUND_SEEDS) % MAX_SEED + 1
+        other, _, _ = search.run(problem.deadline, problem.transits, budget, seed)
+        if other is not None and _cost(scene, other := problem.shortcut(other)) < _cost(scene, segments):
+            segments = other
+    result = problem.result(scene.goal, segments, tree=tree)
+    result.first_length = sum(s.cf_path_length(scene.slider.cf) for s in first)
+    return result
+
+
+def plan_batch(scene: Scene, goals: ArrayLike, seed: int | None = None, time_limit: float | None = None, *,
+               prebuilt: tuple[list[EdgePush], CollisionModel] | None = None) -> list[Plan]:
+    """One :class:`Plan` per goal (rows ``(x, y, theta)``, radians) from ``scene.start``, grown
+    as one search tree.
+
+    Each goal first gets the direct connection (one or two pushes, as in :func:`plan`); the goals
+    left share one OMPL search: every new tree state is tested against all goals not yet reached,
+    and when one is, its path is taken and the same tree grows on towards the rest. The time limit
+    (default: the scene's) bounds that shared search as a whole, so each goal gets the full time
+    limit of tree growth for the price of one. Plans are shortcut as :func:`plan`'s are, but
+    a plan with switches gets no second, one-edge search: a batch answers where the part can go,
+    :func:`plan` also what it costs. ``seed`` and ``prebuilt`` are as for :func:`plan`.
+
+    >>> from planner import load_scene
+    >>> scene = load_scene("scenes/battery.yaml")
+    >>> [p.solved for p in plan_batch(scene, [scene.goal, scene.start])]
+    [True, True]
+    """
+    problem = _Problem(scene, seed, time_limit, None, None, None, None, None, prebuilt)
+    scene = problem.scene
+    goals = np.array(goals, dtype=float).reshape(-1, 3)
+    goals[:, 2] = wrap_angle(goals[:, 2])
+    if problem.failure:
+        return [problem.result(g, [], problem.failure) for g in goals]
+    preimage = problem.preimage(goals)
+    found: dict[int, Plan] = {}  # each timed when found
+    for i, goal in enumerate(goals):
+        if _within_tolerance(scene, scene.start, goal):
+            found[i] = problem.result(goal, [])
+        elif (direct := problem.direct(preimage, i)) is not None:
+            found[i] = problem.result(goal, direct)
+    rest = [i for i in range(len(goals)) if i not in found]
+    if rest:
+        for i, segments in _Search(problem, preimage).grow(rest, problem.deadline, problem.transits):
+            found[i] = (problem.result(goals[i], [], _RECHECK) if segments is None
+                        else problem.result(goals[i], problem.shortcut(segments)))
+    limit = f"no plan found within the time limit of {problem.time_limit:g} s"
+    return [found[i] if i in found else problem.result(g, [], limit) for i, g in enumerate(goals)]
 
 
 def _cost(scene: Scene, segments: list) -> float:
@@ -243,29 +361,34 @@ def _cost(scene: Scene, segments: list) -> float:
 
 
 class _Search:
-    """One OMPL control search from the start states to the goal preimage, re-seeded per run."""
+    """OMPL control searches from the start states to the goal preimage, re-seeded per search."""
 
-    def __init__(self, scene: Scene, pushes: list[EdgePush], model: CollisionModel, preimage: GoalPreimage,
-                 name: str, seed: int, step: float):
-        self.scene, self.pushes, self.model, self.preimage = scene, pushes, model, preimage
-        self.name, self.seed, self.step = name, seed, step
+    def __init__(self, problem: _Problem, preimage: GoalPreimage):
+        self.problem, self.preimage = problem, preimage
 
-    def run(self, starts: list[int], deadline: float, transits: TransitPlanner | None,
-            iterations: int | None = None) -> tuple[list | None, np.ndarray | None, int]:
-        """Segments of the plan found (None if none), the search tree (None if the plan failed
-        its re-check) and the iterations used; the search stops at ``deadline`` (perf_counter
-        time) or after ``iterations``."""
-        _seed_ompl(self.seed)
-        space, si = _spaces(self.scene, self.pushes, self.model, self.step, transits)
+    def _setup(self, transits: TransitPlanner | None, seed: int | None = None):
+        _seed_ompl(self.problem.seed if seed is None else seed)
+        scene, pushes = self.problem.scene, self.problem.pushes
+        space, si = _spaces(scene, pushes, self.problem.model, self.problem.step, transits)
         ss = oc.SimpleSetup(si)
-        for k in starts:
+        for k in self.problem.starts:
             s = space.allocState()
-            s[0].setXY(float(self.scene.start[0]), float(self.scene.start[1]))
-            s[0].setYaw(float(wrap_angle(self.scene.start[2])))
+            s[0].setXY(float(scene.start[0]), float(scene.start[1]))
+            s[0].setYaw(float(wrap_angle(scene.start[2])))
             s[1].value = k
             ss.addStartState(s)
-        ss.setGoal(_PushGoal(si, self.scene, self.preimage, transits))
-        ss.setPlanner(_PLANNERS[self.name](si))
+        goal = _PushGoal(si, scene, self.preimage, transits)
+        ss.setGoal(goal)
+        ss.setPlanner(_PLANNERS[self.problem.name](si))
+        return ss, si, goal
+
+    def run(self, deadline: float, transits: TransitPlanner | None, iterations: int | None = None,
+            seed: int | None = None) -> tuple[list | None, np.ndarray | None, int]:
+        """Segments of the plan found to the first goal (None if none), the search tree (None if
+        the plan failed its re-check) and the iterations used; the search stops at ``deadline``
+        (perf_counter time) or after ``iterations``."""
+        ss, si, goal = self._setup(transits, seed)
+        goal.active = [0]
         count = [0]
 
         def stop() -> bool:
@@ -276,8 +399,35 @@ class _Search:
         tree = _tree(ss, si)
         if not ss.haveExactSolutionPath():
             return None, tree, count[0]
-        segments = _segments(ss.getSolutionPath(), self.scene, self.pushes, self.preimage, transits)
+        segments = _segments(ss.getSolutionPath(), self.problem, self.preimage, transits)
         return segments, tree if segments is not None else None, count[0]
+
+    def grow(self, goals: list[int], deadline: float,
+             transits: TransitPlanner | None) -> Iterator[tuple[int, list | None]]:
+        """One tree towards all of ``goals``: yields each goal index reached with its segments
+        (None if the plan failed its re-check), until every goal is reached or ``deadline``.
+
+        OMPL's planners keep their tree between calls of ``solve`` (only ``clear`` empties it), so
+        each call goes on growing it towards the goals left; every state joins the tree tested
+        against all goals not reached by then.
+        """
+        ss, si, goal = self._setup(transits)
+        goal.active = list(goals)
+        stop = ob.PlannerTerminationCondition(lambda: time.perf_counter() >= deadline)
+        while goal.active and time.perf_counter() < deadline:
+            ss.getProblemDefinition().clearSolutionPaths()
+            ss.solve(stop)
+            if not ss.haveExactSolutionPath():
+                return
+            path = ss.getSolutionPath()
+            last = path.getState(path.getStateCount() - 1)
+            hits = goal.hits[(last[0].getX(), last[0].getY(), last[0].getYaw(), last[1].value)]
+            found = [(g, _segments(path, self.problem, self.preimage, transits, g)) for g in hits]
+            # Python wrappers of C++ states must not outlive them: nanobind would hand a stale one,
+            # typed as it was, to the propagator when the next solve reuses the address.
+            del path, last
+            goal.active = [g for g in goal.active if g not in hits]
+            yield from found
 
 
 def _switch_target(u: float, n: int) -> int | None:
@@ -322,8 +472,7 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
         key = (k, u0, u1, duration)
         if key not in cache:
             cache.clear()
-            dx, dy, dth = exp_twist((0.0, 0.0, 0.0), pushes[k].control_twist((u0, u1)), duration)
-            cache[key] = (float(dx), float(dy), float(dth))
+            cache[key] = pose_along((0.0, 0.0, 0.0), pushes[k].control_twist((u0, u1)))(duration)
         return cache[key]
 
     def propagate(start, control, duration, result) -> None:
@@ -348,8 +497,8 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
 
     def is_valid(state) -> bool:
         p, k = state[0], state[1].value
-        return k < blocked and si.satisfiesBounds(state) and model.clearance(
-            (p.getX(), p.getY(), p.getYaw()), pushes[k].edge) > step / 2
+        return k < blocked and si.satisfiesBounds(state) and model.is_clear(
+            (p.getX(), p.getY(), p.getYaw()), pushes[k].edge, step / 2)
 
     si.setStatePropagator(propagate)
     si.setStateValidityChecker(is_valid)
@@ -359,11 +508,13 @@ def _spaces(scene: Scene, pushes: list[EdgePush], model: CollisionModel, step: f
     return space, si
 
 
-def _segments(path, scene: Scene, pushes: list[EdgePush], preimage: GoalPreimage,
-              transits: TransitPlanner | None) -> list | None:
+def _segments(path, problem: _Problem, preimage: GoalPreimage, transits: TransitPlanner | None,
+              goal: int = 0) -> list | None:
     """Segments of an OMPL control path (copied out at once: its states live in C++): pushes,
     merged where consecutive controls are equal, and transits where the edge changes, plus the
-    final push onto the goal if the path stops short; None if a re-check after rounding fails."""
+    final push onto goal index ``goal`` if the path stops short; None if a re-check after
+    rounding fails."""
+    pushes = problem.pushes
     states = [(s[0].getX(), s[0].getY(), s[0].getYaw(), s[1].value) for s in path.getStates()]
     width = 2 if transits is None else 3
     controls = [tuple(u[i] for i in range(width)) for u in path.getControls()]
@@ -398,9 +549,9 @@ def _segments(path, scene: Scene, pushes: list[EdgePush], preimage: GoalPreimage
         end[2] = wrap_angle(end[2])
         segments.append(Segment(push.edge, push.region.contact, twist, float(d), pose, end))
         pose = end
-    if not _within_tolerance(scene, pose):
+    if not _within_tolerance(problem.scene, pose, preimage.goals[goal]):
         # The goal test accepted the tree's last state; the re-composed pose differs by rounding only.
-        last = _to_goal(preimage, transits, pose, k)
+        last = _to_goal(preimage, transits, pose, k, goal)
         if last is None:
             return None
         segments += last

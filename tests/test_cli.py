@@ -221,6 +221,10 @@ BAD_SCENES = {
     "switch cost negative": (battery(planner={"switch_cost": -0.01}), "planner.switch_cost", ">= 0"),
     "switch cost a string": (battery(planner={"switch_cost": "high"}), "planner.switch_cost", "number"),
     "switch cost infinite": (battery(planner={"switch_cost": float("inf")}), "planner.switch_cost", "finite"),
+    "optimize negative": (battery(planner={"optimize": -1}), "planner.optimize", "0..100"),
+    "optimize fractional": (battery(planner={"optimize": 1.5}), "planner.optimize", "integer"),
+    "optimize a string": (battery(planner={"optimize": "lots"}), "planner.optimize", "integer"),
+    "optimize beyond the cap": (battery(planner={"optimize": 101}), "planner.optimize", "0..100"),
     "name with a slash": (battery(name="a/b"), "name", None),
     "name a number": (battery(name=5), "name", None),
     "name with a NUL": (battery(name="a\0b"), "name", None),
@@ -240,6 +244,8 @@ BAD_FLAGS = {
     "--seed 0": (["--seed", "0"], "--seed"),
     "--seed -3": (["--seed", "-3"], "--seed"),
     "--seed beyond 32 bits": (["--seed", str(2**64)], "--seed"),  # OMPL's binding raises TypeError on it
+    "--optimize -1": (["--optimize", "-1"], "--optimize"),
+    "--optimize 1000": (["--optimize", "1000"], "--optimize"),
 }
 
 

@@ -10,13 +10,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
-from planner import load_scene
+from planner import load_scene, plan
 from planner.car import edge_car
 from planner.dubins import DubinsCurves
 from planner.pushes import clearance_margin, edge_pushes
 from planner.validity import CollisionModel
-from replay import advance, angle_diff
+from replay import advance, angle_diff, replay_plan
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -45,3 +46,14 @@ def test_curves_become_pushes_that_end_at_the_goal():
         assert np.allclose(pose[:2], goal[:2], atol=1e-8) and angle_diff(pose[2], goal[2]) < 1e-8
         curves.states(car.state(start), car.state(goal))
         assert sum(s.cf_path_length(cf) for s in segments) == pytest.approx(curves.length(), abs=1e-9)
+
+
+@pytest.mark.parametrize("goal", [[-0.3005, -0.1437, 0.2602], [-0.1349, 0.4372, -0.5847]])
+def test_a_shortened_plan_changes_edge_only_by_a_transit(goal):
+    """Parking goals whose one-edge plans the shortcut once rebuilt with a first part on another
+    edge's car and the rest on the old edge, the pusher jumping between edges unseen. The plan
+    must replay: every push on the edge the pusher is on, a transit between edges."""
+    scene = load_scene(ROOT / "scenes" / "parking.yaml")
+    found = plan(replace(scene, goal=np.array(goal)), seed=1, time_limit=10.0)
+    assert found.solved
+    replay_plan(yaml.safe_load((ROOT / "scenes" / "parking.yaml").read_text()), found.to_dict(), goal)

@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from planner import certify_unreachable, load_scene, parse_scene, plan, reachability
-from replay import advance, angle_diff
+from replay import replay_plan
 
 ROOT = Path(__file__).resolve().parents[1]
 #: A 8 x 6 cm block; its largest inscribed disk has radius 3 cm, centred at the origin.
@@ -128,13 +128,25 @@ def test_batch_answers_each_goal_and_the_plans_reach_them():
     assert (near.status, near.pushes) == ("reachable", 1) and near.verdicts[3] in ("goal1", "goal2")
     assert (sealed.status, sealed.plan, sealed.reason.split(":")[0]) == ("unreachable", None, "component")
     assert (outside.status, outside.reason.split(":")[0]) == ("unreachable", "collision")
-    # The plan, replayed independently: pushes chain and end within tolerance of the goal.
-    pose = scene.start
-    for segment in near.plan.segments:
-        assert np.allclose(segment.start, pose)
-        pose = advance(segment.start, segment.twist, segment.duration)
-    assert np.hypot(*(pose[:2] - goals[0][:2])) <= scene.tolerance_position
-    assert abs(angle_diff(pose[2], goals[0][2])) <= scene.tolerance_angle
+    replay_plan(yaml.safe_load(Path(scene.path).read_text()), near.plan.to_dict(), goals[0])
+
+
+def test_a_batch_shares_one_tree_and_its_plans_replay():
+    """Goals sampled over the sealed scene, answered by one call: several are reached by the
+    shared search (not by one or two pushes from the start), every plan passes the independent
+    replay (stability by the oracle's LP, collisions by shapely, chaining, the goal's tolerance)
+    and every 'unreachable' is the goal's certificate."""
+    scene = load_scene(ROOT / "scenes" / "unreachable" / "sealed.yaml")
+    spec = yaml.safe_load(Path(scene.path).read_text())
+    rng = np.random.default_rng(7)
+    goals = np.c_[rng.uniform(-0.45, 0.45, (16, 2)), rng.uniform(-np.pi, np.pi, 16)]
+    answers = reachability(scene, goals, time_limit=1.0, seed=1)
+    reached = [a for a in answers if a.status == "reachable"]
+    assert sum(a.pushes > 2 for a in reached) >= 3, [a.pushes for a in reached]
+    for answer in reached:
+        replay_plan(spec, answer.plan.to_dict(), answer.goal)
+    for answer in answers:
+        assert answer.status != "unreachable" or answer.reason == certify_unreachable(scene, answer.goal)
 
 
 def test_a_pushes_budget_turns_longer_plans_into_unknown():

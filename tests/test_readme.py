@@ -42,6 +42,19 @@ def test_python_api_example_runs(capsys):
     assert out[-1].startswith("True ")
 
 
+def test_reachability_example_prints_what_the_readme_says(tmp_path, monkeypatch, capsys):
+    """The README's reachability example, run in a scratch folder (it writes a PNG): its output is
+    the text block after it, and the map is a PNG."""
+    section = README[README.index("## Reachability"):]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    printed = re.search(r"```text\n(.*?)```", section, re.S).group(1)
+    (tmp_path / "scenes").symlink_to(ROOT / "scenes")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "README.md", "exec"), {})
+    assert capsys.readouterr().out == printed
+    assert (tmp_path / "parking-reach.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
 def test_picture_of_a_plan(tmp_path):
     from planner import load_scene, plan
     from planner.picture import draw_plan

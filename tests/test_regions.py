@@ -7,12 +7,14 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
-from mechanics import ExactRegion, Slider, exact_region, stable_region
+from mechanics import ExactRegion, Slider, StableSteering, exact_region, stable_region
 from planner import SceneError, load_scene, parse_scene, plan
-from planner.regions import edge_region
+from oracle import guaranteed_stable
+from planner.regions import compute_regions, edge_region
 
 ROOT = Path(__file__).resolve().parent.parent
 BLOCK = Slider([[-0.05, 0.0], [0.05, 0.0], [0.05, 0.06], [-0.05, 0.06]])
@@ -74,3 +76,25 @@ def test_regions_flag_overrides_the_scene(tmp_path):
     segments = json.loads((tmp_path / "nonconvex.json").read_text())["segments"]
     region = stable_region(scene.slider, segments[0]["edge"], scene.pusher.mu, scene.pusher.width)
     assert all(region.contains(s["twist"]) for s in segments)
+
+
+def test_a_turn_of_the_part_gives_its_twin_edge_the_same_region(tmp_path, monkeypatch):
+    """A 10 x 6 cm block is carried onto itself by a half turn about its CF, edge 0 onto edge 2:
+    only edge 0's region is computed, edge 2 gets the same section of its own push plane. That is
+    sound (every sampled push in it sticks for every support distribution, by the test-only LP
+    oracle, and turns about a centre beyond the part) and agrees with edge 2's region computed
+    on its own. An off-centre CF breaks the symmetry: nothing is shared."""
+    monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path))
+    monkeypatch.setattr("planner.regions._memory", {})
+    block = Slider([[-0.05, -0.03], [0.05, -0.03], [0.05, 0.03], [-0.05, 0.03]])
+    progress: list[tuple[int, int]] = []
+    regions = compute_regions(block, [0, 1, 2, 3], 0.5, 0.05, progress=lambda k, n: progress.append((k, n)))
+    assert progress == [(1, 2), (2, 2)] and sorted(regions) == [0, 1, 2, 3]
+    twin, alone = regions[2], exact_region(block, 2, 0.5, 0.05)
+    assert twin.edge == 2 and twin.polygon.equals(regions[0].polygon)
+    assert twin.polygon.symmetric_difference(alone.polygon).area < 0.005 * alone.polygon.area
+    rng = np.random.default_rng(1)
+    steer = StableSteering(twin)
+    for v in steer.twist(rng.random((40, 2))):
+        assert guaranteed_stable(block.vertices, block.cf, 2, 0.5, 0.05, v), v
+    assert Slider(block.vertices, cf=[0.01, 0.0]).turns == ()

@@ -9,8 +9,8 @@ import shapely
 
 from planner import parse_scene, plan
 from planner.pushes import clearance_margin, edge_pushes, resolution
-from planner.validity import CollisionModel
-from replay import advance, place, pusher_body
+from planner.validity import CollisionModel, pose_along
+from replay import advance, angle_diff, place, pusher_body
 
 BLOCK = [[-0.04, -0.025], [0.04, -0.025], [0.04, 0.025], [-0.04, 0.025]]
 WALL = 0.0005  # 0.5 mm thick: a tenth of the search step
@@ -97,3 +97,17 @@ def test_clearance_matches_shapely_distance_on_random_poses():
         else:
             assert got <= 1e-12, (q, edge)
     assert checked > 100
+
+
+def test_pose_along_follows_the_matrix_exponential():
+    """The rotation-about-the-COR form matches the replay's matrix exponential for turns, slow
+    turns near the translation threshold and pure translations."""
+    rng = np.random.default_rng(5)
+    for omega in [*rng.uniform(-20, 20, 20), 1e-6, -3e-8, 1.9e-8, 0.0]:
+        pose = np.r_[rng.uniform(-1, 1, 2), rng.uniform(-np.pi, np.pi)]
+        twist = np.r_[rng.uniform(-1, 1, 2), omega]
+        at = pose_along(pose, twist)
+        for t in (0.0, 0.3, 2.0):
+            got, want = at(t), advance(pose, twist, t)
+            np.testing.assert_allclose(got[:2], want[:2], rtol=0, atol=1e-8 * (1 + t * t))
+            assert angle_diff(got[2], want[2]) < 1e-9

@@ -1,0 +1,122 @@
+"""What a ``plan`` run costs before and around the search (issue 10).
+
+A warm run imports only what planning and the recording need: scipy's optimize and linalg (a
+third of a second) and matplotlib are left to the commands that use them. A cold run computes the
+edges' exact regions side by side in forked processes (:func:`planner.regions.compute_regions`);
+sources of truth: the same regions computed one by one in this process, bit for bit, and the
+process ids of the workers that computed them.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mechanics import Slider, exact_region
+from planner.regions import compute_regions, is_cached
+
+ROOT = Path(__file__).resolve().parent.parent
+#: The CF off the centre: no turn of the block carries one edge onto another, so each is computed.
+BLOCK = Slider([[-0.05, 0.0], [0.05, 0.0], [0.05, 0.06], [-0.05, 0.06]], cf=[0.01, 0.03])
+#: Imported only by what needs them: the controllability report, the simulator and the pictures.
+HEAVY = ("scipy.optimize", "scipy.linalg", "matplotlib")
+
+
+@pytest.fixture()
+def empty_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr("planner.regions._memory", {})
+    return tmp_path / "cache"
+
+
+def test_a_plan_run_imports_nothing_it_does_not_use(tmp_path):
+    """The whole ``plan`` command in a fresh interpreter, then a look at what it imported; the
+    public names that need scipy still work, importing it when called."""
+    script = f"""
+import json, sys
+from planner.cli import main
+code = main(["scenes/parking.yaml", "--out", {str(tmp_path / 'out')!r}])
+loaded = sorted(m for m in sys.modules if m.startswith({HEAVY!r}))
+from planner import controllability, load_scene
+print(json.dumps([code, loaded, controllability(load_scene("scenes/parking.yaml")).stlc,
+                  "scipy.optimize" in sys.modules]))
+"""
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 0, run.stderr
+    code, loaded, stlc, optimize = json.loads(run.stdout.splitlines()[-1])
+    assert code == 0 and (tmp_path / "out" / "parking.rrd").is_file()
+    assert loaded == []
+    assert stlc and optimize
+
+
+def _noting_process(folder: Path, slider: Slider, edge: int, *args, **kwargs):
+    """:func:`mechanics.exact_region`, leaving a file named by the edge and the process that computed it."""
+    folder.mkdir(exist_ok=True)
+    (folder / f"{edge}-{os.getpid()}").touch()
+    return exact_region(slider, edge, *args, **kwargs)
+
+
+def test_regions_computed_in_parallel_are_the_serial_ones(empty_cache, tmp_path, monkeypatch):
+    monkeypatch.setattr("planner.regions.exact_region", functools.partial(_noting_process, tmp_path / "who"))
+    heard = []
+    got = compute_regions(BLOCK, [0, 1, 2], 0.5, 0.08, progress=lambda k, n: heard.append((k, n)), workers=2)
+    assert heard == [(1, 3), (2, 3), (3, 3)]
+    who = [name.split("-") for name in os.listdir(tmp_path / "who")]
+    assert sorted(int(e) for e, _ in who) == [0, 1, 2]
+    assert all(int(pid) != os.getpid() for _, pid in who)
+    for e in (0, 1, 2):
+        serial = exact_region(BLOCK, e, 0.5, 0.08)
+        assert got[e].polygon.equals_exact(serial.polygon, 0.0)
+        assert np.array_equal(got[e].centre, serial.centre) and got[e].stable.edge == e
+        assert is_cached(BLOCK, e, 0.5, 0.08)
+    assert len(list(empty_cache.iterdir())) == 3  # written by this process, atomically: no temporary left
+
+
+def test_parallel_regions_keep_the_deadline_and_raise_the_workers_errors(empty_cache):
+    """A region of the block takes a tenth of a second or more: with 0.03 s, those begun (one per
+    worker at most, if the workers start in time) are abandoned and the third is never begun."""
+    heard = []
+    start = time.perf_counter()
+    assert compute_regions(BLOCK, [0, 1, 2], 0.5, 0.08, deadline=start + 0.03,
+                           progress=lambda k, n: heard.append((k, n)), workers=2) == {}
+    assert time.perf_counter() - start < 0.5
+    assert heard in ([], [(1, 3)], [(1, 3), (2, 3)]) and not empty_cache.exists()
+    with pytest.raises(ValueError, match="mu must be > 0"):
+        compute_regions(BLOCK, [0, 1], -0.5, 0.08, workers=2)
+
+
+def test_the_recorder_writes_in_a_child_and_passes_its_errors_back(tmp_path):
+    """In a fresh interpreter (rerun not imported), the recording is written by the forked child:
+    the parent never imports rerun, the file verifies, and a failure to write comes back as the
+    OSError it is."""
+    script = f"""
+import sys
+from planner import load_scene, plan
+from planner.recorder import recorder
+scene = load_scene("scenes/battery.yaml")
+result = plan(scene, seed=1)
+with recorder(scene) as write:
+    write({str(tmp_path / "battery.rrd")!r}, scene, result)
+try:
+    with recorder(scene) as write:
+        write({str(tmp_path / "missing" / "battery.rrd")!r}, scene, result)
+except OSError as err:
+    print(type(err).__name__, "rerun" in sys.modules)
+"""
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split() == ["FileNotFoundError", "False"]
+    rerun = Path(sys.executable).parent / "rerun"
+    if rerun.exists():
+        check = subprocess.run([str(rerun), "rrd", "verify", str(tmp_path / "battery.rrd")], capture_output=True,
+                               text=True, timeout=120)
+        assert check.returncode == 0, check.stderr
+
