@@ -25,14 +25,17 @@ from .validity import CollisionModel
 __all__ = ["OneStep", "connect", "goal_verdicts", "one_step"]
 
 
-def connect(start: ArrayLike, goal: ArrayLike, push: EdgePush, model: CollisionModel, margin: float) -> Segment | str:
+def connect(start: ArrayLike, goal: ArrayLike, push: EdgePush, model: CollisionModel, margin: float, *,
+            total: np.ndarray | None = None) -> Segment | str:
     """The single stable push of ``push.edge`` from ``start`` to ``goal`` keeping ``margin`` from
-    obstacles, or why there is none."""
-    total = log_pose(start, goal)
+    obstacles, or why there is none. A caller that has COR_total (``log_pose(start, goal)``) and
+    has found it stable passes it as ``total``: it is not computed nor checked again."""
+    checked = total is not None
+    total = log_pose(start, goal) if total is None else total
     speed = float(push.speed(total))
     if speed == 0.0:
         return "the start is the goal"
-    if not push.region.contains(total):
+    if not checked and not push.region.contains(total):
         return "COR_total is not a stable push"
     twist, duration = total / speed, speed
     if not model.push_is_free(start, twist, duration, push.edge, margin):

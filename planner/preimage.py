@@ -9,8 +9,11 @@ is in the two-push preimage if ``COR_total(s -> m)`` is a stable push for some w
 pushes are collision-free.
 
 Waypoints are a fixed set per edge (a grid of controls times durations growing geometrically),
-screened with vectorised ``log_pose`` and ``contains``; collision checks run only for the few
-nearest that pass, and each waypoint-to-goal push is checked once.
+screened with vectorised ``log_pose`` and ``contains``, then for certain collisions (the part's
+CF sampled along each push, outside where its inscribed disk fits:
+:meth:`~planner.validity.CollisionModel.surely_blocked`); full collision checks run only for the
+few nearest that pass, and each waypoint-to-goal push is checked once. Behind a wall with a gap,
+most waypoints fail the cheap screen, and the few tries go to those that may pass.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ _U1 = np.linspace(0.0, 1.0, 12, endpoint=False)  # around the boundary of the st
 _U2 = (0.5, 1.0)  # half way out, and on the boundary (the sharpest turns)
 _LEGS = (1.0, 2.0, 4.0, 8.0)  # waypoint push lengths, in part radii
 _TRIES = 4  # waypoints collision-checked per state: this test runs on every new tree state
+_SAMPLES = np.linspace(0.0, 1.0, 9)[1:-1]  # where along a push the part's CF is screened
 
 
 class GoalPreimage:
@@ -89,16 +93,28 @@ class GoalPreimage:
         total = log_pose(pose, np.concatenate([self.goals[goals, None], poses[goals]], axis=1))
         ok = push.region.contains(total.reshape(-1, 3)).reshape(total.shape[:2])
         for row, g in enumerate(goals.tolist()):
-            if ok[row, 0] and isinstance(one := connect(pose, self.goals[g], push, self.model, self.margin), Segment):
-                found[g] = [one]
-                continue
-            candidates = np.flatnonzero(ok[row, 1:])
-            length = push.speed(total[row, 1 + candidates]) + tau[candidates]
-            for i in candidates[np.argsort(length, kind="stable")][:_TRIES]:
+            # The goal itself first, then the waypoints, shortest two pushes first.
+            columns = np.flatnonzero(ok[row])
+            speed = push.speed(total[row, columns])
+            order = np.argsort(np.where(columns == 0, -1.0, speed + tau[columns - 1]), kind="stable")
+            columns, speed = columns[order], speed[order]
+            # Pushes whose part certainly hits something on the way (a wall between here and the
+            # goal, say) are dropped before any collision check: sampled poses, one screen.
+            moving = speed > 0
+            columns, speed = columns[moving], speed[moving]
+            along = exp_twist(pose, (total[row, columns] / speed[:, None])[:, None], speed[:, None] * _SAMPLES)
+            columns = columns[~self.model.surely_blocked(along).any(axis=1)]
+            if columns.size and columns[0] == 0:
+                one = connect(pose, self.goals[g], push, self.model, self.margin, total=total[row, 0])
+                if isinstance(one, Segment):
+                    found[g] = [one]
+                    continue
+                columns = columns[1:]
+            for i in columns[:_TRIES] - 1:
                 last = self._final_push(k, g, int(i))
                 if last is None:
                     continue
-                lead = connect(pose, poses[g, i], push, self.model, self.margin)
+                lead = connect(pose, poses[g, i], push, self.model, self.margin, total=total[row, 1 + i])
                 if isinstance(lead, Segment):
                     found[g] = [lead, Segment(last.edge, last.contact, last.twist, last.duration, lead.end, last.end)]
                     break

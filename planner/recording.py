@@ -105,8 +105,10 @@ MAX_FRAMES = 600
 PATH_POINTS = 100
 #: Most frames per push at which the simulated ghost is drawn (each costs a simulation).
 GHOST_SAMPLES = 10
-#: Rays per sense of the sticking force-status map in ``/analysis`` (about a second's work).
+#: Rays per sense of the sticking force-status map in ``/analysis`` (about a tenth of a second).
 ANALYSIS_RAYS = 16
+#: Seconds :func:`prepare` waits between looks for a newly cached region.
+_POLL = 0.02
 
 _THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0.5, 1.0, 2.0, 4.0]))
 _GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
@@ -303,16 +305,21 @@ def _compute_analysis(scene: Scene, edge: int) -> _Analysis:
     return _Analysis(window, np.asarray(config.points, dtype=float), polygons)
 
 
-def prepare(scene: Scene, stop: Callable[[], bool]) -> None:
+def prepare(scene: Scene, wait: Callable[[float], bool]) -> None:
     """Compute ahead of :func:`write_recording`, in this process, the analysis of each allowed
-    edge whose stable region is cached, one after another until ``stop()`` says a plan has come
-    (the first pushed edge is one of them; :mod:`planner.recorder` runs this beside the search)."""
+    edge, as soon as its stable region is cached, until ``wait(seconds)`` (which may wait that
+    long) says a plan has come; the first pushed edge is one of them. :mod:`planner.recorder`
+    runs this beside the search, which caches the regions of a new part first."""
     p = scene.pusher
-    for edge in p.edges:
-        if stop():
-            return
-        if is_cached(scene.slider, edge, p.mu, p.width, "exact", scene.cf_uncertainty):
-            _analysis(scene, edge)
+    pending = list(p.edges)
+    while pending and not wait(0.0):
+        ready = [e for e in pending if is_cached(scene.slider, e, p.mu, p.width, "exact", scene.cf_uncertainty)]
+        if not ready:
+            if wait(_POLL):
+                return
+            continue
+        _analysis(scene, ready[0])
+        pending.remove(ready[0])
 
 
 def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:

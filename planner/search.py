@@ -51,18 +51,20 @@ from .transit import TransitPlanner
 from .validity import CollisionModel, pose_along
 
 __all__ = ["plan", "plan_batch", "MAX_CONTROL_STEPS", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
-           "ROUND_ITERATIONS", "SWITCH_SHARE"]
+           "ROUND_ITERATIONS", "ROUND_MIN_ITERATIONS", "SWITCH_SHARE"]
 #: Longest constant push the planners sample, in collision-check steps.
 MAX_CONTROL_STEPS = 30
 #: Share of sampled controls that switch edges, when switching is allowed.
 SWITCH_SHARE = 0.1
 #: When the first plan found switches, a search without switches gets this many times the
-#: iterations the first search used (at least ``ONE_EDGE_MIN_ITERATIONS``): its iterations cost
-#: about a fifth as much (no transits to find), but one edge alone usually needs more of them.
-ONE_EDGE_ITERATIONS, ONE_EDGE_MIN_ITERATIONS = 4, 1000
+#: iterations the first search used (at least ``ONE_EDGE_MIN_ITERATIONS``): one edge alone
+#: usually needs more of them. On parking, junction, gap and narrow_junction (20 seeds), 2x / 500
+#: against 4x / 1000 raised the mean plan cost by at most 1.6 % and cut the median planning time
+#: by up to a third (gap: 0.44 -> 0.28 s); ``optimize`` is the way to shorter plans.
+ONE_EDGE_ITERATIONS, ONE_EDGE_MIN_ITERATIONS = 2, 500
 #: An improvement round (``optimize``) gets this many times the first search's iterations (and
-#: at least ``ONE_EDGE_MIN_ITERATIONS``).
-ROUND_ITERATIONS = 2
+#: at least ``ROUND_MIN_ITERATIONS``).
+ROUND_ITERATIONS, ROUND_MIN_ITERATIONS = 2, 1000
 
 _ROUND_SEEDS = 1_000_003
 _RECHECK = "the final push failed its re-check after rounding"
@@ -303,7 +305,7 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
             segments = plain
     first = segments
     rounds = scene.planner.optimize if optimize is None else check_optimize(optimize, "optimize")
-    budget = max(ROUND_ITERATIONS * iterations, ONE_EDGE_MIN_ITERATIONS)
+    budget = max(ROUND_ITERATIONS * iterations, ROUND_MIN_ITERATIONS)
     for r in range(1, rounds + 1):
         seed = (problem.seed + r * _ROUND_SEEDS) % MAX_SEED + 1
         other, _, _ = search.run(problem.deadline, problem.transits, budget, seed)
