@@ -138,15 +138,24 @@ class Slider:
         ()
         """
         rel = self.vertices - self.cf
-        angles = np.arctan2(rel[:, 1], rel[:, 0])
         found = []
         for r in range(1, self.n):
-            phi = angles[r] - angles[0]
-            c, s = np.cos(phi), np.sin(phi)
-            turned = rel @ np.array([[c, s], [-s, c]])  # each row rotated by phi
+            c, s = np.cos(self.turn_angle(r)), np.sin(self.turn_angle(r))
+            turned = rel @ np.array([[c, s], [-s, c]])  # each row rotated
             if np.all(np.linalg.norm(turned - np.roll(rel, -r, axis=0), axis=1) <= 1e-10 * self.radius):
                 found.append(r)
         return tuple(found)
+
+    def turn_angle(self, r: int) -> float:
+        """The angle (radians, in ``[-pi, pi)``) of the rotation about the CF that carries vertex
+        0 towards vertex ``r``: the angle of the turn ``r`` of :attr:`turns`.
+
+        >>> round(Slider([[-1, -1], [1, -1], [1, 1], [-1, 1]]).turn_angle(1) / np.pi, 12)
+        0.5
+        """
+        rel = self.vertices[[0, r % self.n]] - self.cf
+        angle = np.arctan2(rel[1, 1], rel[1, 0]) - np.arctan2(rel[0, 1], rel[0, 0])
+        return float((angle + np.pi) % (2 * np.pi) - np.pi)
 
     def contact(self, i: int, width: float | None = None) -> np.ndarray:
         """The central part of edge ``i`` of length ``min(width, edge length)`` a flat face touches.

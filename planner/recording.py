@@ -71,6 +71,7 @@ above the text log.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, NamedTuple
@@ -79,6 +80,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 import shapely
+import shapely.affinity
 from numpy.typing import ArrayLike
 
 from mechanics import (ContactConfiguration, Slider, SupportModel, contact_wrench_cone, exp_twist,
@@ -278,7 +280,7 @@ def _analysis(scene: Scene, edge: int) -> _Analysis:
                           {name: {int(sense): shapely.from_wkb(bytes.fromhex(wkb)) for sense, wkb in by.items()}
                            for name, by in data["polygons"].items()})
     except (OSError, ValueError, KeyError, TypeError, shapely.errors.GEOSException):
-        found = _compute_analysis(scene, edge)
+        found = _turned_twin(scene, edge) or _compute_analysis(scene, edge)
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             write_atomic(path, json.dumps({
@@ -289,6 +291,26 @@ def _analysis(scene: Scene, edge: int) -> _Analysis:
             pass  # a read-only home: compute again next time
     _analyses[key] = found
     return found
+
+
+def _turned_twin(scene: Scene, edge: int) -> _Analysis | None:
+    """The analysis of an edge that a quarter or half turn of the part about its CF carries onto
+    ``edge`` (:attr:`mechanics.Slider.turns`), if this process has it, turned with the part; the
+    window, a square about the CF, turns onto itself."""
+    slider, p = scene.slider, scene.pusher
+    for r in slider.turns:
+        angle = slider.turn_angle(r)
+        if abs(math.remainder(angle, math.pi / 2)) > 1e-9:
+            continue
+        twin = _analyses.get(cache_key("analysis", slider, (edge - r) % slider.n, p.mu, p.width,
+                                       scene.cf_uncertainty, rays=ANALYSIS_RAYS))
+        if twin is not None:
+            c, s = math.cos(angle), math.sin(angle)
+            cf = tuple(slider.cf)
+            return _Analysis(twin.window, (twin.contact - slider.cf) @ np.array([[c, s], [-s, c]]) + slider.cf,
+                             {name: {sense: shapely.affinity.rotate(g, angle, origin=cf, use_radians=True)
+                                     for sense, g in by.items()} for name, by in twin.polygons.items()})
+    return None
 
 
 def _compute_analysis(scene: Scene, edge: int) -> _Analysis:

@@ -495,3 +495,22 @@ def test_the_ghost_follows_the_pushes_and_skips_the_transit(switching, tmp_path)
             assert segment_frames(plan, times, j)[0] in steps
     for step, outline in ghost:  # a push that sticks: the ghost hides under the part
         np.testing.assert_allclose(outline[0], slider[step][1][0], atol=1e-6)
+
+
+def test_a_half_turn_of_the_part_gives_the_twin_edges_analysis(monkeypatch):
+    """Parking's block: edge 2's analysis is edge 0's turned half round the CF, and equals the one
+    computed for edge 2 itself (the force-status map exactly, the exact regions to 0.1 %)."""
+    scene = planner.load_scene(Path(__file__).resolve().parent.parent / "scenes" / "parking.yaml")
+    p = scene.pusher
+    monkeypatch.setattr(recording, "_analyses", {})  # none of other tests' recordings
+    first = recording._compute_analysis(scene, 0)
+    key = recording.cache_key("analysis", scene.slider, 0, p.mu, p.width, scene.cf_uncertainty,
+                              rays=recording.ANALYSIS_RAYS)
+    recording._analyses[key] = first
+    twin, alone = recording._turned_twin(scene, 2), recording._compute_analysis(scene, 2)
+    np.testing.assert_allclose(twin.contact, alone.contact, atol=1e-12)
+    for name, by_sense in alone.polygons.items():
+        for sense, polygon in by_sense.items():
+            turned = twin.polygons[name][sense]
+            assert turned.symmetric_difference(polygon).area <= 1e-3 * polygon.area + 1e-12, (name, sense)
+    assert recording._turned_twin(scene, 1) is None  # edge 3's analysis is not known yet
