@@ -114,11 +114,17 @@ def load_of(twist, x, w):
 
 
 def dense_support_max(twist, x, cf, y):
-    """max over distributions on the points ``x`` with centroid ``cf`` of ``y . load`` (primal LP)."""
+    """max over distributions on the points ``x`` with centroid ``cf`` of ``y . load`` (primal LP).
+
+    HiGHS's default choice of algorithm now and then ends with an unknown model status on these
+    degenerate LPs; the oracle then asks its dual simplex, then its interior point method."""
     g = loads(twist, x) @ np.asarray(y, float)
-    res = linprog(-g, A_eq=np.vstack([np.ones(len(x)), x.T]), b_eq=np.r_[1.0, cf], bounds=(0, None), method="highs")
-    assert res.status == 0, res.message
-    return -res.fun
+    for method in ("highs", "highs-ds", "highs-ipm"):
+        res = linprog(-g, A_eq=np.vstack([np.ones(len(x)), x.T]), b_eq=np.r_[1.0, cf], bounds=(0, None),
+                      method=method)
+        if res.status == 0:
+            return -res.fun
+    raise AssertionError(f"no HiGHS method solved the oracle's LP: {res.message}")
 
 
 def dense_some_in_cone(twist, x, cf, generators):

@@ -12,6 +12,8 @@ Sources of truth, none of them the code under test:
 
 from __future__ import annotations
 
+import zlib
+
 import numpy as np
 import pytest
 import shapely
@@ -221,7 +223,7 @@ CASES = configurations()
 def test_verdicts_against_explicit_distributions(name, config, mode, slider, kind):
     """Brute force: for P every random distribution's load lies in the cone (generators + NNLS),
     for I none does; and a much finer discretisation (dense-point LPs) finds no counter-example."""
-    rng = np.random.default_rng(abs(hash(name + kind)) % 2**32)
+    rng = np.random.default_rng(zlib.crc32((name + kind).encode()))  # hash() is salted per process
     support = SupportModel.of_slider(slider, kind)
     region = region_of(support)
     cone = contact_wrench_cone(config, mode)
