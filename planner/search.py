@@ -28,6 +28,8 @@ time, so a seed still gives one plan), and its plan wins if it costs no more.
 from __future__ import annotations
 
 import math
+import signal
+import threading
 import time
 from dataclasses import replace
 from collections.abc import Iterator
@@ -397,7 +399,7 @@ class _Search:
             count[0] += 1
             return time.perf_counter() >= deadline or (iterations is not None and count[0] > iterations)
 
-        ss.solve(ob.PlannerTerminationCondition(stop))
+        _solve(ss, stop)
         tree = _tree(ss, si)
         if not ss.haveExactSolutionPath():
             return None, tree, count[0]
@@ -415,10 +417,9 @@ class _Search:
         """
         ss, si, goal = self._setup(transits)
         goal.active = list(goals)
-        stop = ob.PlannerTerminationCondition(lambda: time.perf_counter() >= deadline)
         while goal.active and time.perf_counter() < deadline:
             ss.getProblemDefinition().clearSolutionPaths()
-            ss.solve(stop)
+            _solve(ss, lambda: time.perf_counter() >= deadline)
             if not ss.haveExactSolutionPath():
                 return
             path = ss.getSolutionPath()
@@ -430,6 +431,23 @@ class _Search:
             del path, last
             goal.active = [g for g in goal.active if g not in hits]
             yield from found
+
+
+def _solve(ss, stop: Callable[[], bool]) -> None:
+    """``ss.solve()`` until ``stop()``; Ctrl-C also stops it, and is raised as KeyboardInterrupt
+    once OMPL has returned (raised inside OMPL's callbacks it would be lost, and the search would
+    end as if it had run out of time)."""
+    if threading.current_thread() is not threading.main_thread():  # signals reach the main thread only
+        ss.solve(ob.PlannerTerminationCondition(stop))
+        return
+    pressed: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: pressed.append(signum))
+    try:
+        ss.solve(ob.PlannerTerminationCondition(lambda: bool(pressed) or stop()))
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if pressed:
+        raise KeyboardInterrupt
 
 
 def _switch_target(u: float, n: int) -> int | None:

@@ -15,6 +15,7 @@ import copy
 import json
 import math
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -534,3 +535,16 @@ def test_help_lists_exit_codes_defaults_and_the_region_cache(region_cache, capsy
         assert default in text
     assert "$STABLEPUSH_CACHE" in text and "~/.cache/stablepush" in text
     assert f"(here: {region_cache})" in text  # where this run's regions are
+
+
+def test_ctrl_c_during_the_search_ends_as_interrupted(tmp_path):
+    """SIGINT while OMPL searches (junction on one edge never solves): the run stops at once with
+    exit 130 and its one line, writing nothing, instead of ending as if out of time."""
+    run = subprocess.Popen([sys.executable, "-m", "planner.cli", str(SCENES / "junction.yaml"), "--transit", "none",
+                            "--time-limit", "60", "--out", str(tmp_path / "out")],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+    time.sleep(3.0)  # imports and regions (about a second, cold) are done: it is searching
+    run.send_signal(signal.SIGINT)
+    out, err = run.communicate(timeout=30)  # well before the time limit
+    assert (run.returncode, out, err) == (130, "", "plan: interrupted\n")
+    assert not (tmp_path / "out").exists()
