@@ -123,6 +123,16 @@ class Slider:
         return tuple(i for i in range(self.n) if self.is_pushable(i))
 
     @cached_property
+    def cf_depth(self) -> float:
+        """Distance from the CF to the part's boundary: the radius of the largest disk about the
+        CF that lies inside the part.
+
+        >>> Slider([[-2, -1], [2, -1], [2, 1], [-2, 1]], cf=[0.5, 0]).cf_depth
+        1.0
+        """
+        return float(self.polygon.exterior.distance(shapely.Point(self.cf)))
+
+    @cached_property
     def turns(self) -> tuple[int, ...]:
         """The part's rotational symmetries about its CF, as vertex shifts: each ``r`` in
         ``1..n-1`` such that a rotation about the CF carries every vertex ``k`` onto vertex

@@ -216,7 +216,7 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
 def _first_found(scene: Scene, result: Plan) -> str:
     """`` (first found 1.234 m)`` when improvement rounds shortened the plan, else nothing."""
     improved = result.first_length is not None and result.first_length > result.path_length(scene.slider.cf)
-    return f" (first found {result.first_length:.3f} m)" if scene.planner.optimize and improved else ""
+    return f" (first found {result.first_length:.3f} m)" if improved else ""
 
 
 def _progress(k: int, n: int) -> None:

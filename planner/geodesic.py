@@ -138,7 +138,7 @@ def geodesic_bound(scene: Scene) -> float:
     straight = float(np.linalg.norm(goal - start)) - slack
     if straight <= 0.0:  # the start is within the tolerance's reach of the goal
         return 0.0
-    rho = scene.slider.polygon.exterior.distance(shapely.Point(cf)) * (1.0 - RHO_SHRINK)
+    rho = scene.slider.cf_depth * (1.0 - RHO_SHRINK)
     # The disk of the slack about the goal, as a polygon covering it (its radius divided by the
     # cosine of half a chord's angle), so that every end of the CF's path lies in it.
     end = shapely.Point(goal).buffer(slack / math.cos(math.pi / (4 * QUAD_SEGS)), quad_segs=QUAD_SEGS)

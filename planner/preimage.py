@@ -76,9 +76,9 @@ class GoalPreimage:
         """The first (for one goal, the) goal."""
         return self.goals[0]
 
-    def connect(self, pose: ArrayLike, k: int) -> list[Segment] | None:
-        """Pushes of ``self.pushes[k]`` from ``pose`` to the first goal (one or two), or None."""
-        return self.connect_all(pose, k, [0]).get(0)
+    def connect(self, pose: ArrayLike, k: int, goal: int = 0) -> list[Segment] | None:
+        """Pushes of ``self.pushes[k]`` from ``pose`` to goal index ``goal`` (one or two), or None."""
+        return self.connect_all(pose, k, [goal]).get(goal)
 
     def connect_all(self, pose: ArrayLike, k: int, goals: Sequence[int]) -> dict[int, list[Segment]]:
         """Pushes of ``self.pushes[k]`` from ``pose`` to each of ``goals`` (indices) it can

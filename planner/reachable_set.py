@@ -14,8 +14,9 @@ The answers use the planner's own machinery, so they agree with it:
   and the push collision-free, keeping :func:`~planner.pushes.clearance_margin`). A vectorised
   screen (``log_pose`` and the stable regions' ``contains``) picks the cells worth the collision
   check; ``connect`` itself decides them;
-* two pushes: :meth:`planner.preimage.GoalPreimage.connect` for the cell's goal on each edge (the
-  planner's goal region: one push, or two through one of its fixed waypoints). This is
+* two pushes: :meth:`planner.preimage.GoalPreimage.connect_all` for the cells' goals (those of a
+  heading at once) on each edge (the planner's goal region: one push, or two through one of its
+  fixed waypoints). This is
   *sufficient*, not complete: a cell at 0 may still be reachable in two pushes through some other
   waypoint, or in more pushes.
 
@@ -159,11 +160,15 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
             count[todo[hit]], theta[todo[hit]] = 1, th
         if pushes == 2:
             radius = scene.slider.radius
-            for th, ok in zip(thetas, free):
-                for c in np.flatnonzero(ok & (count == 0)):
-                    preimage = GoalPreimage((*xy[c], th), edges, model, margin, radius)
-                    if any(preimage.connect(start, k) for k in range(len(edges))):
-                        count[c], theta[c] = 2, th
+            for th, ok in zip(thetas, free):  # the cells of a heading as the goals of one preimage
+                todo = np.flatnonzero(ok & (count == 0))
+                preimage = GoalPreimage(np.column_stack([xy[todo], np.full(todo.size, th)]), edges, model, margin,
+                                        radius)
+                hit: set[int] = set()
+                for k in range(len(edges)):
+                    hit |= preimage.connect_all(start, k, [i for i in range(todo.size) if i not in hit]).keys()
+                hit_cells = todo[sorted(hit)]
+                count[hit_cells], theta[hit_cells] = 2, th
     return ReachableSet((xmin, ymin, xmax, ymax), (dx, dy), pushes, None if heading is None else float(thetas[0]),
                         thetas, count.reshape(ny, nx), theta.reshape(ny, nx), blocked.reshape(ny, nx),
                         time.perf_counter() - clock)

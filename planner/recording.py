@@ -266,11 +266,15 @@ class _Analysis(NamedTuple):
 _analyses: dict[str, _Analysis] = {}
 
 
+def _analysis_key(scene: Scene, edge: int) -> str:
+    p = scene.pusher
+    return cache_key("analysis", scene.slider, edge, p.mu, p.width, scene.cf_uncertainty, rays=ANALYSIS_RAYS)
+
+
 def _analysis(scene: Scene, edge: int) -> _Analysis:
     """The analysis of ``edge``: from this process's memory, else from the disk cache beside the
     stable regions (:mod:`planner.regions`, as WKB), else computed (0.1 s) and kept in both."""
-    slider, p = scene.slider, scene.pusher
-    key = cache_key("analysis", slider, edge, p.mu, p.width, scene.cf_uncertainty, rays=ANALYSIS_RAYS)
+    key = _analysis_key(scene, edge)
     if key in _analyses:
         return _analyses[key]
     path = cache_folder() / f"analysis-{key}.json"
@@ -297,13 +301,12 @@ def _turned_twin(scene: Scene, edge: int) -> _Analysis | None:
     """The analysis of an edge that a quarter or half turn of the part about its CF carries onto
     ``edge`` (:attr:`mechanics.Slider.turns`), if this process has it, turned with the part; the
     window, a square about the CF, turns onto itself."""
-    slider, p = scene.slider, scene.pusher
+    slider = scene.slider
     for r in slider.turns:
         angle = slider.turn_angle(r)
         if abs(math.remainder(angle, math.pi / 2)) > 1e-9:
             continue
-        twin = _analyses.get(cache_key("analysis", slider, (edge - r) % slider.n, p.mu, p.width,
-                                       scene.cf_uncertainty, rays=ANALYSIS_RAYS))
+        twin = _analyses.get(_analysis_key(scene, (edge - r) % slider.n))
         if twin is not None:
             c, s = math.cos(angle), math.sin(angle)
             cf = tuple(slider.cf)

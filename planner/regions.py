@@ -24,6 +24,7 @@ import signal
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -104,7 +105,7 @@ def _known(slider: Slider, edge: int, mu: float, width: float | None, cf_radius:
     for key in _keys_alike(slider, edge, mu, width, cf_radius):
         found = _memory.get(key) or _read(_path(key), stable, cf_radius)
         if found is not None:
-            return ExactRegion(stable, found.polygon, found.centre, cf_radius)
+            return replace(found, stable=stable)
     return None
 
 
@@ -200,8 +201,8 @@ def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: floa
                 out[edge] = region
     for edge in edges:
         if edge not in first and any((twin := (edge - r) % slider.n) in out for r in slider.turns):
-            out[edge] = _memory[_key(slider, edge, mu, width, cf_radius)] = ExactRegion(
-                stable_region(slider, edge, mu, width), out[twin].polygon, out[twin].centre, cf_radius)
+            out[edge] = _memory[_key(slider, edge, mu, width, cf_radius)] = replace(
+                out[twin], stable=stable_region(slider, edge, mu, width))
     return out
 
 

@@ -159,12 +159,10 @@ class _PushGoal(ob.GoalSampleableRegion):
         if k >= len(self.preimage.pushes):  # the marker of a blocked switch
             return math.inf
         goals = self.preimage.goals[self.active]
-        # Within tolerance needs no pushes (None); the others get theirs, if any.
-        hits: dict[int, list | None] = {g: None for g, goal in zip(self.active, goals)
-                                        if _within_tolerance(self.scene, pose, goal)}
-        hits |= _to_goals(self.preimage, self.transits, pose, k, [g for g in self.active if g not in hits])
+        near = [g for g, goal in zip(self.active, goals) if _within_tolerance(self.scene, pose, goal)]
+        hits = near + list(_to_goals(self.preimage, self.transits, pose, k, [g for g in self.active if g not in near]))
         if hits:
-            self.hits[(*pose, k)] = list(hits)
+            self.hits[(*pose, k)] = hits
             return 0.0
         return float(np.min(np.hypot(goals[:, 0] - pose[0], goals[:, 1] - pose[1])
                             + self.scene.slider.radius * np.abs(wrap_angle(goals[:, 2] - pose[2]))))
@@ -209,7 +207,7 @@ class _Problem:
         self.pushes: list[EdgePush] | None = None
         # Found before any region is computed: the pusher has no room at the start on any edge.
         pushes, self.model = prebuilt or (None, CollisionModel(scene, scene.pusher.edges))
-        if not any(self.model.clearance(scene.start, e) > self.step / 2 for e in scene.pusher.edges):
+        if not any(self.model.is_clear(scene.start, e, self.step / 2) for e in scene.pusher.edges):
             raise SceneError("start", f"the pusher has no room on any allowed edge (needs {self.step / 2:.4g} m "
                                       "clearance)")
         try:  # regions are cached per part (planner.regions); they may take half the time, not all
@@ -219,7 +217,7 @@ class _Problem:
                 self.failure = str(timeout)
                 return
             self.pushes, self.note = timeout.pushes, str(timeout)
-        self.starts = [k for k, p in enumerate(self.pushes) if self.model.clearance(scene.start, p.edge) > self.step / 2]
+        self.starts = [k for k, p in enumerate(self.pushes) if self.model.is_clear(scene.start, p.edge, self.step / 2)]
         if not self.starts:
             raise SceneError("start", "the pusher has room only on edges with no stable push")
         switching = scene.pusher.transit != "none" and len(self.pushes) > 1
@@ -237,6 +235,11 @@ class _Problem:
         found.planning_time_s = time.perf_counter() - self.clock
         return found
 
+    @property
+    def out_of_time(self) -> str:
+        """Why a goal has no plan when the search ran out of time."""
+        return f"no plan found within the time limit of {self.time_limit:g} s"
+
     def preimage(self, goals: np.ndarray) -> GoalPreimage:
         return GoalPreimage(goals, self.pushes, self.model, self.margin, self.scene.slider.radius)
 
@@ -247,7 +250,7 @@ class _Problem:
     def direct(self, preimage: GoalPreimage, goal: int = 0) -> list | None:
         """The cheapest plan of one or two pushes on a start edge, as in the paper's one-step
         planning, or None."""
-        found = [d for k in self.starts if (d := preimage.connect_all(self.scene.start, k, [goal]).get(goal))]
+        found = [d for k in self.starts if (d := preimage.connect(self.scene.start, k, goal))]
         return min((self.shortcut(d) for d in found), key=lambda d: _cost(self.scene, d)) if found else None
 
 
@@ -296,9 +299,7 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     search = _Search(problem, preimage)
     segments, tree, iterations = search.run(problem.deadline, problem.transits)
     if segments is None:
-        reason = (_RECHECK if tree is None
-                  else f"no plan found within the time limit of {problem.time_limit:g} s")
-        return problem.result(scene.goal, [], reason, tree)
+        return problem.result(scene.goal, [], _RECHECK if tree is None else problem.out_of_time, tree)
     segments = problem.shortcut(segments)
     if any(s.kind == "transit" for s in segments):
         budget = max(ONE_EDGE_ITERATIONS * iterations, ONE_EDGE_MIN_ITERATIONS)
@@ -314,7 +315,7 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
         if other is not None and _cost(scene, other := problem.shortcut(other)) < _cost(scene, segments):
             segments = other
     result = problem.result(scene.goal, segments, tree=tree)
-    result.first_length = sum(s.cf_path_length(scene.slider.cf) for s in first)
+    result.first_length = _length(scene, first)
     return result
 
 
@@ -354,14 +355,17 @@ def plan_batch(scene: Scene, goals: ArrayLike, seed: int | None = None, time_lim
         for i, segments in _Search(problem, preimage).grow(rest, problem.deadline, problem.transits):
             found[i] = (problem.result(goals[i], [], _RECHECK) if segments is None
                         else problem.result(goals[i], problem.shortcut(segments)))
-    limit = f"no plan found within the time limit of {problem.time_limit:g} s"
-    return [found[i] if i in found else problem.result(g, [], limit) for i, g in enumerate(goals)]
+    return [found[i] if i in found else problem.result(g, [], problem.out_of_time) for i, g in enumerate(goals)]
+
+
+def _length(scene: Scene, segments: list) -> float:
+    """Length of the centre of friction's path."""
+    return sum(s.cf_path_length(scene.slider.cf) for s in segments)
 
 
 def _cost(scene: Scene, segments: list) -> float:
     """Length of the centre of friction's path plus the switch cost per switch."""
-    return sum(s.cf_path_length(scene.slider.cf) for s in segments) + scene.planner.switch_cost * sum(
-        s.kind == "transit" for s in segments)
+    return _length(scene, segments) + scene.planner.switch_cost * sum(s.kind == "transit" for s in segments)
 
 
 class _Search:

@@ -114,7 +114,7 @@ class CollisionModel:
         # the disk a hair smaller, so that a part just touching an obstacle is not called blocked).
         slider = scene.slider
         self._cf = slider.cf
-        self._cf_room = disk_free_space(scene, slider.polygon.exterior.distance(shapely.Point(slider.cf)) * 0.999)
+        self._cf_room = disk_free_space(scene, slider.cf_depth * 0.999)
         shapely.prepare(self._cf_room)
 
     def _add(self, key: int | str, shapes: list[np.ndarray], outline: np.ndarray) -> None:
@@ -159,9 +159,9 @@ class CollisionModel:
         xmin, ymin, xmax, ymax = self.workspace
         # The body lies in the disc of radius reach about (x, y): lower bounds, walls and obstacles.
         best = min(x - xmin, xmax - x, y - ymin, ymax - y) - reach
-        c, s = math.cos(theta), math.sin(theta)
         if best < enough:
             # The workspace is convex, so the body's distance to its walls is attained at a vertex.
+            c, s = math.cos(theta), math.sin(theta)
             wx = [x + c * px - s * py for px, py in hull]
             wy = [y + s * px + c * py for px, py in hull]
             best = min(min(wx) - xmin, xmax - max(wx), min(wy) - ymin, ymax - max(wy))

@@ -501,12 +501,8 @@ def test_a_half_turn_of_the_part_gives_the_twin_edges_analysis(monkeypatch):
     """Parking's block: edge 2's analysis is edge 0's turned half round the CF, and equals the one
     computed for edge 2 itself (the force-status map exactly, the exact regions to 0.1 %)."""
     scene = planner.load_scene(Path(__file__).resolve().parent.parent / "scenes" / "parking.yaml")
-    p = scene.pusher
     monkeypatch.setattr(recording, "_analyses", {})  # none of other tests' recordings
-    first = recording._compute_analysis(scene, 0)
-    key = recording.cache_key("analysis", scene.slider, 0, p.mu, p.width, scene.cf_uncertainty,
-                              rays=recording.ANALYSIS_RAYS)
-    recording._analyses[key] = first
+    recording._analyses[recording._analysis_key(scene, 0)] = recording._compute_analysis(scene, 0)
     twin, alone = recording._turned_twin(scene, 2), recording._compute_analysis(scene, 2)
     np.testing.assert_allclose(twin.contact, alone.contact, atol=1e-12)
     for name, by_sense in alone.polygons.items():
