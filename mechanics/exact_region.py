@@ -65,7 +65,6 @@ from numpy.typing import ArrayLike
 
 from .contacts import ContactConfiguration
 from .force_status import force_possible
-from .push_plane import PushPlane
 from .slider import Slider
 from .stable import StableRegion, procedure_stable
 from .support import SupportModel

@@ -26,7 +26,6 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..twist import point_velocity
-from ..wrenches import point_wrench
 
 __all__ = ["SupportDistribution", "TOL"]
 
