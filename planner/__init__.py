@@ -12,14 +12,14 @@ command), :mod:`.geodesic` (a lower bound on any plan's length), and the benchma
 :mod:`.quality` and :mod:`.reach_bench`.
 """
 
-from .controllability import SceneControllability, controllability
-from .one_step import OneStep, one_step
-from .plan_file import Plan, Segment, Transit, load_plan
-from .reachability import Reach, certify_unreachable, reachability
-from .scene import DEFAULT_PLANNER, Scene, SceneError, load_scene, parse_scene
+from .queries.controllability import SceneControllability, controllability
+from .queries.one_step import OneStep, one_step
+from .model.plan_file import Plan, Push, Transit, load_plan
+from .queries.reachability import Reach, certify_unreachable, reachability
+from .model.scene import DEFAULT_PLANNER, Scene, SceneError, load_scene, parse_scene
 from .search import plan
-from .verify import Verification, verify
+from .execution.verify import Verification, verify
 
-__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Reach", "Scene", "SceneError", "Segment", "Transit",
+__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Reach", "Scene", "SceneError", "Push", "Transit",
            "certify_unreachable", "load_plan", "load_scene", "one_step", "parse_scene", "plan", "reachability",
            "Verification", "verify", "SceneControllability", "controllability"]

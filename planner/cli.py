@@ -1,11 +1,11 @@
 """The ``plan`` command: plan a scene, print a summary, write the plan JSON and a rerun recording.
 
-``--verify N`` then re-simulates the plan under N support distributions (:func:`planner.verify`)
+``--verify N`` then re-simulates the plan under N support distributions (:func:`planner.execution.verify`)
 and prints a line per push and an overall line with the worst deviation; ``--verify N --plan
 FILE`` verifies a plan file instead of planning, and writes the same outputs (the plan as read,
 and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
 ``--reach N`` (1 or 2) then maps the goal positions reachable from the start in at most N stable
-pushes (:func:`planner.reachable_set.reachable_set`, any heading): ``<name>-reach.png`` in the
+pushes (:func:`planner.queries.reachable_set.reachable_set`, any heading): ``<name>-reach.png`` in the
 output folder and ``/world/reach`` in the recording.
 
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
@@ -26,16 +26,16 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from .fields import shown
-from .plan_file import Plan, atomic_path, load_plan, write_atomic
-from .reachability import certify_unreachable
-from .recorder import recorder
-from .regions import cache_folder
-from .scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_OPTIMIZE, MAX_SEED, MAX_TIME_LIMIT, PLANNERS,
+from .model.fields import shown
+from .model.plan_file import Plan, atomic_path, load_plan, write_atomic
+from .queries.reachability import certify_unreachable
+from .outputs.recorder import recorder
+from .actions.region_cache import cache_folder
+from .model.scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_OPTIMIZE, MAX_SEED, MAX_TIME_LIMIT, PLANNERS,
                     REGIONS, TRANSITS, PlannerOptions, Scene, SceneError, check_optimize, check_seed, check_time_limit,
                     load_scene)
 from .search import plan
-from .verify import Verification, verify
+from .execution.verify import Verification, verify
 
 __all__ = ["Inputs", "main", "read_inputs"]
 
@@ -92,7 +92,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--reach", type=int, metavar="N",
                    help="after planning, map the goal positions reachable from the start in at most N (1 or 2) "
                         "stable pushes, at any heading: <name>-reach.png in the output folder and /world/reach "
-                        "in the recording (planner.reachable_set; seconds per map)")
+                        "in the recording (planner.queries.reachable_set; seconds per map)")
     return p
 
 
@@ -192,7 +192,7 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
              if inputs.verify and (result.solved or inputs.given is not None) else None)
     reach = None
     if inputs.reach:  # after planning: the map is about the start, whatever the plan
-        from .reachable_set import reachable_set
+        from .queries.reachable_set import reachable_set
 
         reach = reachable_set(scene, inputs.reach)
     _write_outputs(out, scene, result, check, reach, write_recording)
@@ -242,7 +242,7 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
         write_atomic(out / f"{scene.name}.json", result.to_json())
         write_recording(out / f"{scene.name}.rrd", scene, result, check, reach)
         if reach is not None:
-            from .reachable_set import write_png
+            from .queries.reachable_set import write_png
 
             with atomic_path(out / f"{scene.name}-reach.png") as tmp:
                 write_png(reach, scene, str(tmp))

@@ -19,7 +19,7 @@ atexit.register(_silence_nanobind_leak_report)
 
 @pytest.fixture(scope="session", autouse=True)
 def region_cache(request, tmp_path_factory):
-    """Exact regions are cached on disk (planner.regions): keep the tests' copy in pytest's cache
+    """Exact regions are cached on disk (planner.actions.region_cache): keep the tests' copy in pytest's cache
     folder, not the user's, for this process and the ``plan`` commands it starts."""
     cache = getattr(request.config, "cache", None)  # None with -p no:cacheprovider
     folder = cache.mkdir("stablepush-regions") if cache else tmp_path_factory.mktemp("stablepush-regions")

@@ -1,4 +1,4 @@
-"""The Dubins car of an edge (planner.car): every motion it can make is a stable push.
+"""The Dubins car of an edge (planner.actions.car): every motion it can make is a stable push.
 
 Checked against the test-only LP oracle over support distributions on the part and Theorem 4's
 condition (tests/oracle.py, which shares no code with ``mechanics``), on every shipped part's
@@ -14,8 +14,8 @@ import pytest
 
 from oracle import guaranteed_stable
 from planner import load_scene
-from planner.car import edge_car
-from planner.pushes import edge_pushes
+from planner.actions.car import edge_car
+from planner.actions.controls import edge_controls
 
 ROOT = Path(__file__).resolve().parent.parent
 PARTS = ["battery", "corridor", "nonconvex", "parking"]  # one scene per distinct part
@@ -28,7 +28,7 @@ def stable_by_oracle(scene, edge: int, twist: np.ndarray) -> bool:
 @pytest.mark.parametrize("name", PARTS)
 def test_every_curvature_of_the_car_is_stable(name):
     scene = load_scene(ROOT / "scenes" / f"{name}.yaml")
-    cars = [edge_car(p, scene.slider.cf) for p in edge_pushes(scene)]
+    cars = [edge_car(p, scene.slider.cf) for p in edge_controls(scene)]
     assert any(cars), "a part with stable translations has a car"
     for car in filter(None, cars):
         assert 0 < car.radius < 10 * scene.slider.radius
@@ -44,14 +44,14 @@ def test_every_curvature_of_the_car_is_stable(name):
 def test_the_radius_is_tight_for_the_region(name):
     # A little tighter than the car's radius, one of the two turns leaves the planner's region.
     scene = load_scene(ROOT / "scenes" / f"{name}.yaml")
-    for car in filter(None, (edge_car(p, scene.slider.cf) for p in edge_pushes(scene))):
+    for car in filter(None, (edge_car(p, scene.slider.cf) for p in edge_controls(scene))):
         tighter = car.twist(np.array([-1.0, 1.0]) / (0.97 * car.radius))
         assert not car.push.region.contains(tighter).all()
 
 
 def test_states_and_poses_are_inverse():
     scene = load_scene(ROOT / "scenes" / "nonconvex.yaml")
-    car = edge_car(edge_pushes(scene)[0], scene.slider.cf)
+    car = edge_car(edge_controls(scene)[0], scene.slider.cf)
     rng = np.random.default_rng(3)
     for pose in rng.uniform([-1, -1, -np.pi], [1, 1, np.pi], (20, 3)):
         back = car.pose(car.state(pose))

@@ -24,10 +24,10 @@ from pathlib import Path
 import pytest
 import yaml
 
-from planner import plan_file
+from planner.model import plan_file
 from planner.cli import main
-from planner.plan_file import write_atomic
-from planner.scene import DEFAULT_PLANNER, load_scene
+from planner.model.plan_file import write_atomic
+from planner.model.scene import DEFAULT_PLANNER, load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "scenes"
@@ -44,7 +44,7 @@ L_SHAPE = [[0.0, 0.0], [0.09, 0.0], [0.09, 0.035], [0.035, 0.035], [0.035, 0.09]
 # The goal sits inside a closed ring of four walls: free of collision, but no path leads there.
 # A corridor just wider than the part and too narrow to turn it, pushed on its left edge only
 # (pushes go right) with the goal to its left: unreachable, but no certificate of
-# planner.reachability shows it, so the search runs out its time limit.
+# planner.queries.reachability shows it, so the search runs out its time limit.
 BEHIND = {
     "name": "behind",
     "slider": {"vertices": [[-0.04, -0.03], [0.04, -0.03], [0.04, 0.03], [-0.04, 0.03]]},
@@ -361,11 +361,11 @@ def test_command_bad_planner_name_is_argparse_usage_error(tmp_path):
 def test_unreachable_goal_exits_2_within_the_time_limit(tmp_path):
     write(tmp_path, BEHIND)
     # The time limit bounds the search; the part's exact regions are computed once per part and
-    # cached on disk (planner.regions), so compute them first, as any earlier run would have.
+    # cached on disk (planner.actions.region_cache), so compute them first, as any earlier run would have.
     from planner import load_scene
-    from planner.pushes import edge_pushes
+    from planner.actions.controls import edge_controls
 
-    edge_pushes(load_scene(tmp_path / "scene.yaml"))
+    edge_controls(load_scene(tmp_path / "scene.yaml"))
     clock = time.perf_counter()
     run = run_plan("scene.yaml", "--time-limit", "2", "--out", "out", cwd=tmp_path, timeout=30)
     wall = time.perf_counter() - clock

@@ -14,7 +14,7 @@ from scipy.spatial import ConvexHull
 
 from mechanics import controllability as twists_controllability
 from planner import SceneError, controllability, load_scene, parse_scene
-from planner.pushes import edge_pushes
+from planner.actions.controls import edge_controls
 
 
 def ccw(c):
@@ -236,7 +236,7 @@ def test_one_edge_lies_in_a_half_space(name, regions):
     scene = load_scene(f"scenes/{name}.yaml")
     scene = dataclasses.replace(scene, planner=dataclasses.replace(scene.planner, regions=regions))
     c = controllability(with_pusher(scene, transit="none"))
-    twists = {p.edge: p.region.extremal_twists() for p in edge_pushes(scene)}
+    twists = {p.edge: p.region.extremal_twists() for p in edge_controls(scene)}
     assert set(twists) == set(c.per_edge)
     for edge, alone in c.per_edge.items():
         n = scene.slider.inward_normal(edge)

@@ -1,4 +1,4 @@
-"""Dubins curves as chains of stable pushes (planner.dubins): the pieces recovered from OMPL's
+"""Dubins curves as chains of stable pushes (planner.actions.dubins): the pieces recovered from OMPL's
 interpolation compose, by the test-only matrix exponential, to exactly the curve's end, with the
 curve's length, as at most three pushes of the car's three motions."""
 
@@ -13,10 +13,10 @@ import pytest
 import yaml
 
 from planner import load_scene, plan
-from planner.car import edge_car
-from planner.dubins import DubinsCurves
-from planner.pushes import clearance_margin, edge_pushes
-from planner.validity import CollisionModel
+from planner.actions.car import edge_car
+from planner.actions.dubins import DubinsCurves
+from planner.actions.controls import clearance_margin, edge_controls
+from planner.world.validity import CollisionModel
 from replay import advance, angle_diff, replay_plan
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parent.parent
 def test_curves_become_pushes_that_end_at_the_goal():
     scene = load_scene(ROOT / "scenes" / "parking.yaml")
     scene = replace(scene, obstacles=(), workspace=(-2.0, -2.0, 2.0, 2.0))
-    push = edge_pushes(scene)[0]
+    push = edge_controls(scene)[0]
     car = edge_car(push, scene.slider.cf)
     curves = DubinsCurves(scene, car, CollisionModel(scene, [push.edge]), clearance_margin(scene))
     rng = np.random.default_rng(7)

@@ -3,7 +3,7 @@
 ``tests/data/exact_regions_v2.json`` holds, for every shipped scene's allowed edges (a part shared
 by several scenes once) and the fixtures of ``test_exact_region.py`` and ``test_uncertainty.py``,
 the section (push-plane polygon and centre) that ``exact_region`` returned with its default
-parameters before its linear programmes were batched (planner.regions ``_VERSION`` 2, one HiGHS
+parameters before its linear programmes were batched (planner.actions.region_cache ``_VERSION`` 2, one HiGHS
 or Qhull call per twist and direction). Both constructions are sound on their own (the soundness
 tests check the current one); this file checks that the faster one gave up no stable push: the
 region is not smaller, and covers the old one polygon by polygon but for slivers where the two

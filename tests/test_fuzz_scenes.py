@@ -33,7 +33,7 @@ from hypothesis import strategies as st
 
 from planner import load_scene
 from planner.cli import read_inputs
-from planner.scene import ANGLE, LENGTH, MIN_SIZE, Scene, SceneError
+from planner.model.scene import ANGLE, LENGTH, MIN_SIZE, Scene, SceneError
 from test_cli import BATTERY
 from test_hostile_scenes import STAR, alias_bomb
 

@@ -14,7 +14,8 @@ import shapely
 
 from mechanics import Slider
 from planner import Scene, load_scene, parse_scene, plan
-from planner.geodesic import QUAD_SEGS, geodesic_bound
+from planner.queries.geodesic import geodesic_bound
+from planner.world.free_space import QUAD_SEGS
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = sorted((ROOT / "scenes").glob("*.yaml"))  # not scenes/unreachable/: nothing to plan there

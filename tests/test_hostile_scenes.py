@@ -19,8 +19,8 @@ import pytest
 import yaml
 
 from planner.cli import main
-from planner.fields import SceneError
-from planner.scene import _simple_polygon, load_scene
+from planner.model.fields import SceneError
+from planner.model.scene import _simple_polygon, load_scene
 from test_cli import BATTERY_TEXT, VERTICES, assert_nothing_written, battery, error_field, nested, run_plan, write
 
 #: An eight-pointed star: its vertices alternate between two radii, so no edge lies on its hull.
@@ -216,7 +216,7 @@ def test_figures_without_matplotlib_say_which_extra_to_install():
 
 
 def test_bench_help_describes_every_argument(capsys):
-    from planner.bench import main as bench
+    from planner.bench.planners import main as bench
 
     with pytest.raises(SystemExit) as exit_:
         bench(["--help"])

@@ -1,4 +1,4 @@
-"""`python -m planner.bench --ompl-log FILE`: OMPL's benchmark log format (planner.ompl_log), read
+"""`python -m planner.bench.planners --ompl-log FILE`: OMPL's benchmark log format (planner.bench.ompl_log), read
 back by a parser written here from the format's grammar and by OMPL's own readBenchmarkLog."""
 
 from __future__ import annotations
@@ -10,8 +10,8 @@ import sqlite3
 
 import pytest
 
-from planner.bench import main as bench
-from planner.ompl_log import PROPERTIES, Run, format_ompl_log, log_paths
+from planner.bench.planners import main as bench
+from planner.bench.ompl_log import PROPERTIES, Run, format_ompl_log, log_paths
 
 
 def _parse(text: str) -> dict:

@@ -11,8 +11,8 @@ import yaml
 
 from oracle import guaranteed_stable
 from planner import load_scene, plan
-from planner.geodesic import geodesic_bound
-from planner.quality import TASKS, dubins_length, open_task
+from planner.queries.geodesic import geodesic_bound
+from planner.bench.quality import TASKS, dubins_length, open_task
 from replay import replay_plan
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -1,4 +1,4 @@
-"""Reachable-set maps (planner/reachable_set.py) agree with one_step and the goal preimage, and the
+"""Reachable-set maps (planner/queries/reachable_set.py) agree with one_step and the goal region, and the
 ``plan --reach N`` flag writes them."""
 
 from __future__ import annotations
@@ -13,10 +13,10 @@ from rerun.chunk import RrdReader
 
 from planner import load_scene, one_step
 from planner.cli import main
-from planner.preimage import GoalPreimage
-from planner.pushes import clearance_margin, edge_pushes
-from planner.reachable_set import reach_points, reachable_set, write_png
-from planner.validity import CollisionModel
+from planner.search.goal_region import GoalRegion
+from planner.actions.controls import clearance_margin, edge_controls
+from planner.queries.reachable_set import reach_points, reachable_set, write_png
+from planner.world.validity import CollisionModel
 
 SCENES = Path(__file__).resolve().parent.parent / "scenes"
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -76,16 +76,16 @@ def test_any_heading_map_agrees_with_one_step(scene):
         assert not any(one_step(scene, goal=goal(reach, j, i, th)).reachable for th in reach.headings)
 
 
-def test_two_push_map_agrees_with_the_goal_preimage(scene, one, two):
+def test_two_push_map_agrees_with_the_goal_region(scene, one, two):
     assert np.array_equal(two.count == 1, one.count == 1), "two pushes keep every one-push cell at 1"
     assert (two.count == 2).any()
-    pushes = edge_pushes(scene)
+    pushes = edge_controls(scene)
     model = CollisionModel(scene, [p.edge for p in pushes])
     free = ~two.blocked
     for j, i in cells(two, two.count == 2, 3) + cells(two, free & (two.count == 0), 3, seed=2):
         g = goal(two, j, i, two.heading)
-        pre = GoalPreimage(g, pushes, model, clearance_margin(scene), scene.slider.radius)
-        found = [pre.connect(scene.start, k) for k in range(len(pushes))]
+        region = GoalRegion(scene, g, pushes, model, clearance_margin(scene))
+        found = [region.pushes_to(scene.start, k, [0]).get(0) for k in range(len(pushes))]
         found = [f for f in found if f]
         assert bool(found) == (two.count[j, i] == 2), (j, i)
         for segments in found:  # two pushes, ending at the cell's pose

@@ -57,7 +57,7 @@ def test_reachability_example_prints_what_the_readme_says(tmp_path, monkeypatch,
 
 def test_picture_of_a_plan(tmp_path):
     from planner import load_scene, plan
-    from planner.picture import draw_plan
+    from planner.outputs.picture import draw_plan
 
     scene = load_scene(ROOT / "scenes" / "battery.yaml")
     draw_plan(scene, plan(scene, seed=1), str(tmp_path / "battery.png"))

@@ -1,4 +1,4 @@
-"""The rerun recording of a plan (planner.recording), read back from the file.
+"""The rerun recording of a plan (planner.outputs.recording), read back from the file.
 
 Sources of truth, none of them the code under test: ``rerun rrd verify`` for the file format; the
 scene's own numbers (the YAML written here) and poses applied to the slider's vertices by the
@@ -22,7 +22,7 @@ from rerun.chunk import RrdReader
 
 import planner
 from mechanics import exp_twist
-from planner import recording
+from planner.outputs import recording
 
 RERUN = Path(sys.executable).parent / "rerun"
 
@@ -232,7 +232,7 @@ def test_a_long_plan_is_capped_and_its_cf_path_thinned(straight, tmp_path):
     segments, pose = [], np.array(scene.start)
     for twist, duration in zip(twists, durations):
         end = exp_twist(pose, twist, duration)
-        segments.append(planner.Segment(3, np.array(SLIDER[3::-3]), np.array(twist), duration, pose, end))
+        segments.append(planner.Push(3, np.array(SLIDER[3::-3]), np.array(twist), duration, pose, end))
         pose = end
     plan = planner.Plan(scene.path, True, "rrt", 1, 0.0, scene.start, pose, segments)
     path = tmp_path / "long.rrd"
@@ -356,7 +356,7 @@ def segment_frames(plan, times: np.ndarray, k: int) -> np.ndarray:
     return np.flatnonzero((times >= start - 1e-9) & (times < start + plan.segments[k].duration - 1e-9))
 
 
-def the_transit(plan) -> tuple[int, planner.plan_file.Transit]:
+def the_transit(plan) -> tuple[int, planner.model.plan_file.Transit]:
     (k,) = [k for k, s in enumerate(plan.segments) if s.kind == "transit"]
     return k, plan.segments[k]
 
@@ -464,7 +464,7 @@ def test_a_switching_recording_verifies_and_draws_its_transit(switching):
 
 
 class PlannedGhost:
-    """Stands in for a Verification (planner.verify) whose pushes all stick: one check per push,
+    """Stands in for a Verification (planner.execution.verify) whose pushes all stick: one check per push,
     in plan order, transits skipped, and every run's poses the planned ones."""
 
     passed = True

@@ -1,6 +1,6 @@
 """Time limits and progress while the stable regions are computed (issue 10).
 
-``mechanics.exact_region`` stops at a deadline with ``DeadlineExceeded``; ``planner.pushes.edge_pushes``
+``mechanics.exact_region`` stops at a deadline with ``DeadlineExceeded``; ``planner.actions.controls.edge_controls``
 computes the edges that fit before it and raises ``RegionTimeout`` holding them; a progress
 callback hears of each region actually computed; and an input with no stable push anywhere is
 refused before any exact region is computed. Sources of truth: the clock, the cache folder's
@@ -20,8 +20,8 @@ import yaml
 
 from mechanics import DeadlineExceeded, Slider, exact_region
 from planner import SceneError, parse_scene
-from planner.pushes import RegionTimeout, edge_pushes
-from planner.regions import is_cached
+from planner.actions.controls import RegionTimeout, edge_controls
+from planner.actions.region_cache import is_cached
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -29,7 +29,7 @@ ROOT = Path(__file__).resolve().parent.parent
 @pytest.fixture()
 def empty_cache(tmp_path, monkeypatch):
     monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path))
-    monkeypatch.setattr("planner.regions._memory", {})
+    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     return tmp_path
 
 
@@ -67,7 +67,7 @@ def test_a_many_edged_part_computes_what_fits_and_says_so(empty_cache):
     assert len(edges) == 200
     start = time.perf_counter()
     with pytest.raises(RegionTimeout) as caught:
-        edge_pushes(scene, deadline=start + 2.0)
+        edge_controls(scene, deadline=start + 2.0)
     assert time.perf_counter() - start < 3.0
     done = [p.edge for p in caught.value.pushes]
     pending = caught.value.pending
@@ -86,10 +86,10 @@ def test_past_the_deadline_cached_edges_are_still_read(empty_cache):
     the cached two come back and only the others are pending."""
     spec = yaml.safe_load((ROOT / "scenes" / "corridor.yaml").read_text())
     spec["pusher"]["edges"] = [0, 2]
-    edge_pushes(parse_scene(spec, "corridor"))
+    edge_controls(parse_scene(spec, "corridor"))
     spec["pusher"].pop("edges")
     with pytest.raises(RegionTimeout) as caught:
-        edge_pushes(parse_scene(spec, "corridor"), deadline=time.perf_counter())
+        edge_controls(parse_scene(spec, "corridor"), deadline=time.perf_counter())
     assert [p.edge for p in caught.value.pushes] == [0, 2] and caught.value.pending == (1, 3)
 
 
@@ -98,10 +98,10 @@ def test_progress_hears_of_each_region_computed_and_none_cached(empty_cache):
     spec["pusher"]["edges"] = [0, 1, 3]
     scene = parse_scene(spec, "corridor")
     heard = []
-    first = edge_pushes(scene, progress=lambda k, n: heard.append((k, n)))
+    first = edge_controls(scene, progress=lambda k, n: heard.append((k, n)))
     assert heard == [(1, 2), (2, 2)]  # edge 3 is edge 1 turned half round the block: not computed
     heard.clear()
-    again = edge_pushes(scene, progress=lambda k, n: heard.append((k, n)))
+    again = edge_controls(scene, progress=lambda k, n: heard.append((k, n)))
     assert heard == [] and [p.edge for p in again] == [p.edge for p in first] == [0, 1, 3]
 
 
@@ -118,9 +118,9 @@ def test_no_stable_push_anywhere_is_refused_before_any_region(empty_cache, monke
     def refuse(*args, **kwargs):
         raise AssertionError("an exact region was computed")
 
-    monkeypatch.setattr("planner.regions.exact_region", refuse)
+    monkeypatch.setattr("planner.actions.region_cache.exact_region", refuse)
     with pytest.raises(SceneError, match="pusher.edges: no allowed edge has a stable push"):
-        edge_pushes(scene)
+        edge_controls(scene)
 
 
 def test_the_plan_command_honours_its_time_limit_on_a_200_gon(empty_cache, tmp_path):
@@ -145,8 +145,8 @@ def test_no_room_for_the_pusher_is_found_before_any_region(monkeypatch):
     def never(*args, **kwargs):
         raise AssertionError("an exact region was computed")
 
-    monkeypatch.setattr("planner.regions.exact_region", never)
-    monkeypatch.setattr("planner.regions._memory", {})
+    monkeypatch.setattr("planner.actions.region_cache.exact_region", never)
+    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     spec = yaml.safe_load((ROOT / "scenes" / "battery.yaml").read_text())
     spec["obstacles"] = [{"box": {"center": [-0.035, 0.0], "size": [0.01, 0.1]}}]  # against the pushed face
     monkeypatch.setenv("STABLEPUSH_CACHE", "/nonexistent-cache")

@@ -1,4 +1,4 @@
-"""Which stable regions the planner uses (planner.regions): the scene option, the cache, the choice."""
+"""Which stable regions the planner uses (planner.actions.region_cache): the scene option, the cache, the choice."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import yaml
 from mechanics import ExactRegion, Slider, StableSteering, exact_region, stable_region
 from planner import SceneError, load_scene, parse_scene, plan
 from oracle import guaranteed_stable
-from planner.regions import compute_regions, edge_region
+from planner.actions.region_cache import compute_regions, edge_region
 
 ROOT = Path(__file__).resolve().parent.parent
 BLOCK = Slider([[-0.05, 0.0], [0.05, 0.0], [0.05, 0.06], [-0.05, 0.06]])
@@ -31,10 +31,10 @@ def test_bad_regions_option_names_the_field():
 
 def test_cached_region_is_the_computed_one(tmp_path, monkeypatch):
     monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path))
-    monkeypatch.setattr("planner.regions._memory", {})
+    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     first = edge_region(BLOCK, 0, 0.5, 0.08)
     assert isinstance(first, ExactRegion) and len(list(tmp_path.iterdir())) == 1
-    monkeypatch.setattr("planner.regions._memory", {})
+    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     again = edge_region(BLOCK, 0, 0.5, 0.08)
     assert again is not first and again.polygon.equals_exact(first.polygon, 0.0)
     fresh = exact_region(BLOCK, 0, 0.5, 0.08)
@@ -44,16 +44,16 @@ def test_cached_region_is_the_computed_one(tmp_path, monkeypatch):
 
 def test_a_broken_or_unwritable_cache_is_ignored(tmp_path, monkeypatch):
     monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path))
-    monkeypatch.setattr("planner.regions._memory", {})
+    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     good = edge_region(BLOCK, 1, 0.5, None)
     (cached,) = tmp_path.iterdir()
     cached.write_text('{"polygon": [[0, 0], [1')  # cut short
-    monkeypatch.setattr("planner.regions._memory", {})
+    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     assert edge_region(BLOCK, 1, 0.5, None).polygon.equals_exact(good.polygon, 0.0)
     blocked = tmp_path / "file"
     blocked.write_text("")
     monkeypatch.setenv("STABLEPUSH_CACHE", str(blocked / "sub"))  # cannot be made
-    monkeypatch.setattr("planner.regions._memory", {})
+    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     assert edge_region(BLOCK, 1, 0.5, None).polygon.equals_exact(good.polygon, 0.0)
 
 
@@ -85,7 +85,7 @@ def test_a_turn_of_the_part_gives_its_twin_edge_the_same_region(tmp_path, monkey
     oracle, and turns about a centre beyond the part) and agrees with edge 2's region computed
     on its own. An off-centre CF breaks the symmetry: nothing is shared."""
     monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path))
-    monkeypatch.setattr("planner.regions._memory", {})
+    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     block = Slider([[-0.05, -0.03], [0.05, -0.03], [0.05, 0.03], [-0.05, 0.03]])
     progress: list[tuple[int, int]] = []
     regions = compute_regions(block, [0, 1, 2, 3], 0.5, 0.05, progress=lambda k, n: progress.append((k, n)))

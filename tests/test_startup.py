@@ -2,7 +2,7 @@
 
 A warm run imports only what planning and the recording need: scipy's optimize and linalg (a
 third of a second) and matplotlib are left to the commands that use them. A cold run computes the
-edges' exact regions side by side in forked processes (:func:`planner.regions.compute_regions`);
+edges' exact regions side by side in forked processes (:func:`planner.actions.region_cache.compute_regions`);
 sources of truth: the same regions computed one by one in this process, bit for bit, and the
 process ids of the workers that computed them.
 """
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from mechanics import Slider, exact_region
-from planner.regions import compute_regions, is_cached
+from planner.actions.region_cache import compute_regions, is_cached
 
 ROOT = Path(__file__).resolve().parent.parent
 #: The CF off the centre: no turn of the block carries one edge onto another, so each is computed.
@@ -33,7 +33,7 @@ HEAVY = ("scipy.optimize", "scipy.linalg", "matplotlib")
 @pytest.fixture()
 def empty_cache(tmp_path, monkeypatch):
     monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path / "cache"))
-    monkeypatch.setattr("planner.regions._memory", {})
+    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     return tmp_path / "cache"
 
 
@@ -65,7 +65,7 @@ def _noting_process(folder: Path, slider: Slider, edge: int, *args, **kwargs):
 
 
 def test_regions_computed_in_parallel_are_the_serial_ones(empty_cache, tmp_path, monkeypatch):
-    monkeypatch.setattr("planner.regions.exact_region", functools.partial(_noting_process, tmp_path / "who"))
+    monkeypatch.setattr("planner.actions.region_cache.exact_region", functools.partial(_noting_process, tmp_path / "who"))
     heard = []
     got = compute_regions(BLOCK, [0, 1, 2], 0.5, 0.08, progress=lambda k, n: heard.append((k, n)), workers=2)
     assert heard == [(1, 3), (2, 3), (3, 3)]
@@ -100,7 +100,7 @@ def test_the_recorder_writes_in_a_child_and_passes_its_errors_back(tmp_path):
     script = f"""
 import sys
 from planner import load_scene, plan
-from planner.recorder import recorder
+from planner.outputs.recorder import recorder
 scene = load_scene("scenes/battery.yaml")
 result = plan(scene, seed=1)
 with recorder(scene) as write:

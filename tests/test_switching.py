@@ -1,4 +1,4 @@
-"""Plans that switch the pushed edge (planner.search with planner.transit): when they switch,
+"""Plans that switch the pushed edge (planner.search.planning with planner.actions.transit): when they switch,
 what a switch costs, and the options that forbid it.
 
 The transits' geometry is checked independently in tests/test_plans.py (replay of every shipped

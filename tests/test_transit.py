@@ -1,4 +1,4 @@
-"""Transits (planner.transit): the pusher's way from one edge to another, checked with shapely.
+"""Transits (planner.actions.transit): the pusher's way from one edge to another, checked with shapely.
 
 The checks place the pusher's rectangle from the README's definition of the pusher frame and
 measure distances with shapely on densely interpolated poses; they share no geometry code with
@@ -15,8 +15,8 @@ import pytest
 import shapely
 
 from planner import parse_scene
-from planner.transit import ARC_STEP, TransitPlanner
-from planner.validity import CollisionModel
+from planner.actions.transit import ARC_STEP, TransitPlanner
+from planner.world.validity import CollisionModel
 
 RECT = [[-0.05, -0.03], [0.05, -0.03], [0.05, 0.03], [-0.05, 0.03]]
 L_SHAPE = [[0.0, 0.0], [0.09, 0.0], [0.09, 0.035], [0.035, 0.035], [0.035, 0.09], [0.0, 0.09]]

@@ -17,8 +17,8 @@ import yaml
 
 import oracle as O
 from planner import SceneError, parse_scene, plan
-from planner.pushes import edge_pushes
-from planner.verify import verify
+from planner.actions.controls import edge_controls
+from planner.execution.verify import verify
 
 ROOT = Path(__file__).resolve().parent.parent
 PLAN = Path(sys.executable).parent / "plan"
@@ -104,8 +104,8 @@ def test_stable_regions_cannot_take_an_uncertain_cf(tmp_path):
 
 def test_the_uncertain_regions_are_inside_the_known_ones(uncertain):
     _, scene, _ = uncertain
-    (robust,) = edge_pushes(scene)
-    (known,) = edge_pushes(parse_scene(corridor()))
+    (robust,) = edge_controls(scene)
+    (known,) = edge_controls(parse_scene(corridor()))
     assert robust.region.cf_radius == RHO and known.region.cf_radius == 0
     small, large = robust.region.section()[0], known.region.section()[0]
     assert small.area < 0.95 * large.area and large.buffer(0.01).contains(small)

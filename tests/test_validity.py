@@ -8,8 +8,8 @@ import numpy as np
 import shapely
 
 from planner import parse_scene, plan
-from planner.pushes import clearance_margin, edge_pushes, resolution
-from planner.validity import CollisionModel, pose_along
+from planner.actions.controls import clearance_margin, edge_controls, step_length
+from planner.world.validity import CollisionModel, pose_along
 from replay import advance, angle_diff, place, pusher_body
 
 BLOCK = [[-0.04, -0.025], [0.04, -0.025], [0.04, 0.025], [-0.04, 0.025]]
@@ -30,12 +30,12 @@ THIN = [{"box": {"center": [0.0, 0.0], "size": [WALL, 0.3]}}]
 
 def test_wall_is_much_thinner_than_the_search_step():
     s = scene(THIN)
-    assert s.obstacles[0].bounds[2] - s.obstacles[0].bounds[0] < resolution(s) / 5
+    assert s.obstacles[0].bounds[2] - s.obstacles[0].bounds[0] < step_length(s) / 5
 
 
 def test_push_through_thin_wall_is_rejected():
     s = scene(THIN)
-    push = edge_pushes(s)[0]
+    push = edge_controls(s)[0]
     model = CollisionModel(s, [push.edge])
     straight = np.array([1.0, 0.0, 0.0]) / push.speed([1.0, 0.0, 0.0])
     assert not model.push_is_free(s.start, straight, 0.4, push.edge, clearance_margin(s))

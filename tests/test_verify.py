@@ -1,4 +1,4 @@
-"""Verification of plans by the independent simulator (planner.verify, ``plan --verify``).
+"""Verification of plans by the independent simulator (planner.execution.verify, ``plan --verify``).
 
 Sources of truth, none of them the code under test: the planner's guarantee (every shipped plan
 must stick under every distribution); twists placed just across the boundary of procedure STABLE
@@ -26,9 +26,9 @@ import shapely
 import planner
 from mechanics import cor_to_twist, point_velocity, stable_region
 from planner.cli import main
-from planner.plan_file import write_atomic
-from planner.recording import write_recording
-from planner.verify import distributions, verify
+from planner.model.plan_file import write_atomic
+from planner.outputs.recording import write_recording
+from planner.execution.verify import distributions, verify
 from replay import advance
 from test_cli import PLAN, error_field
 from test_recording import entities, rrd_rows

@@ -1,0 +1,245 @@
+"""Each edge's stable region for planning, computed once per part.
+
+Procedure STABLE is a closed form; the exact region (:mod:`mechanics.exact_region`) costs about a
+tenth of a second of certified linear programmes per edge. It depends only on the part, the edge,
+the friction and the pusher's width, so it is kept in memory for the process and on disk across runs:
+a JSON file per region under ``$STABLEPUSH_CACHE`` (default ``$XDG_CACHE_HOME/stablepush`` or
+``~/.cache/stablepush``), named by a hash of everything it depends on, written atomically. A cache
+that cannot be read or written is ignored: the region is then computed again, never guessed.
+
+:func:`compute_regions` computes several edges' regions at once, one process per core: the edges
+are independent, and a cold run of a part otherwise waits for each in turn. The processes are
+forked, so they start in milliseconds with everything already imported (spawning would import
+numpy, shapely and the rest again, which costs about as much as a region); they run only
+numpy and shapely code, never OMPL's. The regions come back pickled, bit for bit the ones this
+process would compute, and this process alone writes the cache.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import signal
+import time
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import shapely
+
+from mechanics import DeadlineExceeded, ExactRegion, Slider, StableRegion, exact_region, stable_region
+
+from ..model.fields import SceneError
+from ..model.plan_file import write_atomic
+
+__all__ = ["cache_folder", "cache_key", "compute_regions", "edge_region", "is_cached"]
+
+#: Bump when the exact region's construction (or the recording's analysis) changes, so old cache
+#: files are not used. 3: the support LPs by a batched simplex (its duals can differ where the LP
+#: is degenerate).
+_VERSION = 3
+
+_memory: dict[str, ExactRegion] = {}
+
+
+def cache_folder() -> Path:
+    """Where exact regions are kept between runs."""
+    if os.environ.get("STABLEPUSH_CACHE"):
+        return Path(os.environ["STABLEPUSH_CACHE"])
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "stablepush"
+
+
+def cache_key(kind: str, slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float,
+              **more) -> str:
+    """The name of a cache file of ``kind`` for one edge: a hash of everything it depends on
+    (and of :data:`_VERSION`, so a change of the mechanics leaves old files unused)."""
+    spec = {"kind": kind, "version": _VERSION, "vertices": slider.vertices.tolist(), "cf": slider.cf.tolist(),
+            "edge": int(edge), "mu": float(mu), "width": None if width is None else float(width),
+            "cf_radius": float(cf_radius)} | more
+    return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
+
+
+def _key(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float) -> str:
+    return cache_key("exact", slider, edge, mu, width, cf_radius)
+
+
+def _path(key: str) -> Path:
+    return cache_folder() / f"exact-{key}.json"
+
+
+def _read(path: Path, stable: StableRegion, cf_radius: float) -> ExactRegion | None:
+    try:
+        data = json.loads(path.read_text())
+        polygon = shapely.Polygon(np.asarray(data["polygon"], dtype=float))
+        centre = np.asarray(data["centre"], dtype=float)
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if not polygon.is_valid or polygon.area <= 0 or centre.shape != (2,):
+        return None
+    return ExactRegion(stable, polygon, centre, cf_radius)
+
+
+def is_cached(slider: Slider, edge: int, mu: float, width: float | None = None, method: str = "exact",
+              cf_radius: float = 0.0) -> bool:
+    """Whether :func:`edge_region` would answer without computing an exact region (a file that
+    turns out unreadable is computed all the same)."""
+    if method == "stable" or stable_region(slider, edge, mu, width).is_empty:
+        return True
+    return any(key in _memory or _path(key).is_file() for key in _keys_alike(slider, edge, mu, width, cf_radius))
+
+
+def _keys_alike(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float) -> list[str]:
+    """The cache keys of ``edge`` and of each edge a turn of the part carries onto it
+    (:attr:`mechanics.Slider.turns`): all have the same region."""
+    return [_key(slider, (edge - r) % slider.n, mu, width, cf_radius) for r in (0, *slider.turns)]
+
+
+def _known(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float,
+           stable: StableRegion) -> ExactRegion | None:
+    """The exact region of ``edge`` from memory or disk, or else of an edge a turn of the part
+    carries onto it: that one's section of the push plane, which is this one's (each edge's push
+    plane is drawn in its own frame, and the turn carries part, CF, contact and pusher along)."""
+    for key in _keys_alike(slider, edge, mu, width, cf_radius):
+        found = _memory.get(key) or _read(_path(key), stable, cf_radius)
+        if found is not None:
+            return replace(found, stable=stable)
+    return None
+
+
+def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None, method: str = "exact",
+                cf_radius: float = 0.0, deadline: float | None = None) -> StableRegion | ExactRegion:
+    """The ``method`` (``'stable'`` or ``'exact'``) stable region of ``edge``, cached as above;
+    ``cf_radius`` (exact only) makes it hold for every CF within that distance of the slider's.
+
+    Raises
+    ------
+    SceneError
+        For ``method='stable'`` with ``cf_radius > 0``: procedure STABLE assumes a known CF.
+    mechanics.DeadlineExceeded
+        When an exact region must be computed and is not done by ``deadline`` (a
+        :func:`time.perf_counter` time); nothing is cached then.
+    """
+    if method == "stable" and cf_radius > 0:
+        raise SceneError("planner.regions", "procedure STABLE assumes a known CF; slider.cf_uncertainty needs "
+                                            "the exact regions")
+    stable = stable_region(slider, edge, mu, width)
+    if method == "stable" or stable.is_empty:
+        return stable
+    key = _key(slider, edge, mu, width, cf_radius)
+    if key in _memory:
+        return _memory[key]
+    region = _known(slider, edge, mu, width, cf_radius, stable)
+    if region is None:
+        _keep(key, exact_region(slider, edge, mu, width, cf_radius=cf_radius, deadline=deadline))
+    else:
+        _memory[key] = region
+    return _memory[key]
+
+
+def _keep(key: str, region: ExactRegion) -> None:
+    """Keep a freshly computed region in memory and, unless it is degenerate, on disk."""
+    _memory[key] = region
+    polygon, centre = region.section()
+    if isinstance(polygon, shapely.Polygon) and polygon.area > 0:  # a degenerate one is cheap: not stored
+        path = _path(key)
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write_atomic(path, json.dumps({"polygon": np.asarray(polygon.exterior.coords).tolist(),
+                                           "centre": centre.tolist()}))
+        except OSError:
+            pass  # a read-only home: compute again next time
+
+
+def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: float | None = None,
+                    cf_radius: float = 0.0, deadline: float | None = None,
+                    progress: Callable[[int, int], None] | None = None,
+                    workers: int | None = None) -> dict[int, ExactRegion]:
+    """Compute the exact regions of ``edges`` (whatever the cache holds) and cache them, up to
+    ``workers`` at a time (default: one per core, at most one per edge) in forked processes. Of
+    edges that a turn of the part carries onto one another (:attr:`mechanics.Slider.turns`), only
+    the first is computed: the others have its region.
+
+    Edges are begun in order, each as soon as a worker is free, ``progress(k, n)`` being called
+    just before the ``k``-th of the ``n`` computed is begun. ``deadline`` (a :func:`time.perf_counter`
+    time, the same clock in every process) abandons the regions still running when it passes
+    and skips those not begun: they are left out of the answer, and nothing is cached for them.
+
+    Examples
+    --------
+    >>> block = Slider([[-0.05, 0.0], [0.05, 0.0], [0.05, 0.06], [-0.05, 0.06]])
+    >>> sorted(compute_regions(block, [0, 2], 0.5, 0.08))
+    [0, 2]
+    >>> compute_regions(block, [0, 2], 0.5, 0.08, deadline=time.perf_counter())
+    {}
+    """
+    first: list[int] = []
+    for edge in edges:
+        if not any((edge - r) % slider.n in first for r in slider.turns):
+            first.append(edge)
+    workers = min(len(first), _cores() if workers is None else workers)
+    out: dict[int, ExactRegion] = {}
+    with _executor(workers) as pool:
+        waiting, running = list(first), {}
+        while waiting or running:
+            while waiting and len(running) < workers and (deadline is None or time.perf_counter() <= deadline):
+                edge = waiting.pop(0)
+                if progress is not None:
+                    progress(len(first) - len(waiting), len(first))
+                running[pool.submit(exact_region, slider, edge, mu, width, cf_radius=cf_radius, deadline=deadline)] = edge
+            if not running:  # past the deadline: the rest are not begun
+                break
+            for future in wait(running, return_when=FIRST_COMPLETED).done:
+                edge = running.pop(future)
+                try:
+                    region = future.result()
+                except DeadlineExceeded:
+                    continue
+                _keep(_key(slider, edge, mu, width, cf_radius), region)
+                out[edge] = region
+    for edge in edges:
+        if edge not in first and any((twin := (edge - r) % slider.n) in out for r in slider.turns):
+            out[edge] = _memory[_key(slider, edge, mu, width, cf_radius)] = replace(
+                out[twin], stable=stable_region(slider, edge, mu, width))
+    return out
+
+
+def _cores() -> int:
+    """The CPUs this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+class _InProcess(Executor):
+    """An executor that runs each call at once, in this process: one worker is not worth a fork."""
+
+    def submit(self, fn: Callable, /, *args, **kwargs) -> Future:
+        future: Future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except Exception as err:  # raised by result(), as a worker's would be
+            future.set_exception(err)
+        return future
+
+
+def _ignore_interrupts() -> None:
+    # Ctrl-C reaches every process of the terminal's group: the parent alone handles it, instead
+    # of each worker printing a traceback. Leaving the executor then waits for the regions still
+    # running, which end by their deadline at the latest.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _executor(workers: int) -> Executor:
+    """``workers`` forked processes, or this process for one (or where processes cannot fork)."""
+    if workers > 1:
+        import multiprocessing  # only for a cold cache: a warm run is spared importing it
+        from concurrent.futures import ProcessPoolExecutor
+
+        if "fork" in multiprocessing.get_all_start_methods():
+            return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
+                                       initializer=_ignore_interrupts)
+    return _InProcess()

@@ -1,0 +1,116 @@
+"""Path quality: how long plans are against a sound lower bound and the Dubins length.
+
+``python -m planner.bench.quality scenes/*.yaml --runs 10`` plans, for every scene's part, four
+obstacle-free tasks (the centre of friction 1 m ahead turned 90 degrees, 0.5 m to the side, 0.5 m
+behind turned round, 0.3 m behind) and the scene itself, for seeds ``1..runs``, and prints per
+task the median length of the centre of friction's path, the lower bound, the Dubins length at
+the tightest car of the part's edges (:mod:`planner.actions.car`) and their ratios.
+
+Lower bound (:func:`planner.queries.geodesic.geodesic_bound`): the length of the shortest path the centre
+of friction can take at all. The disk of radius ``rho`` about the CF (``rho`` its distance to the
+part's boundary) lies inside the part, which never overlaps an obstacle nor leaves the workspace,
+so the CF stays in the workspace shrunk by ``rho`` outside the obstacles grown by ``rho``; the
+shortest path there (a visibility graph of that region's vertices), less how far the goal
+tolerance lets the CF end from its goal position, is at most the CF's path length of any plan
+whatever (any pushes, switches, crabbing). It is sound: the grown obstacles' round corners are
+polygons inside the true circles, which only enlarges the region and shortens its paths. On an
+empty table it is the straight line less that slack; it is weak for tasks that must turn. The
+Dubins length is the shortest path of the best edge's car: a bound for plans that stay on one
+edge's car, not for plans that crab or switch.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import multiprocessing
+import os
+import statistics
+import sys
+from dataclasses import replace
+
+import numpy as np
+from ompl import base as ob
+
+from ..actions.car import edge_car
+from ..queries.geodesic import geodesic_bound
+from ..actions.controls import edge_controls
+from ..model.scene import Scene, load_scene
+from ..search import plan
+
+__all__ = ["TASKS", "dubins_length", "open_task", "main"]
+
+#: Obstacle-free tasks: where the CF goes (metres, in the part's start frame) and the turn (degrees).
+TASKS = {"ahead+90": ((1.0, 0.0), 90.0), "side": ((0.0, 0.5), 0.0), "behind+180": ((-0.5, 0.0), 180.0),
+         "behind": ((-0.3, 0.0), 0.0)}
+
+
+def _pose_with_cf_at(scene: Scene, xy, theta: float) -> np.ndarray:
+    c, s = math.cos(theta), math.sin(theta)
+    cx, cy = scene.slider.cf
+    return np.array([xy[0] - (c * cx - s * cy), xy[1] - (s * cx + c * cy), theta])
+
+
+def open_task(scene: Scene, task: str) -> Scene:
+    """``scene``'s part and pusher on an empty 4 x 4 m table, its CF at the origin, heading 0."""
+    target, turn = TASKS[task]
+    return replace(scene, name=f"{scene.name}:{task}", obstacles=(), workspace=(-2.0, -2.0, 2.0, 2.0),
+                   start=_pose_with_cf_at(scene, (0.0, 0.0), 0.0),
+                   goal=_pose_with_cf_at(scene, target, math.radians(turn)), path=None)
+
+
+def dubins_length(scene: Scene) -> float:
+    """The shortest Dubins path from start to goal among the allowed edges' cars (obstacles ignored)."""
+    best = math.inf
+    for push in edge_controls(scene):
+        car = edge_car(push, scene.slider.cf)
+        if car is None:
+            continue
+        space = ob.DubinsStateSpace(car.radius)
+        a, b = space.allocState(), space.allocState()
+        for state, pose in ((a, scene.start), (b, scene.goal)):
+            x, y, psi = car.state(pose)
+            state.setXY(x, y), state.setYaw(psi)
+        best = min(best, space.distance(a, b))
+    return best
+
+
+def _run(job: tuple[str, str, int, float]) -> tuple[str, str, bool, float, int, int, float, float, float]:
+    path, task, seed, limit = job
+    scene = load_scene(path)
+    if task != "scene":
+        scene = open_task(scene, task)
+    result = plan(scene, seed=seed, time_limit=limit)
+    return (path, task, result.solved, result.path_length(scene.slider.cf), result.pushes, result.switches,
+            result.planning_time_s, geodesic_bound(scene), dubins_length(scene))
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m planner.bench.quality", description=__doc__.splitlines()[0])
+    p.add_argument("scenes", nargs="+", help="scene files; their parts also get the obstacle-free tasks")
+    p.add_argument("--runs", type=int, default=10, help="seeds 1..RUNS per task")
+    p.add_argument("--time-limit", type=float, default=10.0, metavar="S")
+    p.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    args = p.parse_args(argv)
+    tasks = [*TASKS, "scene"]
+    jobs = [(s, t, seed, args.time_limit) for s in args.scenes for t in tasks for seed in range(1, args.runs + 1)]
+    with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
+        results = pool.map(_run, jobs, chunksize=1)
+    print(f"{'scene':<16}{'task':<12}{'solved':>7}{'len_med':>9}{'lower':>8}{'dubins':>8}{'len/low':>8}"
+          f"{'len/dub':>8}{'pushes':>7}{'switch':>7}{'t_med':>7}")
+    for s in args.scenes:
+        for t in tasks:
+            rows = [r for r in results if r[0] == s and r[1] == t]
+            ok = [r for r in rows if r[2]]
+            low, dub = rows[0][7], rows[0][8]
+            med = statistics.median(r[3] for r in ok) if ok else math.nan
+            print(f"{os.path.basename(s)[:-5]:<16}{t:<12}{len(ok):>4}/{len(rows):<2}{med:>9.3f}{low:>8.3f}{dub:>8.3f}"
+                  f"{med / low if low else math.nan:>8.2f}{med / dub:>8.2f}"
+                  f"{statistics.median(r[4] for r in ok) if ok else math.nan:>7g}"
+                  f"{statistics.median(r[5] for r in ok) if ok else math.nan:>7g}"
+                  f"{statistics.median(r[6] for r in rows):>7.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,7 @@
+"""What a person looks at: the rerun recording (:mod:`.recording`), written beside the search by
+a forked process (:mod:`.recorder`), and still pictures (:mod:`.picture`, matplotlib).
+
+Allowed imports: every package below it (:mod:`planner.model`, :mod:`planner.world`,
+:mod:`planner.actions`, :mod:`planner.search`, :mod:`planner.queries`,
+:mod:`planner.execution`) and this one.
+"""

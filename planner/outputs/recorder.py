@@ -1,0 +1,97 @@
+"""Writing the rerun recording beside the search: the ``plan`` command's recorder.
+
+Importing rerun takes about 0.3 s, as long as many searches, and drawing the pushed edge's
+force-status map another 0.1 s. :func:`recorder` forks a child process before the search; while
+the parent plans, the child imports rerun and the recording code and draws the map of each edge
+the plan may start on, then writes the recording it is sent. On a two-core machine the import costs the command
+nothing. The child is forked only where that is safe: on a platform with ``fork`` and while rerun
+is not yet imported (its threads would not survive a fork); otherwise the recording is written in
+this process, as :func:`planner.outputs.recording.write_recording` does.
+
+>>> with recorder(scene) as write:   # doctest: +SKIP
+...     result = plan(scene)
+...     write("out/scene.rrd", scene, result)
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import signal
+import sys
+import traceback
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from ..model.scene import Scene
+
+__all__ = ["recorder"]
+
+#: Seconds the parent waits for a child that has been told to stop.
+_GRACE = 5.0
+
+
+def _write_inline(path: str | Path, *args) -> None:
+    from .recording import write_recording  # rerun takes a third of a second to import
+
+    write_recording(path, *args)
+
+
+def _child(conn, scene: Scene) -> None:
+    """The forked recorder: import rerun and prepare the recording of ``scene`` now, write it
+    when sent the plan."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to report
+    from .recording import prepare  # the import the parent is spared
+
+    prepare(scene, conn.poll)
+    try:
+        job = conn.recv()
+    except EOFError:  # the parent stopped before there was anything to record
+        return
+    try:
+        _write_inline(*job)
+        conn.send(None)
+    except OSError as err:
+        conn.send(err)
+    except Exception:  # a bug: the parent shows it with the child's traceback
+        conn.send(RuntimeError(f"the recorder failed:\n{traceback.format_exc()}"))
+
+
+@contextmanager
+def recorder(scene: Scene) -> Iterator[Callable[..., None]]:
+    """A function with :func:`planner.outputs.recording.write_recording`'s arguments, writing through a
+    child forked now (module docstring) or else in this process; the child is stopped on leaving.
+    A child also prepares what any recording of ``scene`` needs (:func:`planner.outputs.recording.prepare`).
+
+    Raises
+    ------
+    OSError
+        From the call, if the recording cannot be written (as ``write_recording`` raises it).
+    """
+    if "rerun" in sys.modules or "fork" not in multiprocessing.get_all_start_methods():
+        yield _write_inline
+        return
+    context = multiprocessing.get_context("fork")
+    conn, theirs = context.Pipe()
+    child = context.Process(target=_child, args=(theirs, scene), name="stablepush-recorder", daemon=True)
+    child.start()
+    theirs.close()
+
+    sent = []
+
+    def write(path: str | Path, *args) -> None:
+        conn.send((path, *args))
+        sent.append(path)
+        error = conn.recv()
+        if error is not None:
+            raise error
+
+    try:
+        yield write
+    finally:
+        conn.close()
+        if sent:  # it has answered: it is ending
+            child.join(_GRACE)
+        if child.is_alive():  # nothing to record (an error, Ctrl-C): not worth waiting for
+            child.kill()
+            child.join()
