@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
-from planner import certify_unreachable, load_scene, parse_scene, plan, reachability
+from planner import certify_unreachable, load_scene, one_step, parse_scene, plan, reachability
 from replay import replay_plan
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -99,6 +99,23 @@ def test_component_fires_only_when_the_gap_is_narrower_than_the_inscribed_disk(g
     """The disk (diameter 6 cm) passes a 61 mm gap and one exactly 6 cm wide, not a 59 mm one."""
     reason = certify_unreachable(ring(gap), regions=False)
     assert (reason is not None and reason.startswith("component")) is fires, reason
+
+
+def test_component_allows_the_goal_tolerance():
+    """A wall at y >= 0.24 and a goal 5 mm into it: the block's top (3 cm above its centre, as
+    far as its inscribed disk reaches) and the disk's centre are 5 mm beyond where they can be.
+    With the default 1 cm tolerance the goal is still reachable: one straight push on the bottom
+    edge ends 8 mm short of it, clear of the wall. So no certificate may fire, the component one
+    (5 mm < its 1 cm slack) included: a certificate that ignored the slack would call it unreachable."""
+    short, goal = [0.0, 0.207, 0.0], [0.0, 0.215, 0.0]
+    spec = copy.deepcopy(BLOCK) | {"obstacles": [{"box": {"center": [0.0, 0.34], "size": [0.6, 0.2]}}],
+                                   "start": [0.0, -0.3, 0.0], "goal": short}  # a scene's own goal must be clear
+    del spec["tolerance"]
+    scene = parse_scene(spec, "test")
+    assert certify_unreachable(scene, goal, regions=False) is None
+    assert scene.within_tolerance(short, goal)
+    answer = one_step(scene, goal=short)
+    assert answer.reachable and answer.edge == 0 and np.allclose(answer.twist[[0, 2]], 0.0)
 
 
 def test_the_shipped_sealed_scene_gets_the_component_reason():
