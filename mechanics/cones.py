@@ -6,7 +6,7 @@ the frame origin). A cone is kept both ways: by *generators* (its edges) and by 
 ``a . x >= 0`` for every ``x`` in it (its facets). The two are dual: the rows of a cone generate
 its dual cone ``{y : y . x >= 0 for all x in the cone}``.
 
-Lynch (1992) draws both kinds of cone in the plane (MECHANICS.md §3.4):
+Lynch (1992) draws both kinds of cone in the plane (docs/mechanics.md, "Moment labelling"):
 
 * a cone of twists by the rotation centres of its twists, one picture per sense (§2.2);
 * a cone of wrenches by moment labelling (§3.1): the points about which every wrench has a

@@ -5,7 +5,7 @@ with the *inward* normal (the direction the pusher pushes the slider there), and
 coefficient ``mu`` between pusher and slider. An edge-edge contact is its two end points.
 
 Each contact has a tangent ``t = (n_y, -n_x)``: looking from the pusher into the slider along
-``n``, ``t`` points to the right (MECHANICS.md §1.2). Slider motions are twists in the slider frame
+``n``, ``t`` points to the right (docs/mechanics.md, "Conventions"). Slider motions are twists in the slider frame
 (:mod:`mechanics.twist`): a signed COR ``(c, s)`` is the twist ``cor_to_twist(c, s)`` and a
 translation (a COR at infinity) is ``(vx, vy, 0)``.
 """

@@ -1,9 +1,9 @@
-"""Controllability of a part pushed with a finite set of twists (Lynch & Mason 1996, §2; MECHANICS.md §4).
+"""Controllability of a part pushed with a finite set of twists (Lynch & Mason 1996, §2; docs/mechanics.md, "Controllability").
 
 Each control is a constant body twist ``v = (v_x, v_y, omega)``; only its direction matters, so
 the controls are points of the velocity sphere. With ``X_i`` the vector field of twist ``i``,
 ``det(X_i, X_j, [X_i, X_j])`` is the squared length of the first two components of ``v_i x v_j``
-(MECHANICS.md §4), zero just when the two twists are parallel or both translations:
+(docs/mechanics.md, "Controllability"), zero just when the two twists are parallel or both translations:
 
 - **Prop. 1** the part is (small-time) accessible iff some pair has a nonzero determinant;
 - **Prop. 2** then it is also controllable in the obstacle-free plane (the system has no drift);
@@ -86,7 +86,7 @@ def controllability(twists: ArrayLike, tol: float = TOL) -> Controllability:
     Examples
     --------
     A counter-clockwise rotation about ``c`` is the twist ``(c_y, -c_x, 1)``, a clockwise one
-    ``(-c_y, c_x, -1)`` (MECHANICS.md §1.2). Two rotations about distinct centres, ``(0, 0)`` and
+    ``(-c_y, c_x, -1)`` (docs/mechanics.md, "Conventions"). Two rotations about distinct centres, ``(0, 0)`` and
     ``(1, 0)``: controllable (Fig. 5), but every combination turns counter-clockwise, so no
     neighbourhood is reachable in small time:
 

@@ -1,4 +1,4 @@
-"""The exact guaranteed-stable pushes of an edge (Lynch 1992, §4-5; MECHANICS.md §2.5b).
+"""The exact guaranteed-stable pushes of an edge (Lynch 1992, §4-5; docs/mechanics.md, "Exact edge region").
 
 A flat pusher on an edge pushes stably when the slider stays stuck to it whatever the support
 pressure: sticking ``ss`` is force possible (**P**) for every distribution on the part's footprint
@@ -42,7 +42,7 @@ both against a much finer grid and an independent linear programme over explicit
 
 Examples
 --------
-MECHANICS.md §6.2 fixture A (2 x 1 block pushed on its whole bottom face, mu = 0.5): CCW about
+docs/mechanics.md, "Membership table", fixture A (2 x 1 block pushed on its whole bottom face, mu = 0.5): CCW about
 (-3, 1.2) and (-1.5, 0.5) are stable, though STABLE misses both; the mirror CW turn is not.
 
 >>> from mechanics import Slider, cor_to_twist, stable_region

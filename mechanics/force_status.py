@@ -1,4 +1,4 @@
-"""Force status of slider motions: P, U or I (Lynch 1992, §3.3-3.4; MECHANICS.md §2.4, §3.6-3.7).
+"""Force status of slider motions: P, U or I (Lynch 1992, §3.3-3.4; docs/mechanics.md, "Force status").
 
 For a contact mode with composite wrench cone ``W`` (rows ``a``: ``a . w >= 0`` on ``W``) and a
 slider twist, each admissible support distribution ``mu`` needs the load ``L(mu)`` from the
@@ -143,7 +143,7 @@ def force_status(twist: ArrayLike, cone: Cone, support: SupportModel, refinement
     --------
     A 2 x 1 block pushed on its whole bottom face, both ends sticking, mu = 0.5. Pushing straight
     ahead is P (its load, through the CF, is inside the cone); sideways is I. Turning about
-    ``(-3, 0.5)``, far to the left, is P (MECHANICS.md §6.2, fixture A); turning about the CF is
+    ``(-3, 0.5)``, far to the left, is P (docs/mechanics.md, "Membership table", fixture A); turning about the CF is
     U (a ring of support needs a pure moment, a point support at the CF needs nothing at all).
 
     >>> from mechanics import ContactConfiguration, Slider, contact_wrench_cone, cor_to_twist
@@ -194,7 +194,7 @@ def force_possible(twists: ArrayLike, cone: Cone, support: SupportModel, refinem
 
     Examples
     --------
-    Fixture A (MECHANICS.md §6.2): turning CCW about (-3, 0.5) or (-3, 1.2) and pushing straight
+    Fixture A (docs/mechanics.md, "Membership table"): turning CCW about (-3, 0.5) or (-3, 1.2) and pushing straight
     are P for both ends sticking; the mirror CW turn and a sideways push are not.
 
     >>> from mechanics import ContactConfiguration, Slider, contact_wrench_cone, cor_to_twist

@@ -1,4 +1,4 @@
-"""Kinematic analysis of multiple-contact pushing (Lynch 1992, §2; MECHANICS.md §3.5).
+"""Kinematic analysis of multiple-contact pushing (Lynch 1992, §2; docs/mechanics.md, "Kinematic analysis").
 
 **Reuleaux's method (§2.1).** Let ``rho`` be the slider's twist *relative to the pusher*. The
 slider point at contact ``i`` moves relative to the pusher with ``u_i = v + omega k x p_i``; with

@@ -10,7 +10,7 @@ Whether the intersection is empty is decided here by *sampling* the kinematic co
 positive combinations of its generators (the open cone of §2.3), each given a certified force
 status. A sample that is P or U proves the mode can occur (a U still open after refinement is
 counted too: never wrongly impossible); none does not prove the opposite,
-though the samples are spread over every scale of the generators (MECHANICS.md §2.5b: no
+though the samples are spread over every scale of the generators (docs/mechanics.md, "Exact edge region": no
 counterexample was found to the paper's claim that a stable push excludes all other modes). The
 pointwise question, :func:`mode_possible`, has no such caveat.
 
@@ -131,7 +131,7 @@ def possible_motions(
     Examples
     --------
     The 2 x 1 block's bottom face, mu = 0.5, pushed by a CCW rotation about ``(-3, 0.5)``, a
-    guaranteed-stable push (MECHANICS.md §6.2, fixture A): the slider moves with the pusher,
+    guaranteed-stable push (docs/mechanics.md, "Fixtures", fixture A): the slider moves with the pusher,
     sticking, and no other contact mode can occur.
 
     >>> from mechanics import Slider, cor_to_twist

@@ -43,7 +43,7 @@ def stable_region(
 
     Examples
     --------
-    Fixture A of MECHANICS.md §6.2 (a 2 x 1 block pushed on its whole bottom face, mu = 0.5):
+    Fixture A of docs/mechanics.md, "Fixtures" (a 2 x 1 block pushed on its whole bottom face, mu = 0.5):
     turning CCW about (-3, 1.2) is stable, but only the exact region knows it.
 
     >>> from mechanics import cor_to_twist

@@ -4,9 +4,9 @@ A flat pusher in contact with a slider edge pushes it *stably* when the slider s
 pusher whatever the support pressure distribution (inside the part, centre at the CF). STABLE
 returns a conservative set of such pushes: two convex regions of rotation centres, one per
 rotation sense, joined by an interval of translations. As twists, the set is a convex polyhedral
-cone, so every condition below is a linear inequality on the twist (MECHANICS.md §2.2).
+cone, so every condition below is a linear inequality on the twist (docs/mechanics.md, "Procedure STABLE").
 
-Notation (MECHANICS.md §1.2): ``n`` is the edge's inward normal (push direction), ``t = (n_y,
+Notation (docs/mechanics.md, "Conventions"): ``n`` is the edge's inward normal (push direction), ``t = (n_y,
 -n_x)``, ``e_L``/``e_R`` the contact end points with ``t.e_L < t.e_R``, ``d_L``/``d_R`` the friction
 cone edges tilted left/right by ``alpha = atan(mu)``, ``r`` the CF's distance to the farthest
 point of the part and ``p_L``, ``p_R`` its distances to the end points.
@@ -27,7 +27,7 @@ from .twist import cor_to_twist
 
 __all__ = ["StableRegion", "procedure_stable", "DEFAULT_TIP_FACTOR"]
 
-#: Peshkin & Sanderson's tip line lies slightly beyond r^2/p; MECHANICS.md §2.5 found violations
+#: Peshkin & Sanderson's tip line lies slightly beyond r^2/p; docs/mechanics.md, "Checks of STABLE" found violations
 #: 0.5 % inside it, so the line is moved out by 2 %.
 DEFAULT_TIP_FACTOR = 1.02
 
@@ -101,7 +101,7 @@ class StableRegion:
         """Corners of the region (shape ``(k, 3)``): the controls of the 1996 planner.
 
         Rotations are scaled to ``|omega| = 1`` and translations to unit speed; rows are ordered
-        CCW corners, the two end translations, CW corners (MECHANICS.md §2.2).
+        CCW corners, the two end translations, CW corners (docs/mechanics.md, "Translations and extremal twists").
         """
         if self.is_empty:
             return np.zeros((0, 3))
@@ -184,7 +184,7 @@ def procedure_stable(
 
     Examples
     --------
-    Fixture A of MECHANICS.md §6.2: a 2 x 1 block pushed on its whole bottom face, mu = 0.5.
+    Fixture A of docs/mechanics.md, "Fixtures": a 2 x 1 block pushed on its whole bottom face, mu = 0.5.
     The CCW region is the wedge with apex (-2, 0.5), the CW one its mirror image, and the
     translations are those within atan(0.5) = 26.565 deg of the normal:
 
@@ -220,7 +220,7 @@ def procedure_stable(
     u_l, u_r = (e_l - c0) / p_l, (e_r - c0) / p_r
 
     def sense_rows(sense: int, d_near, d_far, u_near, p_near, u_far, p_far) -> np.ndarray:
-        # Steps 1 and 2 of STABLE, as read in MECHANICS.md §2.2 (S1-S4; S1'-S4' mirrored).
+        # Steps 1 and 2 of STABLE, as read in docs/mechanics.md, "Procedure STABLE" (S1-S4; S1'-S4' mirrored).
         return np.array([
             _halfplane_row(d_near, (verts @ d_near).max(), sense),
             _halfplane_row(-d_far, -(verts @ d_far).min(), sense),

@@ -1,4 +1,4 @@
-"""Support friction of a sliding part (Lynch 1992, §3.2; MECHANICS.md §3.6).
+"""Support friction of a sliding part (Lynch 1992, §3.2; docs/mechanics.md, "Effective centre of friction").
 
 **Known pressure.** A support point ``x`` of weight ``w`` (pressure times area) moving with
 velocity ``v(x)`` feels Coulomb friction ``-mu_s w v/|v|``. For a rotation about ``c`` with sense

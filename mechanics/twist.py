@@ -1,4 +1,4 @@
-"""Planar twists and signed centres of rotation (Lynch & Mason 1996, §1; MECHANICS.md §1.2).
+"""Planar twists and signed centres of rotation (Lynch & Mason 1996, §1; docs/mechanics.md, "Conventions").
 
 A planar motion is a twist ``(vx, vy, omega)``: the velocity of the frame origin and the
 angular velocity, both in the same frame. For ``omega != 0`` the same motion is a rotation

@@ -1,4 +1,4 @@
-"""Pusher contact forces of a contact mode (Lynch 1992, §3.1; MECHANICS.md §3.3-3.4).
+"""Pusher contact forces of a contact mode (Lynch 1992, §3.1; docs/mechanics.md, "Contact modes", "Moment labelling").
 
 At a sticking contact (``s``) the force on the slider may lie anywhere in the friction cone; at a
 sliding contact it lies on the cone edge opposite the slider's motion relative to the pusher
@@ -72,7 +72,7 @@ def moment_labels(cone: Cone, window: ArrayLike) -> dict[int, shapely.Geometry]:
     """Moment-labelling regions of a wrench cone: ``{+1: P+, -1: P-}`` clipped to ``window``.
 
     ``P+`` holds the points about which every wrench of the cone has a moment ``>= 0``, ``P-``
-    those with moment ``<= 0`` (MECHANICS.md §3.4). They are the CCW and CW rotation centres of the
+    those with moment ``<= 0`` (docs/mechanics.md, "Moment labelling"). They are the CCW and CW rotation centres of the
     dual cone, since the moment about ``q`` is the power on a unit CCW rotation about ``q``.
 
     Examples

@@ -59,7 +59,7 @@ $STABLEPUSH_CACHE, else $XDG_CACHE_HOME/stablepush or ~/.cache/stablepush (here:
 
 def _silence_nanobind_leak_report() -> None:
     # nanobind reports OMPL objects still alive at interpreter exit on stderr; harmless noise
-    # (STACK.md §1.13). Runs before finalisation, after everything of ours is flushed.
+    # (docs/stack.md, "Leak report at exit"). Runs before finalisation, after everything of ours is flushed.
     sys.stdout.flush()
     sys.stderr.flush()
     os.dup2(os.open(os.devnull, os.O_WRONLY), 2)

@@ -8,7 +8,7 @@ from hypothesis import HealthCheck, settings
 
 def _silence_nanobind_leak_report() -> None:
     # OMPL objects alive at exit (e.g. in tracebacks kept by pytest) make nanobind print a leak
-    # report after the results; harmless (STACK.md §1.13).
+    # report after the results; harmless (docs/stack.md, "Leak report at exit").
     sys.stdout.flush()
     sys.stderr.flush()
     os.dup2(os.open(os.devnull, os.O_WRONLY), 2)

@@ -1,10 +1,10 @@
-"""Test-only oracles for the stable-pushing mechanics (MECHANICS.md §2.2-2.4).
+"""Test-only oracles for the stable-pushing mechanics (docs/mechanics.md, "Procedure STABLE", "Exact LP oracle").
 
 Nothing here imports ``mechanics``: the edge frame, the conditions S1-S4 / S1'-S4', the
 translation test, the composite friction cone and the exact LP oracle are written out again from
 the note, so a test comparing them with ``mechanics.stable`` compares two independent derivations.
 
-Conventions (MECHANICS.md §1.2): twist ``(vx, vy, omega)``; the velocity of a point ``x`` is
+Conventions (docs/mechanics.md, "Conventions"): twist ``(vx, vy, omega)``; the velocity of a point ``x`` is
 ``(vx - omega y, vy + omega x)``; the COR of a rotation is ``(-vy, vx) / omega``; ``n`` is the
 inward normal of the pushed edge, ``t = (n_y, -n_x)``, ``t.e_L < t.e_R``.
 """
@@ -56,7 +56,7 @@ def edge_frame(vertices, i: int, width=None) -> dict:
 
 
 def twist_of_cor(c, sense) -> np.ndarray:
-    """Rotation about ``c`` with ``sense`` (+1 CCW / -1 CW), |omega| = 1 (MECHANICS.md §1.2)."""
+    """Rotation about ``c`` with ``sense`` (+1 CCW / -1 CW), |omega| = 1 (docs/mechanics.md, "Conventions")."""
     c = np.asarray(c, float)
     s = np.broadcast_to(np.asarray(sense, float), c.shape[:-1])
     return np.stack([s * c[..., 1], -s * c[..., 0], s], axis=-1)
@@ -89,7 +89,7 @@ def angle_between(a, b) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------------------
-# Procedure STABLE, re-derived from MECHANICS.md §2.2 (the §2.3 reference form, vectorised)
+# Procedure STABLE, re-derived from docs/mechanics.md, "Procedure STABLE" (vectorised)
 
 
 class Reference:
@@ -218,7 +218,7 @@ class Reference:
 
 
 # ----------------------------------------------------------------------------------------------
-# Exact V_F oracle (MECHANICS.md §2.4)
+# Exact V_F oracle (docs/mechanics.md, "Exact LP oracle")
 
 
 def composite_cone_facets(ref: Reference) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Accessibility, controllability and STLC by stable pushes (Lynch & Mason 1996, §2-3; MECHANICS.md §4).
+"""Accessibility, controllability and STLC by stable pushes (Lynch & Mason 1996, §2-3; docs/mechanics.md, "Controllability").
 
 The hand-built twist sets are checked against reasoning that does not use the code's linear
 programmes: the Lie bracket computed by finite differences for Prop. 1, the convex hull of the
@@ -18,7 +18,7 @@ from planner.actions.controls import edge_controls
 
 
 def ccw(c):
-    """Counter-clockwise rotation about centre ``c`` (MECHANICS.md §1.2)."""
+    """Counter-clockwise rotation about centre ``c`` (docs/mechanics.md, "Conventions")."""
     return [c[1], -c[0], 1.0]
 
 

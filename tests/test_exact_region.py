@@ -1,9 +1,9 @@
 """The exact stable region of an edge (mechanics.exact_region) against independent reasoning.
 
 Sources of truth, none of them the code under test:
-* the membership table of MECHANICS.md §6.2 (its "exact V_F" column, computed by the note's own
+* the membership table of docs/mechanics.md, "Membership table" (its "exact V_F" column, computed by the note's own
   LP oracle), and the note's statement that STABLE finds every stable translation;
-* ``oracle.LPOracle``: the exact V_F test of MECHANICS.md §2.4, linear programmes over explicit
+* ``oracle.LPOracle``: the exact V_F test of docs/mechanics.md, "Exact LP oracle", linear programmes over explicit
   support distributions on a grid of the part (no ``mechanics`` code), plus Theorem 4's
   condition re-derived here (the COR lies beyond the part along the edge);
 * containment of procedure STABLE's region, monotonicity in mu and mirror symmetry.
@@ -22,7 +22,7 @@ RECT = [[-1, 0], [1, 0], [1, 1], [-1, 1]]
 D_VERTS = [(-2, 0), (-0.5, 0), (1, 0), (2, 0), (2, 1), (-2, 1)]
 RAYS = 24  # a coarse trace keeps the suite fast; the guarantee does not depend on it
 
-# Parts for soundness and size: MECHANICS.md fixtures A, B, D, an L-shaped part and a random convex one.
+# Parts for soundness and size: fixtures A, B, D (docs/mechanics.md, "Fixtures"), an L-shaped part and a random convex one.
 PARTS = {
     "A": dict(vertices=np.array(RECT, float), cf=np.array([0.0, 0.5]), edge=0, mu=0.5, width=None),
     "B": dict(vertices=np.array(RECT, float), cf=np.array([0.4, 0.3]), edge=0, mu=0.5, width=None),
@@ -47,7 +47,7 @@ def part(name):
     return CACHE[name]
 
 
-# MECHANICS.md §6.2, rows whose COR lies beyond the part along the edge (Theorem 4).
+# docs/mechanics.md, "Membership table", rows whose COR lies beyond the part along the edge (Theorem 4).
 TABLE = [
     ("A", (-3, 0.5), 1, True), ("A", (-3, 1.2), 1, True), ("A", (-1.5, 0.5), 1, True),
     ("A", (-3, 0.5), -1, False), ("A", (10, 0.5), -1, True),
@@ -162,7 +162,7 @@ def test_mirror_symmetry():
 
 
 def test_no_stable_push_without_a_force_through_the_cf():
-    """Fixture E (MECHANICS.md §6.2): the contact's cone holds no pure force, so nothing is stable
+    """Fixture E (docs/mechanics.md, "Fixtures"): the contact's cone holds no pure force, so nothing is stable
     (Proposition 6), whatever the method."""
     slider = Slider([(-1, 0), (0.5, 0), (1, 0), (1, 1), (-1, 1)], cf=[0.8, 0.5])
     region = exact_region(slider, 0, 0.5, rays=RAYS)

@@ -3,7 +3,7 @@
 Sources of truth, none of them the code under test:
 * the paper's statements (fig. 10b, a single line of force, translations never U, the four ray
   patterns, the disk model being looser than the footprint);
-* MECHANICS.md §6.2's exact-oracle table for fixtures A, B, D, and procedure STABLE (already
+* the exact V_F column of docs/mechanics.md, "Membership table" for fixtures A, B, D, and procedure STABLE (already
   tested against it), whose pushes must all be P;
 * explicit random support distributions and dense-point linear programmes (``brute_force``),
   for the soundness of every P and I verdict and of the bounds behind them;
@@ -166,7 +166,7 @@ def test_upper_bound_is_sound_for_any_multiplier(kind):
 # Force status: fixtures and cross-checks
 
 
-FIXTURE_TABLE = [  # MECHANICS.md §6.2: (vertices, cf, edge, mu, COR, sense, exact V_F)
+FIXTURE_TABLE = [  # docs/mechanics.md, "Membership table": (vertices, cf, edge, mu, COR, sense, exact V_F)
     (RECT, (0, 0.5), 0, 0.5, (-3, 0.5), 1, True),
     (RECT, (0, 0.5), 0, 0.5, (-3, 1.2), 1, True),
     (RECT, (0, 0.5), 0, 0.5, (-1.5, 0.5), 1, True),
@@ -184,7 +184,7 @@ FIXTURE_TABLE = [  # MECHANICS.md §6.2: (vertices, cf, edge, mu, COR, sense, ex
 
 @pytest.mark.parametrize("vertices, cf, edge, mu, cor, sense, want", FIXTURE_TABLE)
 def test_sticking_edge_matches_the_exact_oracle_table(vertices, cf, edge, mu, cor, sense, want):
-    """ss with the footprint model is the exact V_F of MECHANICS.md §2.4/§6.2."""
+    """ss with the footprint model is the exact V_F (docs/mechanics.md, "Exact LP oracle", "Membership table")."""
     slider = Slider(vertices, cf=cf)
     cone = contact_wrench_cone(ContactConfiguration.slider_edge(slider, edge, mu), "ss")
     verdict = force_status(cor_to_twist(cor, sense), cone, SupportModel.of_slider(slider, "footprint"))

@@ -5,9 +5,9 @@ Sources of truth, none of them the code under test (and none of the stable-regio
   gradient of the dissipated power; Coulomb's law checked by a linear program of this file;
 * hand-derived pushes: a translation's load is a pure force through the CF for every support
   distribution, so it sticks iff its line crosses the contact inside the friction cone; far
-  rotation centres of MECHANICS.md §6.2 fixture A (its STABLE wedge apexes are (-2, 0.5) CCW and
+  rotation centres of docs/mechanics.md, "Fixtures", fixture A (its STABLE wedge apexes are (-2, 0.5) CCW and
   (2, 0.5) CW, the wedges opening away from the part);
-* Mason's voting theorem for a point contact (MECHANICS.md §3.8);
+* Mason's voting theorem for a point contact (docs/mechanics.md, "Voting theorem");
 * symmetry (mirror) and convergence of the integrator as the step shrinks.
 """
 

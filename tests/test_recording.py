@@ -81,7 +81,7 @@ def column(batch: pa.RecordBatch, name: str) -> list:
 
 
 def rrd_rows(path: Path, entity: str, component: str, timeline: str | None = None) -> list[tuple]:
-    """[(time, value)] of one component of one entity, over all chunks, sorted (STACK.md §3.6)."""
+    """[(time, value)] of one component of one entity, over all chunks, sorted (docs/stack.md, "Reading recordings")."""
     rows = []
     for chunk in RrdReader(str(path)).store().stream():
         if chunk.entity_path != entity:

@@ -64,7 +64,7 @@ def test_exp_twist_hand_cases(q, v, t, want):
 
 
 def test_exp_twist_keeps_the_cor_fixed():
-    """A rotation about COR c leaves the world image of c in place (MECHANICS.md §1.2)."""
+    """A rotation about COR c leaves the world image of c in place (docs/mechanics.md, "Conventions")."""
     rng = np.random.default_rng(1)
     for _ in range(50):
         q = rng.uniform(-3, 3, 3)
@@ -187,7 +187,7 @@ def test_small_rotations_are_accurate():
 
 
 def test_cor_twist_conventions():
-    """MECHANICS.md §1.2: COR of (vx, vy, w) is (-vy/w, vx/w); CCW about c is (c_y, -c_x, 1)."""
+    """docs/mechanics.md, "Conventions": COR of (vx, vy, w) is (-vy/w, vx/w); CCW about c is (c_y, -c_x, 1)."""
     np.testing.assert_allclose(cor_to_twist([-2.0, 0.0], 1), [0, 2, 1])
     np.testing.assert_allclose(cor_to_twist([3.0, 1.0], -1), [-1, 3, -1])
     cor, sense = twist_to_cor([0.0, 4.0, 2.0])

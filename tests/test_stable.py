@@ -1,9 +1,9 @@
 """Procedure STABLE (mechanics.stable) against independent reasoning.
 
 Sources of truth, none of them the code under test:
-* the hand-derived fixtures A-E and the membership table of MECHANICS.md §6.2;
-* ``oracle.Reference``: the §2.2/§2.3 conditions re-written from the note;
-* ``oracle.LPOracle``: the exact V_F test of §2.4 (linear programs over support distributions);
+* the hand-derived fixtures A-E and the membership table of docs/mechanics.md, "Fixtures", "Membership table";
+* ``oracle.Reference``: the conditions re-written from docs/mechanics.md, "Procedure STABLE";
+* ``oracle.LPOracle``: the exact V_F test of docs/mechanics.md, "Exact LP oracle" (linear programs over support distributions);
 * invariances (mirror, rigid motion, scaling, winding) and monotonicity in mu.
 """
 
@@ -23,7 +23,7 @@ RECT = [[-1, 0], [1, 0], [1, 1], [-1, 1]]
 D_VERTS = [(-2, 0), (-0.5, 0), (1, 0), (2, 0), (2, 1), (-2, 1)]
 E_VERTS = [(-1, 0), (0.5, 0), (1, 0), (1, 1), (-1, 1)]
 
-# MECHANICS.md §6.2 (values given to 4-5 significant digits there).
+# docs/mechanics.md, "Fixtures" (values given to 4-5 significant digits there).
 FIXTURES = {
     "A": dict(vertices=RECT, cf=(0, 0.5), edge=0, mu=0.5, contact=[(-1, 0), (1, 0)], r=1.1180,
               ccw=[(-2, 0.5)], cw=[(2, 0.5)], theta=26.565),
@@ -84,7 +84,7 @@ def unit_dirs(T, r):
 
 
 # ----------------------------------------------------------------------------------------------
-# Fixtures A-E of MECHANICS.md §6.2 (tip_factor = 1.0)
+# Fixtures A-E of docs/mechanics.md, "Fixtures" (tip_factor = 1.0)
 
 
 def test_collinear_vertices_make_a_partial_contact_edge():
@@ -171,7 +171,7 @@ def test_fixture_e_is_empty():
     assert polys[1].is_empty and polys[-1].is_empty
 
 
-# membership table of MECHANICS.md §6.2: (case, COR, sense, STABLE, exact V_F)
+# docs/mechanics.md, "Membership table": (case, COR, sense, STABLE, exact V_F)
 TABLE = [
     ("A", (-3, 0.5), 1, True, True),
     ("A", (-3, 1.2), 1, False, True),
@@ -210,7 +210,7 @@ def test_contains_is_scale_free_and_rejects_zero():
 
 
 # ----------------------------------------------------------------------------------------------
-# Agreement with the independent §2.3 reference on random geometries
+# Agreement with the independent reference on random geometries
 
 
 @pytest.mark.parametrize("seed", range(8))
@@ -247,7 +247,7 @@ def test_cor_vertices_match_brute_force(seed):
 
 
 def test_translations_are_the_limit_of_far_cors():
-    """MECHANICS.md §6.2 (6): a CCW COR at cf + R rho (CW: cf - R rho), R -> inf, gives the
+    """docs/mechanics.md, "Translations and extremal twists": a CCW COR at cf + R rho (CW: cf - R rho), R -> inf, gives the
     translation (rho_y, -rho_x)."""
     for g in geometries(77, 15, nonempty=True):
         region, ref = build(g)
@@ -408,7 +408,7 @@ def test_winding_invariance(seed):
 
 
 # ----------------------------------------------------------------------------------------------
-# Soundness against the exact LP oracle (MECHANICS.md §2.4) and Theorem 4
+# Soundness against the exact LP oracle (docs/mechanics.md, "Exact LP oracle") and Theorem 4
 
 
 def soundness_cases():
@@ -468,7 +468,7 @@ def test_lp_oracle_has_teeth():
     """The oracle rejects twists outside V_F: it can fail.
 
     (1) Translations just outside the friction cone: the wrench is the pure force along the push,
-    outside F for every distribution. (2) Fixture B (MECHANICS.md §2.5): CORs violating only S1, or
+    outside F for every distribution. (2) Fixture B (docs/mechanics.md, "Checks of STABLE"): CORs violating only S1, or
     only S2, on a grid: a good part of them have a distribution pushing the wrench out of F.
     (Note: CORs *just* outside S1/S2 are still in the exact V_F; the exact boundary lies ~0.35-1.2
     beyond S1/S2 in B, so the points are taken on a grid, as in the note.)

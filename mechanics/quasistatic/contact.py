@@ -1,8 +1,8 @@
-"""Pusher-slider point contacts with Coulomb friction and their contact modes (MECHANICS.md §3.3).
+"""Pusher-slider point contacts with Coulomb friction and their contact modes (docs/mechanics.md, "Contact modes").
 
 A contact is a point ``p`` on the slider's boundary with the unit normal ``n`` pointing *into* the
 slider (the direction the pusher pushes) and a friction coefficient ``mu``. Its tangent is
-``t = (n_y, -n_x)`` (MECHANICS.md §1.2: ``(t, n)`` is right-handed; "left" is the ``-t`` side).
+``t = (n_y, -n_x)`` (docs/mechanics.md, "Conventions": ``(t, n)`` is right-handed; "left" is the ``-t`` side).
 A flat pusher on an edge is the two point contacts at the ends of the touching segment (Lynch &
 Mason 1996, §3.3.1).
 

@@ -1,6 +1,6 @@
 """Support distributions over a part's footprint: uniform grids, random ones, and the extreme
 two- and three-point distributions ("dipods", "tripods") that bound what an unknown pressure
-distribution with a known CF can do (MECHANICS.md §2.4: the distributions with centre at the CF
+distribution with a known CF can do (docs/mechanics.md, "Exact LP oracle": the distributions with centre at the CF
 form a polytope whose vertices have at most three points).
 
 Footprints are shapely polygons (``Slider.polygon``). Points on the footprint's boundary count as

@@ -1,4 +1,4 @@
-"""One quasi-static step: every contact mode consistent with force balance (MECHANICS.md §3.3).
+"""One quasi-static step: every contact mode consistent with force balance (docs/mechanics.md, "Contact modes").
 
 Problem. The pusher is kinematically driven with twist ``V_p``; the slider's twist ``V`` is
 unknown. At each contact the relative velocity ``u = v_S(p) - v_P(p)`` and the contact force obey

@@ -6,7 +6,7 @@ Lynch & Mason 1996, §1.1). When the part moves with twist ``V``, the table's fr
 point ``i`` is ``-w_i v_i/|v_i|``, ``v_i`` the point's velocity (Mason 1986). Quasi-statically the
 pusher must supply the opposite wrench, the *load* ``W(V) = sum_i w_i (u_i, x_i x u_i)`` with
 ``u_i = v_i/|v_i|``. ``W`` is the gradient of the dissipated power ``D(V) = sum_i w_i |v_i|``, a
-convex function; the loads ``W`` form the limit surface (MECHANICS.md §3.2).
+convex function; the loads ``W`` form the limit surface (docs/mechanics.md, "Limit surface").
 
 Point supports give the limit surface flat facets: when the rotation centre (COR) sits on support
 point ``k``, that point's friction is any force of norm at most ``w_k`` (it is not moving), so a
@@ -241,7 +241,7 @@ class SupportDistribution:
         wherever the COR crosses a support point, where plain Newton stalls. So it is solved by
         damped Newton on ``sum_i w_i sqrt(|v_i|^2 + eps^2)`` for decreasing ``eps``, each stage
         followed by a try at ``eps = 0`` from there, started from the ellipsoidal limit
-        surface's answer (MECHANICS.md §3.9).
+        surface's answer (docs/mechanics.md, "Ellipsoidal limit surface").
         """
         g = np.asarray(wrench, dtype=float)
         g = g / np.linalg.norm(g)

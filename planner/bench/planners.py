@@ -4,7 +4,7 @@ Plans every scene with every planner for seeds ``1..runs`` and prints, per scene
 success rate, the median and 90th-percentile planning time, and the median path length (of the
 centre of friction), number of pushes and number of switches (edge changes) of the solved runs.
 ``--transit`` overrides every scene's ``pusher.transit`` (``none``: one edge per plan). Runs go to worker processes, one per
-core, each building its own OMPL objects (they cannot be pickled; STACK.md §1.5). ``--ompl-log FILE``
+core, each building its own OMPL objects (they cannot be pickled; docs/stack.md, "Worker processes"). ``--ompl-log FILE``
 also writes the runs in OMPL's benchmark log format (planner.bench.ompl_log), one log per scene, for
 ``ompl_benchmark_statistics.py`` and Planner Arena.
 """

@@ -1,4 +1,4 @@
-"""Which controllability a scene's stable pushes give (Lynch & Mason 1996, §2-3; MECHANICS.md §4).
+"""Which controllability a scene's stable pushes give (Lynch & Mason 1996, §2-3; docs/mechanics.md, "Controllability").
 
 The controls are the extremal stable twists of each allowed edge (the corners of its region,
 whose positive combinations hold the whole region, Prop. 3), decided by

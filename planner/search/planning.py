@@ -60,7 +60,7 @@ _PLANNERS: dict[str, Callable] = {"rrt": oc.RRT, "kpiece": oc.KPIECE1, "est": oc
 
 def _seed_ompl(seed: int) -> None:
     # Re-seeding after the first time prints an OMPL error but works for objects made afterwards
-    # (docs/stack.md), which is all a fresh planning run needs.
+    # (docs/stack.md, "Seeding"), which is all a fresh planning run needs.
     ou.setLogLevel(ou.LOG_NONE)
     ou.RNG.setSeed(seed)
     ou.setLogLevel(ou.LOG_ERROR)

@@ -49,7 +49,7 @@ class PoseProjection(ob.ProjectionEvaluator):
         return 3
 
     def defaultCellSizes(self) -> None:
-        pass  # OMPL infers them from samples (setting them here fails before setup: docs/stack.md)
+        pass  # OMPL infers them from samples (setting them here fails before setup: docs/stack.md, "Projection cell sizes")
 
     def project(self, state, out) -> None:
         p = state[0]

@@ -12,7 +12,7 @@ anything, however thin the obstacle. Two uses:
   clearance itself, and rejecting the push if the clearance ever drops below ``margin``.
 
 Obstacles and the body are python-fcl convex prisms; non-convex shapes are split into convex
-pieces (STACK.md §2: solid ``Convex`` detects containment, meshes do not). Exact narrow-phase
+pieces (docs/stack.md, "Solid convex prisms": solid ``Convex`` detects containment, meshes do not). Exact narrow-phase
 ``fcl.distance`` is called per pair, nearest bounding box first, stopping once no remaining box
 can be nearer. (``DynamicAABBTreeCollisionManager.distance`` was tried and over-reported
 clearances, e.g. 0.154 m for a true 0.150 m, which would make the rule above unsafe.)
