@@ -242,8 +242,8 @@ class _Search:
             hits = list(goal.found[pose_of(path.getState(path.getStateCount() - 1))])
             found = [(g, self._decoded(path, goal, g)) for g in hits]
             # Python wrappers of C++ states must not outlive them: nanobind would hand a stale one,
-            # typed as it was, to the propagator when the next solve reuses the address (docs/stack.md,
-            # "Solution states").
+            # typed as it was, to the propagator when the next solve reuses the address
+            # (docs/stack.md, "Solution states").
             del path
             goal.active = [g for g in goal.active if g not in hits]
             yield from found
