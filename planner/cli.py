@@ -1,6 +1,6 @@
 """The ``plan`` command: plan a scene, print a summary, write the plan JSON and a rerun recording.
 
-``--verify N`` then re-simulates the plan under N support distributions (:func:`planner.execution.verify`)
+``--verify N`` then re-simulates the plan under N support distributions (:func:`planner.verify`)
 and prints a line per push and an overall line with the worst deviation; ``--verify N --plan
 FILE`` verifies a plan file instead of planning, and writes the same outputs (the plan as read,
 and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
@@ -11,7 +11,9 @@ output folder and ``/world/reach`` in the recording.
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
 solved or certified unreachable (:func:`planner.certify_unreachable`, checked before planning; one
 line saying why; nothing is verified), 3 verified and some push slipped beyond the
-tolerance. Output files are written atomically, so an interrupted run leaves no half-written file.
+tolerance, 4 an output could not be written (one line naming the file), 130 Ctrl-C and 143
+SIGTERM (:mod:`planner.model.stop`). Output files are written atomically and checked
+(:mod:`planner.model.files`), so an interrupted or failed run leaves no half-written file.
 :func:`read_inputs` checks everything a run reads before anything is computed or written.
 """
 
@@ -27,9 +29,11 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from .model.fields import shown
-from .model.plan_file import Plan, atomic_path, load_plan, write_atomic
+from .model.files import atomic_path, write_atomic
+from .model.stop import Terminated, raise_on_sigterm
+from .model.plan_file import Plan, load_plan
 from .queries.reachability import certify_unreachable
-from .outputs.recorder import recorder
+from .outputs.recorder import RecordingFailed, recorder
 from .actions.region_cache import cache_folder
 from .model.scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_OPTIMIZE, MAX_SEED, MAX_TIME_LIMIT, PLANNERS,
                     REGIONS, TRANSITS, PlannerOptions, Scene, SceneError, check_optimize, check_seed, check_time_limit,
@@ -47,7 +51,9 @@ exit codes:
        "plan: unreachable: <reason>", at once); the files are still written, "solved": false
        with the reason; or a usage error of these options
   3    --verify: a push slips in the simulator
-  130  interrupted
+  4    an output could not be written: one line "plan: error: cannot write <file>: <OS error>";
+       no file is left in its place (a file already there is kept as it was)
+  130  interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing is written, no process is left
 
 Defaults: a scene's planner: mapping (and pusher.transit) sets its own, which these options
 override; without them --planner {DEFAULT_PLANNER}, --time-limit {PlannerOptions.time_limit:g}, \
@@ -153,13 +159,24 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
 def main(argv: list[str] | None = None) -> int:
     atexit.register(_silence_nanobind_leak_report)
     try:
-        return _run(read_inputs(argv))
+        with raise_on_sigterm():
+            return _run(read_inputs(argv))
     except SceneError as err:
         print(f"plan: error: {err}", file=sys.stderr)
         return 1
+    except _NotWritten as err:
+        print(f"plan: error: {err}", file=sys.stderr)
+        return 4
     except KeyboardInterrupt:
         print("plan: interrupted", file=sys.stderr)
         return 130
+    except Terminated:
+        print("plan: terminated", file=sys.stderr)
+        return 143
+
+
+class _NotWritten(Exception):
+    """An output file could not be written (the message names it and says why)."""
 
 
 def _run(inputs: Inputs) -> int:
@@ -235,19 +252,22 @@ def _fresh_folder(base: Path) -> Path:
 
 def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None, reach,
                    write_recording: Callable[..., None]) -> None:
-    """Write the plan JSON and the recording (with ``check``'s ghost and ``reach``'s map, by
-    ``write_recording``) into ``out``, creating it if need be, and ``reach``'s PNG if given."""
+    """Write the recording (with ``check``'s ghost and ``reach``'s map, by ``write_recording``),
+    ``reach``'s PNG if given, and the plan JSON into ``out``, creating it if need be. The plan file
+    comes last: where it is, the run wrote everything it had to."""
     try:
         out.mkdir(parents=True, exist_ok=True)
-        write_atomic(out / f"{scene.name}.json", result.to_json())
         write_recording(out / f"{scene.name}.rrd", scene, result, check, reach)
         if reach is not None:
             from .queries.reachable_set import write_png
 
             with atomic_path(out / f"{scene.name}-reach.png") as tmp:
                 write_png(reach, scene, str(tmp))
+        write_atomic(out / f"{scene.name}.json", result.to_json())
     except OSError as err:
-        raise SceneError("--out", f"cannot write to {str(out)!r}: {err.strerror or err}") from None
+        raise _NotWritten(f"cannot write {shown(str(err.filename or out))}: {err.strerror or err}") from None
+    except RecordingFailed as err:
+        raise _NotWritten(f"cannot write {shown(str(out / f'{scene.name}.rrd'))}: the recording failed: {err}") from None
 
 
 if __name__ == "__main__":

@@ -24,9 +24,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from planner.model import plan_file
+from planner.model import files
 from planner.cli import main
-from planner.model.plan_file import write_atomic
+from planner.model.files import write_atomic
 from planner.model.scene import DEFAULT_PLANNER, load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -474,7 +474,7 @@ def test_write_atomic_failure_keeps_the_old_file(failing, error, tmp_path, monke
     def fail(*args):
         raise error
 
-    monkeypatch.setattr(plan_file.os, failing, fail)
+    monkeypatch.setattr(files.os, failing, fail)
     with pytest.raises(type(error)):
         write_atomic(target, "new")
     assert target.read_text() == "old"
@@ -490,10 +490,11 @@ def test_failed_write_is_one_error_line_and_keeps_the_old_plan(tmp_path, monkeyp
     def fail(*args):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(plan_file.os, "replace", fail)
-    assert main([str(SCENES / "battery.yaml"), "--out", "out"]) == 1
+    monkeypatch.setattr(files.os, "replace", fail)
+    assert main([str(SCENES / "battery.yaml"), "--out", "out"]) == 4
     captured = capsys.readouterr()
-    assert error_field(captured.err) == "--out" and "No space left" in captured.err and captured.out == ""
+    assert captured.err == "plan: error: cannot write 'out/battery.rrd': No space left on device\n"
+    assert captured.out == ""
     assert (out / "battery.json").read_text() == "old plan"
     assert [p.name for p in out.iterdir()] == ["battery.json"]
 

@@ -26,7 +26,7 @@ import shapely
 import planner
 from mechanics import cor_to_twist, point_velocity, stable_region
 from planner.cli import main
-from planner.model.plan_file import write_atomic
+from planner.model.files import write_atomic
 from planner.outputs.recording import write_recording
 from planner.execution.verify import distributions, verify
 from replay import advance

@@ -33,7 +33,7 @@ import shapely
 from mechanics import DeadlineExceeded, ExactRegion, Slider, StableRegion, exact_region, stable_region
 
 from ..model.fields import SceneError
-from ..model.plan_file import write_atomic
+from ..model.files import write_atomic
 
 __all__ = ["cache_folder", "cache_key", "compute_regions", "edge_region", "is_cached"]
 

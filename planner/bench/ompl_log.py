@@ -25,7 +25,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..model.plan_file import write_atomic
+from ..model.files import write_atomic
 
 __all__ = ["PROPERTIES", "Run", "format_ompl_log", "log_paths", "write_ompl_log"]
 

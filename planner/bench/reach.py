@@ -2,7 +2,7 @@
 
 ``python -m planner.bench.reach scenes/unreachable/sealed.yaml --goals 100 --time-limit 2``
 samples goals uniformly over the scene's workspace (positions) and headings (a fixed random seed),
-answers them with one :func:`planner.queries.reachability` call, then with one call per goal (the
+answers them with one :func:`planner.reachability` call, then with one call per goal (the
 certificates and a :func:`planner.plan`, as ``plan`` on the command line does), and prints the
 answers of each, their wall times and the ratio batch / separate (issue 9's goal: below 0.25). The
 stable regions are computed (or read from the cache) before either is timed.

@@ -10,10 +10,6 @@ the way (:mod:`planner.actions.transit`). Angles are radians.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -26,7 +22,7 @@ from mechanics import exp_twist, point_velocity, relative_pose, wrap_angle
 from .bodies import transform_points
 from .fields import SceneError, integer, keys, number, vector
 
-__all__ = ["FORMAT", "TRANSIT_MODES", "Push", "Transit", "Plan", "atomic_path", "append_push", "load_plan", "rechain", "write_atomic"]
+__all__ = ["FORMAT", "TRANSIT_MODES", "Push", "Transit", "Plan", "append_push", "load_plan", "rechain"]
 
 FORMAT = "stablepush.plan/1"
 #: How a transit moves the pusher: on the table, or lifted over it between two standoff poses.
@@ -349,30 +345,3 @@ def load_plan(path: str | Path) -> Plan:
     except (UnicodeDecodeError, json.JSONDecodeError) as err:
         raise SceneError("plan", f"{str(path)!r} is not valid JSON: {err}") from None
     return Plan.from_dict(data)
-
-
-@contextmanager
-def atomic_path(path: str | Path) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; when the block succeeds, flush it to disk and rename
-    it onto ``path``; when it fails, delete it. Readers see the old file or the whole new one."""
-    path = Path(path)
-    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    tmp = Path(name)
-    try:
-        yield tmp
-        umask = os.umask(0)
-        os.umask(umask)
-        tmp.chmod(0o666 & ~umask)  # mkstemp makes files private; outputs are ordinary files
-        with open(tmp, "rb") as f:
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
-def write_atomic(path: str | Path, data: str | bytes) -> None:
-    """Write ``data`` to ``path`` atomically (see :func:`atomic_path`)."""
-    with atomic_path(path) as tmp:
-        tmp.write_bytes(data.encode() if isinstance(data, str) else data)

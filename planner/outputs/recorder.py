@@ -16,6 +16,7 @@ this process, as :func:`planner.outputs.recording.write_recording` does.
 from __future__ import annotations
 
 import multiprocessing
+import os
 import signal
 import sys
 import traceback
@@ -24,8 +25,9 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from ..model.scene import Scene
+from ..model.stop import Terminated, die_with_parent
 
-__all__ = ["recorder"]
+__all__ = ["RecordingFailed", "recorder"]
 
 #: Seconds the parent waits for a child that has been told to stop.
 _GRACE = 5.0
@@ -34,27 +36,59 @@ _GRACE = 5.0
 def _write_inline(path: str | Path, *args) -> None:
     from .recording import write_recording  # rerun takes a third of a second to import
 
-    write_recording(path, *args)
+    try:
+        write_recording(path, *args)
+    except OSError:
+        raise
+    except Exception as err:
+        raise RecordingFailed.of(err) from err
 
 
-def _child(conn, scene: Scene) -> None:
+def _child(conn, parents_end, parent: int, scene: Scene) -> None:
     """The forked recorder: import rerun and prepare the recording of ``scene`` now, write it
-    when sent the plan."""
+    when sent the plan. It ends with the parent, however that ends: the parent's end of the pipe
+    is closed here (so the parent's exit is an end of file), and a signal comes if the parent is
+    killed. Whatever fails is sent back as one :class:`RecordingFailed`, never printed here."""
+    parents_end.close()
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to report
-    from .recording import prepare  # the import the parent is spared
+    try:
+        die_with_parent(parent)
+        failed = None
+        try:
+            from .recording import prepare  # the import the parent is spared
 
-    prepare(scene, conn.poll)
-    try:
+            prepare(scene, conn.poll)
+        except Exception as err:  # reported when the recording is asked for, with what it says
+            failed = RecordingFailed.of(err)
         job = conn.recv()
-    except EOFError:  # the parent stopped before there was anything to record
+        if failed is not None:
+            conn.send(failed)
+            return
+        try:
+            _write_inline(*job)
+            conn.send(None)
+        except OSError as err:
+            conn.send(err)
+        except Exception as err:
+            conn.send(RecordingFailed.of(err))
+    except (EOFError, BrokenPipeError, Terminated):  # the parent has stopped: so does this process
         return
-    try:
-        _write_inline(*job)
-        conn.send(None)
-    except OSError as err:
-        conn.send(err)
-    except Exception:  # a bug: the parent shows it with the child's traceback
-        conn.send(RuntimeError(f"the recorder failed:\n{traceback.format_exc()}"))
+
+
+class RecordingFailed(Exception):
+    """The recording could not be made (not an OS error: the message names the exception;
+    ``details`` holds its traceback)."""
+
+    def __init__(self, message: str, details: str = ""):
+        super().__init__(message)
+        self.details = details
+
+    @classmethod
+    def of(cls, err: Exception) -> "RecordingFailed":
+        return cls(f"{type(err).__name__}: {err}".splitlines()[0], traceback.format_exc())
+
+    def __reduce__(self):  # sent through the pipe with its details
+        return RecordingFailed, (str(self), self.details)
 
 
 @contextmanager
@@ -67,22 +101,29 @@ def recorder(scene: Scene) -> Iterator[Callable[..., None]]:
     ------
     OSError
         From the call, if the recording cannot be written (as ``write_recording`` raises it).
+    RecordingFailed
+        From the call, if anything else stopped the recording (the recorder process included).
     """
     if "rerun" in sys.modules or "fork" not in multiprocessing.get_all_start_methods():
         yield _write_inline
         return
     context = multiprocessing.get_context("fork")
     conn, theirs = context.Pipe()
-    child = context.Process(target=_child, args=(theirs, scene), name="stablepush-recorder", daemon=True)
+    child = context.Process(target=_child, args=(theirs, conn, os.getpid(), scene), name="stablepush-recorder",
+                            daemon=True)
     child.start()
     theirs.close()
 
     sent = []
 
     def write(path: str | Path, *args) -> None:
-        conn.send((path, *args))
-        sent.append(path)
-        error = conn.recv()
+        try:
+            conn.send((path, *args))
+            sent.append(path)
+            error = conn.recv()
+        except (BrokenPipeError, EOFError):
+            child.join(_GRACE)
+            raise RecordingFailed(f"the recorder process ended unexpectedly (exit code {child.exitcode})") from None
         if error is not None:
             raise error
 

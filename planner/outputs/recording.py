@@ -87,7 +87,8 @@ from mechanics import (ContactConfiguration, Slider, SupportModel, contact_wrenc
                        force_status_regions, twist_to_cor)
 
 from ..model.bodies import pusher_frame_body
-from ..model.plan_file import Plan, Push, Transit, atomic_path, write_atomic
+from ..model.files import write_atomic
+from ..model.plan_file import Plan, Push, Transit
 from ..actions.region_cache import cache_folder, cache_key, edge_region, is_cached
 from ..model.scene import Scene
 from ..actions.transit import edge_contact_pose, transit_pieces, transit_poses
@@ -452,9 +453,9 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
                     reach: ReachableSet | None = None) -> None:
     """Write a rerun recording of ``plan`` for ``scene`` to ``path`` (layout: module docstring).
 
-    The file is written atomically: a temporary file in the same folder is completed (footer
-    included) and then renamed onto ``path``, so readers see the old file or the whole new one,
-    and a failure leaves any previous file untouched and no temporary file behind.
+    The recording is made in memory (footer included) and written with
+    :func:`~planner.model.files.write_atomic`: readers see the old file or the whole new one, and
+    a failed write leaves any previous file untouched and no temporary file behind.
 
     Parameters
     ----------
@@ -465,14 +466,14 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
     plan : Plan
         The planner's result, solved or not (an unsolved plan gives the static scene only).
     verification : Verification, optional
-        :func:`planner.execution.verify` of ``plan``: adds the simulated ghost and the verdict.
+        :func:`planner.verify` of ``plan``: adds the simulated ghost and the verdict.
     reach : ReachableSet, optional
         :func:`planner.queries.reachable_set.reachable_set` from the scene's start: adds ``/world/reach``.
 
     Raises
     ------
     OSError
-        If the temporary file cannot be created or renamed.
+        If the file cannot be written whole (a full disk, say), naming ``path``.
     """
     xmin, ymin, xmax, ymax = scene.workspace
     blueprint = rrb.Blueprint(rrb.Vertical(
@@ -483,19 +484,23 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
             column_shares=[3, 2]),
         rrb.TextLogView(origin="/log", name="summary"),
         row_shares=[6, 1]))
-    with atomic_path(path) as tmp:
-        rec = rr.RecordingStream("stablepush", recording_id=f"{scene.name}-{plan.planner}-seed{plan.seed}")
-        rec.set_log_time_enabled(False)
-        rec.save(str(tmp), default_blueprint=blueprint)
-        try:
-            _log_static(rec, scene, plan)
-            if plan.segments:
-                index, times = _log_motion(rec, scene, plan)
-                if plan.pushes:
-                    _log_analysis(rec, scene, plan)
-                if verification is not None:
-                    _log_ghost(rec, plan, verification, index, times)
-            if reach is not None:
-                _log_reach(rec, reach)
-        finally:
-            rec.disconnect()  # flushes and writes the footer
+    rec = rr.RecordingStream("stablepush", recording_id=f"{scene.name}-{plan.planner}-seed{plan.seed}")
+    rec.set_log_time_enabled(False)
+    # Into memory, then written by this process: rerun's own file sink reports a failed write
+    # (a full disk) only in its log, and the caller would take a truncated file for a good one.
+    stream = rec.binary_stream()
+    try:
+        rec.send_blueprint(blueprint, make_active=False, make_default=True)
+        _log_static(rec, scene, plan)
+        if plan.segments:
+            index, times = _log_motion(rec, scene, plan)
+            if plan.pushes:
+                _log_analysis(rec, scene, plan)
+            if verification is not None:
+                _log_ghost(rec, plan, verification, index, times)
+        if reach is not None:
+            _log_reach(rec, reach)
+        data = stream.read(flush=True)  # the whole recording, footer included
+    finally:
+        rec.disconnect()
+    write_atomic(path, data)

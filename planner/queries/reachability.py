@@ -63,7 +63,7 @@ class Reach:
     pushes, 1 when one push does), ``'unreachable'`` (``reason`` names the certificate) or
     ``'unknown'`` (``reason`` says what ran out). ``verdicts`` (the one-step Goal1/2/3 label per
     allowed edge, :func:`planner.queries.one_step.goal_verdicts`) and ``controllability`` (the scene's,
-    :func:`planner.queries.controllability`) are computed when first read: each costs about 0.1 s, as
+    :func:`planner.controllability`) are computed when first read: each costs about 0.1 s, as
     much as finding most plans.
     """
 

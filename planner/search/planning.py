@@ -18,8 +18,6 @@ time, so a seed still gives one plan), and its plan wins if it costs no more.
 
 from __future__ import annotations
 
-import signal
-import threading
 import time
 from collections.abc import Callable, Iterator
 
@@ -34,6 +32,7 @@ from mechanics import wrap_angle
 from ..actions.controls import RegionTimeout
 from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import MAX_SEED, Scene
+from ..model.stop import signals_deferred
 from . import decode
 from .context import PlanningContext, PlanRequest, Prebuilt, cost, length
 from .goal import PushGoal
@@ -90,7 +89,7 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     from the start (found before any search) is not searched again.
 
     ``prebuilt`` is the edges' pushes and the collision model (built with ``scene.pusher.edges``)
-    for this scene's part, pusher and options, as :func:`planner.queries.reachability` shares them between
+    for this scene's part, pusher and options, as :func:`planner.reachability` shares them between
     goals; they are then not rebuilt, and the time limit is the search's alone.
 
     Raises
@@ -250,20 +249,11 @@ class _Search:
 
 
 def _solve(ss, stop: Callable[[], bool]) -> None:
-    """``ss.solve()`` until ``stop()``; Ctrl-C also stops it, and is raised as KeyboardInterrupt
-    once OMPL has returned (raised inside OMPL's callbacks it would be lost, and the search would
-    end as if it had run out of time)."""
-    if threading.current_thread() is not threading.main_thread():  # signals reach the main thread only
-        ss.solve(ob.PlannerTerminationCondition(stop))
-        return
-    pressed: list[int] = []
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: pressed.append(signum))
-    try:
-        ss.solve(ob.PlannerTerminationCondition(lambda: bool(pressed) or stop()))
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    if pressed:
-        raise KeyboardInterrupt
+    """``ss.solve()`` until ``stop()``; Ctrl-C or SIGTERM also stops it, and is raised (as
+    KeyboardInterrupt or :class:`~planner.model.stop.Terminated`) once OMPL has returned: raised
+    inside OMPL's callbacks it would be lost, and the search would end as if it had run out of time."""
+    with signals_deferred() as noted:
+        ss.solve(ob.PlannerTerminationCondition(lambda: bool(noted) or stop()))
 
 
 def _tree(ss, si) -> np.ndarray:
