@@ -1,7 +1,7 @@
 """The data a run reads and writes: scene files (:mod:`.scene`, over the hardened YAML reader of
-:mod:`.yaml_file`), checked fields and their one-line errors (:mod:`.fields`), the moving bodies
-in the slider frame (:mod:`.bodies`), and plans with their JSON format and atomic file writes
-(:mod:`.plan_file`).
+:mod:`.yaml_file`), the planner's options and their checks (:mod:`.options`), checked fields and
+their one-line errors (:mod:`.fields`), the moving bodies in the slider frame (:mod:`.bodies`),
+and plans with their JSON format and atomic file writes (:mod:`.plan_file`).
 
 Allowed imports: :mod:`mechanics` and this package only. Everything else in :mod:`planner`
 builds on it.
