@@ -5,7 +5,8 @@ Modules follow the papers. Lynch & Mason 1996: :mod:`.twist` (signed CORs and tw
 (procedure STABLE), :mod:`.push_plane` (the chart of an edge's pushes), :mod:`.steering` (a control box mapped onto the stable pushes). Lynch 1992,
 the general multi-contact analysis: :mod:`.cones` (polyhedral cones of twists and wrenches),
 :mod:`.contacts` (contact configurations), :mod:`.kinematics` (Reuleaux's method, §2),
-:mod:`.wrenches` (contact forces, §3.1), :mod:`.support` (support friction, §3.2),
+:mod:`.wrenches` (contact forces, §3.1), :mod:`.support` (support friction, §3.2; its LPs
+solved by the batched simplex of :mod:`.simplex`),
 :mod:`.force_status` (P/U/I, §3.3-3.4), :mod:`.possible_motions` (the combined analysis, §4),
 :mod:`.stable_pushing` (guaranteed-stable pushes and one-step goals, §4-5.1),
 :mod:`.exact_region` (the exact stable pushes of an edge, containing STABLE's), :mod:`.regions`

@@ -42,7 +42,8 @@ question best in a support function's LP, with a fan of directions in :meth:`Loa
 
 These LPs have a handful of constraints (total weight, centroid, and for the minimax one per
 row of the cone), so they are solved by a simplex method run on many twists and directions at
-once in numpy (:class:`LoadBatch`, :func:`_simplex`); HiGHS is only a fallback.
+once in numpy (:class:`LoadBatch`, :func:`~mechanics.simplex.batched_simplex`); HiGHS is only a
+fallback.
 """
 
 from __future__ import annotations
@@ -56,6 +57,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
+from .simplex import batched_simplex
 from .slider import Slider
 from .twist import point_velocity, twist_to_cor
 from .wrenches import point_wrench
@@ -360,8 +362,9 @@ class LoadBatch:
 
     The discrete LP has three constraints (total weight and centroid; four with an uncertain CF),
     so each is solved by a few pivots of the simplex method, all of them at once in numpy
-    (:func:`_simplex`). A sample at the COR, when the COR lies in the region, carries the friction
-    direction that suits ``y`` best (static friction may point anywhere there).
+    (:func:`~mechanics.simplex.batched_simplex`). A sample at the COR, when the COR lies in the
+    region, carries the friction direction that suits ``y`` best (static friction may point
+    anywhere there).
 
     Examples
     --------
@@ -420,7 +423,7 @@ class LoadBatch:
             extra[:, :3, 0] = np.c_[np.ones(k), (self.cor - self.cf) / self.model.radius]
             per_twist = np.concatenate([np.broadcast_to(columns, (k, *columns.shape)), extra], axis=2)
             columns = np.broadcast_to(per_twist[:, None], (k, r, *per_twist.shape[1:])).reshape(k * r, len(rhs), -1)
-        duals, _ = _simplex(costs.reshape(k * r, -1), columns, rhs, np.broadcast_to(start, (k * r, len(rhs))))
+        duals, _ = batched_simplex(costs.reshape(k * r, -1), columns, rhs, np.broadcast_to(start, (k * r, len(rhs))))
         return (duals @ rhs).reshape(k, r), (-duals[:, 1:3] / self.model.radius).reshape(k, r, 2)
 
     @cached_property
@@ -563,79 +566,10 @@ class LoadBatch:
         basis = np.c_[np.broadcast_to(triangle, (k, 3)), np.where(values[np.arange(k), least] >= 0, z, z + 1),
                       slacks[slacks != (z + 2 + least)[:, None]].reshape(k, r - 1),
                       np.full((k, int(rho > 0)), a.shape[2] - 1)].astype(int)
-        duals, unbounded = _simplex(costs, a, rhs, basis)
+        duals, unbounded = batched_simplex(costs, a, rhs, basis)
         beta, lam, value = -duals[:, :r], -duals[:, r + 1:r + 3] / radius, duals @ rhs
         beta[unbounded], lam[unbounded], value[unbounded] = np.nan, 0.0, np.inf
         return beta, lam, value
-
-
-def _simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, basis: np.ndarray,
-             limit: int = 100) -> tuple[np.ndarray, np.ndarray]:
-    """Optimal duals of the LPs ``max costs[p] . s`` s.t. ``columns s = rhs``, ``s >= 0``, one per
-    row of ``costs``, and which LPs are unbounded (their duals mean nothing).
-
-    The revised simplex method on all problems at once: each pivot costs one product of the
-    duals with the columns. ``columns`` (``m, n``) is shared, or one per problem (``P, m, n``);
-    ``basis`` (``P, m``) must be feasible; a cost of ``-inf`` keeps a column out. The returned
-    duals ``pi`` (``P, m``) satisfy ``pi . column <= cost`` to rounding, and ``pi . rhs`` is the
-    optimum. Pivots follow Dantzig's rule (the largest reduced cost), which converges in a few
-    pivots but can cycle on the degenerate vertices a grid through the CF makes (a sample at the
-    CF, others in line with it); after ``limit // 4`` pivots the open problems follow Bland's
-    rule (lowest indices), which cannot cycle. One still open after ``limit`` (rounding) goes to
-    HiGHS.
-
-    >>> # Weights on 0, 1 and 3 (points of a line) with mean 1: the best of costs 0, 2 and 9 mixes 0 and 3.
-    >>> pi, unbounded = _simplex(np.array([[0.0, 2.0, 9.0]]), np.array([[1.0, 1, 1], [-1, 0, 2]]),
-    ...                          np.array([1.0, 0]), np.array([[0, 1]]))
-    >>> (pi @ [1.0, 0]).round(12).tolist(), unbounded.tolist()
-    ([3.0], [False])
-    """
-    problems, m = basis.shape
-    shared = columns.ndim == 2
-    basis = np.array(basis)
-    duals = np.zeros((problems, m))
-    unbounded = np.zeros(problems, dtype=bool)
-    tol = 1e-12 * (1.0 + np.max(np.abs(np.where(np.isfinite(costs), costs, 0.0)), axis=1))
-    open_ = np.arange(problems)
-    for pivot in range(limit):
-        bland = pivot >= limit // 4
-        a = columns if shared else columns[open_]
-        cols = (a[:, basis[open_]].transpose(1, 0, 2) if shared
-                else np.take_along_axis(a, basis[open_][:, None, :], axis=2))
-        c = costs[open_]
-        pi = np.linalg.solve(np.swapaxes(cols, 1, 2), np.take_along_axis(c, basis[open_], axis=1)[..., None])[..., 0]
-        duals[open_] = pi
-        reduced = c - (pi @ a if shared else np.einsum("pm,pmn->pn", pi, a))
-        improving = reduced > tol[open_, None]
-        going = improving.any(axis=1)
-        if not going.any():
-            return duals, unbounded
-        enter = np.argmax(improving if bland else reduced, axis=1)[going]
-        open_, cols = open_[going], cols[going]
-        entering = a[:, enter].T if shared else a[going][np.arange(len(open_)), :, enter]
-        weights = np.linalg.solve(cols, np.broadcast_to(rhs, (len(open_), m))[..., None])[..., 0]
-        step = np.linalg.solve(cols, entering[..., None])[..., 0]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.where(step > 1e-11, np.maximum(weights, 0.0) / step, np.inf)
-        bounded = np.isfinite(ratio).any(axis=1)  # else the entering column grows without end
-        unbounded[open_[~bounded]] = True
-        open_, enter, ratio = open_[bounded], enter[bounded], ratio[bounded]
-        if bland:  # of the tied leaving columns, the lowest
-            ratio = np.where(ratio <= ratio.min(axis=1, keepdims=True), basis[open_], np.inf)
-        basis[open_, np.argmin(ratio, axis=1)] = enter
-    from scipy.optimize import linprog  # rarely needed: scipy.optimize takes a third of a second to import
-
-    for p in open_:
-        a = columns if shared else columns[p]
-        keep = np.isfinite(costs[p])
-        res = linprog(rhs, A_ub=-a[:, keep].T, b_ub=-costs[p, keep], bounds=[(None, None)] * m, method="highs")
-        if res.status == 2:  # no feasible duals: the LP itself is unbounded
-            unbounded[p] = True
-        elif res.status != 0:
-            raise RuntimeError(f"support LP failed: {res.message}")
-        else:
-            duals[p] = res.x
-    return duals, unbounded
 
 
 class SupportLoads:

@@ -12,14 +12,38 @@ command), :mod:`.geodesic` (a lower bound on any plan's length), and the benchma
 :mod:`.quality` and :mod:`.reach_bench`.
 """
 
-from .queries.controllability import SceneControllability, controllability
-from .queries.one_step import OneStep, one_step
+from importlib import import_module
+from typing import TYPE_CHECKING, Any
+
+from .model.fields import SceneError
+from .model.options import DEFAULT_PLANNER
 from .model.plan_file import Plan, Push, Transit, load_plan
+from .model.scene import Scene, load_scene, parse_scene
+from .queries.one_step import OneStep, one_step
 from .queries.reachability import Reach, certify_unreachable, reachability
-from .model.scene import DEFAULT_PLANNER, Scene, SceneError, load_scene, parse_scene
 from .search import plan
-from .execution.verify import Verification, verify
+
+if TYPE_CHECKING:
+    from .execution.verify import Verification, verify
+    from .queries.controllability import SceneControllability, controllability
 
 __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Reach", "Scene", "SceneError", "Push", "Transit",
            "certify_unreachable", "load_plan", "load_scene", "one_step", "parse_scene", "plan", "reachability",
            "Verification", "verify", "SceneControllability", "controllability"]
+
+#: Public names imported on first use, by module: the controllability report needs scipy and
+#: the re-simulator its own mechanics, which a plan run does not (tests/test_startup.py).
+_ON_FIRST_USE = {"SceneControllability": ".queries.controllability", "controllability": ".queries.controllability",
+                 "Verification": ".execution.verify", "verify": ".execution.verify"}
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _ON_FIRST_USE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(import_module(_ON_FIRST_USE[name], __name__), name)
+    globals()[name] = value  # later look-ups find it without coming here
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_ON_FIRST_USE})

@@ -28,16 +28,16 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from .model.fields import shown
+from .model.fields import SceneError, shown
 from .model.files import atomic_path, write_atomic
-from .model.stop import Terminated, raise_on_sigterm
 from .model.plan_file import Plan, load_plan
+from .model.stop import Terminated, raise_on_sigterm
 from .queries.reachability import certify_unreachable
 from .outputs.recorder import RecordingFailed, recorder
 from .actions.region_cache import cache_folder
-from .model.scene import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_OPTIMIZE, MAX_SEED, MAX_TIME_LIMIT, PLANNERS,
-                    REGIONS, TRANSITS, PlannerOptions, Scene, SceneError, check_optimize, check_seed, check_time_limit,
-                    load_scene)
+from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_OPTIMIZE, MAX_SEED, MAX_TIME_LIMIT,
+                            PLANNERS, REGIONS, TRANSITS, PlannerOptions, check_optimize, check_seed, check_time_limit)
+from .model.scene import Scene, load_scene
 from .search import plan
 from .execution.verify import Verification, verify
 

@@ -27,7 +27,8 @@ import yaml
 from planner.model import files
 from planner.cli import main
 from planner.model.files import write_atomic
-from planner.model.scene import DEFAULT_PLANNER, load_scene
+from planner.model.options import DEFAULT_PLANNER
+from planner.model.scene import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "scenes"

@@ -33,7 +33,8 @@ from hypothesis import strategies as st
 
 from planner import load_scene
 from planner.cli import read_inputs
-from planner.model.scene import ANGLE, LENGTH, MIN_SIZE, Scene, SceneError
+from planner.model.fields import ANGLE, LENGTH, SceneError
+from planner.model.scene import MIN_SIZE, Scene
 from test_cli import BATTERY
 from test_hostile_scenes import STAR, alias_bomb
 

@@ -28,6 +28,16 @@ ROOT = Path(__file__).resolve().parent.parent
 BLOCK = Slider([[-0.05, 0.0], [0.05, 0.0], [0.05, 0.06], [-0.05, 0.06]], cf=[0.01, 0.03])
 #: Imported only by what needs them: the controllability report, the simulator and the pictures.
 HEAVY = ("scipy.optimize", "scipy.linalg", "matplotlib")
+#: Left out by ``import planner`` until their public names are used: the controllability report
+#: (scipy) and the quasi-static re-simulator.
+ON_FIRST_USE = ("planner.queries.controllability", "planner.execution.verify", "mechanics.quasistatic")
+
+
+def _fresh(script: str) -> str:
+    """What ``script`` prints, run in a fresh interpreter from the project's folder."""
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 0, run.stderr
+    return run.stdout
 
 
 @pytest.fixture()
@@ -49,12 +59,24 @@ from planner import controllability, load_scene
 print(json.dumps([code, loaded, controllability(load_scene("scenes/parking.yaml")).stlc,
                   "scipy.optimize" in sys.modules]))
 """
-    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=120)
-    assert run.returncode == 0, run.stderr
-    code, loaded, stlc, optimize = json.loads(run.stdout.splitlines()[-1])
+    code, loaded, stlc, optimize = json.loads(_fresh(script).splitlines()[-1])
     assert code == 0 and (tmp_path / "out" / "parking.rrd").is_file()
     assert loaded == []
     assert stlc and optimize
+
+
+def test_import_planner_leaves_the_rarely_used_parts_for_their_first_use():
+    script = f"""
+import json, sys
+import planner
+before = [m for m in {ON_FIRST_USE!r} if m in sys.modules]
+from planner import SceneControllability, Verification, controllability, verify
+from planner import *
+print(json.dumps([before, [m for m in {ON_FIRST_USE!r} if m in sys.modules],
+                  [name for name in planner.__all__ if name not in dir(planner) or name not in globals()]]))
+"""
+    before, after, missing = json.loads(_fresh(script).splitlines()[-1])
+    assert before == [] and after == list(ON_FIRST_USE) and missing == []
 
 
 def _noting_process(folder: Path, slider: Slider, edge: int, *args, **kwargs):
@@ -111,9 +133,7 @@ try:
 except OSError as err:
     print(type(err).__name__, "rerun" in sys.modules)
 """
-    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=120)
-    assert run.returncode == 0, run.stderr
-    assert run.stdout.split() == ["FileNotFoundError", "False"]
+    assert _fresh(script).split() == ["FileNotFoundError", "False"]
     rerun = Path(sys.executable).parent / "rerun"
     if rerun.exists():
         check = subprocess.run([str(rerun), "rrd", "verify", str(tmp_path / "battery.rrd")], capture_output=True,

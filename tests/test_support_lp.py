@@ -1,4 +1,4 @@
-"""The batched support LPs (mechanics.support: LoadBatch, _simplex) against HiGHS.
+"""The batched support LPs (mechanics.support.LoadBatch, mechanics.simplex.batched_simplex) against HiGHS.
 
 Until issue 10 every support value of a certification was one HiGHS linear programme (or a Qhull
 hull) per twist and direction, and every impossibility proof one more (the minimax LP); now a
@@ -34,7 +34,8 @@ from mechanics import (
     force_status,
     procedure_stable,
 )
-from mechanics.support import CF_DIRECTIONS, _simplex
+from mechanics.simplex import batched_simplex
+from mechanics.support import CF_DIRECTIONS
 
 TRAPEZOID = Slider([[-1.2, 0], [1.0, 0], [0.6, 0.9], [-0.5, 1.1]], cf=(-0.1, 0.45))
 BLOCK = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]], cf=(0.3, 0.4))
@@ -280,7 +281,7 @@ def test_simplex_on_random_degenerate_lps():
     columns = np.vstack([np.ones(len(x)), x.T])
     costs = rng.integers(-3, 4, size=(200, len(x))).astype(float)
     start = np.array([[i for i, p in enumerate(x.tolist()) if p in ([-2, -2], [2, -2], [0, 2])]] * 200)
-    duals, unbounded = _simplex(costs, columns, np.array([1.0, 0.0, 0.0]), start)
+    duals, unbounded = batched_simplex(costs, columns, np.array([1.0, 0.0, 0.0]), start)
     assert not unbounded.any()
     for c, pi in zip(costs, duals):
         res = linprog(-c, A_eq=columns, b_eq=[1.0, 0.0, 0.0], bounds=(0, None), method="highs", options=TIGHT)

@@ -21,9 +21,11 @@ from mechanics import DeadlineExceeded, ExactRegion, StableRegion, StableSteerin
 from ..model.bodies import body_outline
 from ..model.plan_file import Push
 from .region_cache import compute_regions, edge_region, is_cached
-from ..model.scene import Scene, SceneError
+from ..model.fields import SceneError
+from ..model.scene import Scene
 
-__all__ = ["EdgeControls", "RegionTimeout", "clearance_margin", "edge_controls", "step_length"]
+__all__ = ["EdgeControls", "NoStablePush", "RegionTimeout", "clearance_margin", "controls_or_reason", "edge_controls",
+           "step_length"]
 
 
 def step_length(scene: Scene) -> float:
@@ -97,11 +99,13 @@ def edge_controls(scene: Scene, deadline: float | None = None,
 
     Raises
     ------
-    SceneError
+    NoStablePush
         If no allowed edge has any (the friction cone of the contact cannot push through the CF, or
-        not for every CF the scene's ``slider.cf_uncertainty`` allows), or if procedure STABLE is
-        asked for with an uncertain CF. An edge on which procedure STABLE finds no push has no
-        exact region to compute (Proposition 6), so such input fails at once.
+        not for every CF the scene's ``slider.cf_uncertainty`` allows). An edge on which procedure
+        STABLE finds no push has no exact region to compute (Proposition 6), so such input fails
+        at once.
+    SceneError
+        If procedure STABLE is asked for with an uncertain CF.
     RegionTimeout
         If ``deadline`` passed first; it holds the pushes of the edges done.
     """
@@ -124,16 +128,42 @@ def edge_controls(scene: Scene, deadline: float | None = None,
     if pending:
         raise RegionTimeout(out, tuple(pending))
     if not out:
-        raise _no_stable_push(scene)
+        raise NoStablePush(scene)
     return out
 
 
-def _no_stable_push(scene: Scene) -> SceneError:
-    """Why no allowed edge has a stable push: the CF's uncertainty, if the CF known exactly would
-    leave one (procedure STABLE's region, cheap and inside the exact one, has pushes), else the edges."""
-    p = scene.pusher
-    if scene.cf_uncertainty > 0 and any(not stable_region(scene.slider, e, p.mu, p.width).is_empty for e in p.edges):
-        return SceneError("slider.cf_uncertainty", f"is too large: no allowed edge has a push stable for every CF "
-                                                   f"within {scene.cf_uncertainty:g} m of the cf, though with the cf "
-                                                   "known exactly some have")
-    return SceneError("pusher.edges", "no allowed edge has a stable push (no contact force can pass through the cf)")
+class NoStablePush(SceneError):
+    """No allowed edge of ``scene`` has a stable push. The field blamed is the CF's uncertainty if
+    the CF known exactly would leave one (procedure STABLE's region, cheap and inside the exact
+    one, has pushes), else the edges."""
+
+    def __init__(self, scene: Scene):
+        p = scene.pusher
+        if scene.cf_uncertainty > 0 and any(not stable_region(scene.slider, e, p.mu, p.width).is_empty
+                                            for e in p.edges):
+            super().__init__("slider.cf_uncertainty", f"is too large: no allowed edge has a push stable for every CF "
+                                                      f"within {scene.cf_uncertainty:g} m of the cf, though with the "
+                                                      "cf known exactly some have")
+        else:
+            super().__init__("pusher.edges", "no allowed edge has a stable push (no contact force can pass through "
+                                             "the cf)")
+
+
+def controls_or_reason(scene: Scene) -> tuple[list[EdgeControls] | None, str | None]:
+    """``(edge_controls(scene), None)``, or ``(None, why)`` when no allowed edge has a stable push
+    (the problem of the :class:`NoStablePush` it raised); other errors pass through.
+
+    A CF beyond the end of edge 0, which no force in the contact's friction cone passes through:
+
+    >>> from planner.model.scene import parse_scene
+    >>> scene = parse_scene({"slider": {"vertices": [[-0.1, 0], [0.05, 0], [0.1, 0], [0.1, 0.1], [-0.1, 0.1]],
+    ...                                 "cf": [0.08, 0.05]},
+    ...     "pusher": {"width": 0.01, "depth": 0.01, "mu": 0.5, "edges": [0]},
+    ...     "workspace": {"min": [-1, -1], "max": [1, 1]}, "start": [0, 0, 0], "goal": [0.5, 0, 0]})
+    >>> controls_or_reason(scene)
+    (None, 'no allowed edge has a stable push (no contact force can pass through the cf)')
+    """
+    try:
+        return edge_controls(scene), None
+    except NoStablePush as err:
+        return None, err.problem

@@ -105,13 +105,26 @@ class DubinsCurves:
     ----------
     scene : Scene
     car : EdgeCar
-    model : CollisionModel
-        With a body for the car's edge.
+    model : CollisionModel, optional
+        With a body for the car's edge; needed only to check curves (:meth:`is_free`, :meth:`connect`).
     margin : float
         Clearance every push keeps.
+
+    Examples
+    --------
+    Lengths need no collision model. The battery's pusher, on the edge at the back, pushes the CF
+    along +x, so the shortest curve to 0.2 m straight ahead is that straight line:
+
+    >>> from planner.actions.car import edge_car
+    >>> from planner.actions.controls import edge_controls
+    >>> from planner.model.scene import load_scene
+    >>> scene = load_scene("scenes/battery.yaml")
+    >>> car = edge_car(edge_controls(scene)[0], scene.slider.cf)
+    >>> round(DubinsCurves(scene, car).between(scene.start, scene.start + [0.2, 0.0, 0.0]), 9)
+    0.2
     """
 
-    def __init__(self, scene: Scene, car: EdgeCar, model: CollisionModel, margin: float):
+    def __init__(self, scene: Scene, car: EdgeCar, model: CollisionModel | None = None, margin: float = 0.0):
         self.car, self.model, self.margin = car, model, margin
         self.space = ob.DubinsStateSpace(car.radius)
         bounds = ob.RealVectorBounds(2)
@@ -129,6 +142,11 @@ class DubinsCurves:
     def length(self) -> float:
         """Length of the CF's path along the Dubins curve between the loaded states."""
         return self.space.distance(self._a, self._b)
+
+    def between(self, start: np.ndarray, goal: np.ndarray) -> float:
+        """Load the car states of slider poses ``start`` and ``goal``; the :meth:`length` between them."""
+        self.states(self.car.state(start), self.car.state(goal))
+        return self.length()
 
     def is_free(self) -> bool:
         """Whether the curve between the loaded states keeps the margin, by conservative
@@ -230,9 +248,9 @@ class DubinsShortcut:
             curves = self.curves.get(e)
             if curves is None:
                 continue
-            curves.states(curves.car.state(start), curves.car.state(end))
-            if curves.length() < (1.0 - _GAIN) * longest:
-                options.append((curves.length(), e))
+            length = curves.between(start, end)
+            if length < (1.0 - _GAIN) * longest:
+                options.append((length, e))
         for _, e in sorted(options):
             found = self.curves[e].connect(start, end)
             if found is not None:

@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 from .ompl_log import Run, log_paths, write_ompl_log
-from ..model.scene import PLANNERS, TRANSITS, load_scene
+from ..model.options import PLANNERS, TRANSITS
+from ..model.scene import load_scene
 from ..search import plan
 
 __all__ = ["main"]

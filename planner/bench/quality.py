@@ -30,9 +30,9 @@ import sys
 from dataclasses import replace
 
 import numpy as np
-from ompl import base as ob
 
 from ..actions.car import edge_car
+from ..actions.dubins import DubinsCurves
 from ..queries.geodesic import geodesic_bound
 from ..actions.controls import edge_controls
 from ..model.scene import Scene, load_scene
@@ -61,18 +61,10 @@ def open_task(scene: Scene, task: str) -> Scene:
 
 def dubins_length(scene: Scene) -> float:
     """The shortest Dubins path from start to goal among the allowed edges' cars (obstacles ignored)."""
-    best = math.inf
-    for push in edge_controls(scene):
-        car = edge_car(push, scene.slider.cf)
-        if car is None:
-            continue
-        space = ob.DubinsStateSpace(car.radius)
-        a, b = space.allocState(), space.allocState()
-        for state, pose in ((a, scene.start), (b, scene.goal)):
-            x, y, psi = car.state(pose)
-            state.setXY(x, y), state.setYaw(psi)
-        best = min(best, space.distance(a, b))
-    return best
+    cf = scene.slider.cf
+    cars = (edge_car(push, cf) for push in edge_controls(scene))
+    return min((DubinsCurves(scene, car).between(scene.start, scene.goal) for car in cars if car is not None),
+               default=math.inf)
 
 
 def _run(job: tuple[str, str, int, float]) -> tuple[str, str, bool, float, int, int, float, float, float]:

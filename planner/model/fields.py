@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "shown", "vector"]
+__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "shown",
+           "vector"]
 
 #: Most characters of a bad value a message quotes: enough to recognise it, never a flood.
 MAX_SHOWN = 100
@@ -110,6 +111,15 @@ class Limit:
             raise SceneError(name, f"must be at most {self.bound:g} {self.unit} in absolute value, "
                                    f"got {shown(float(value))}")
         return value
+
+
+#: Every coordinate and length of the input, in metres: a kilometre is far beyond any table, keeps
+#: squares and areas far from overflow, and is where the recording's 32-bit floats still resolve
+#: 0.1 mm (float64 resolves 1e-13 m there, so a micron-sized feature anywhere is exact to 1e-7).
+LENGTH = Limit(1e3, "m")
+#: Every angle of the input, in degrees: 2777 turns, wrapped to within 1e-10 degrees. Beyond some
+#: 1e16 degrees a float has no digits left below a turn, so the heading it meant is lost.
+ANGLE = Limit(1e6, "degrees")
 
 
 def number(value: Any, name: str, positive: bool = False, limit: Limit | None = None) -> float:

@@ -1,76 +1,40 @@
 """Scene files: the part, the pusher, the table and the task, read from YAML and validated.
 
-Every problem is reported as a :class:`~planner.model.fields.SceneError` naming the offending field, so the command
-line can print one line and exit 1. The format is documented in the README.
+The file is read by the hardened YAML reader of :mod:`.yaml_file`, the ``planner:`` block's options
+are checked by :mod:`.options`. Every problem is reported as a :class:`~planner.model.fields.SceneError`
+naming the offending field, so the command line can print one line and exit 1. The format is
+documented in the README.
 """
 
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import shapely
-import yaml
 from numpy.typing import ArrayLike
 
 from mechanics import Slider, wrap_angle
 
 from .bodies import slider_at
-from .fields import Limit, SceneError, integer, keys, member, number, shown, vector
+from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vector
+from .options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEFAULT_TRANSIT, PlannerOptions,
+                      check_optimize, check_planner, check_regions, check_seed, check_switch_cost, check_time_limit,
+                      check_transit)
+from .yaml_file import read_yaml
 
-__all__ = ["ANGLE", "LENGTH", "MAX_NODES", "MAX_SCENE_BYTES", "MIN_SIZE", "MU_RANGE",
-           "DEFAULT_PLANNER", "DEFAULT_REGIONS", "DEFAULT_SWITCH_COST", "DEFAULT_TRANSIT", "REGIONS", "TRANSITS",
-           "check_optimize", "check_switch_cost", "check_transit", "MAX_OPTIMIZE", "MAX_SEED", "MAX_TIME_LIMIT", "SceneError", "Pusher", "PlannerOptions", "Scene",
-           "check_regions", "check_seed", "check_time_limit", "load_scene", "parse_scene", "PLANNERS"]
+__all__ = ["MIN_SIZE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene"]
 
-PLANNERS = ("rrt", "kpiece", "est")
-#: How each edge's stable pushes are found: procedure STABLE, or the exact region that contains it.
-REGIONS = ("stable", "exact")
-#: Both are sound (mechanics.exact_region); the exact region is the larger.
-DEFAULT_REGIONS = "exact"
-#: How the pusher may get from one edge to another: on the table, lifted over it (an arm; table
-#: moves are allowed too), or not at all (one edge per plan).
-TRANSITS = ("plane", "lift", "none")
-DEFAULT_TRANSIT = "plane"
-#: What a switch of edge costs, in metres of the centre of friction's path: a plan that switches
-#: must be shorter than one that does not by more than this for each switch (Lynch & Mason 1996,
-#: §4, cost per contact change).
-DEFAULT_SWITCH_COST = 0.25
-#: The planner used when neither the scene nor the caller names one (chosen by planner.bench.planners).
-DEFAULT_PLANNER = "rrt"
-#: Seeds are OMPL's ``std::uint_fast32_t``: 32 bits is the most every platform takes.
-MAX_SEED = 2**32 - 1
-#: Most improvement rounds (``planner.optimize``): each is a search as long as the first.
-MAX_OPTIMIZE = 100
-#: One day. OMPL's deadline (now + limit) overflows for limits of some years and then ends the
-#: search at once, so a huge or infinite limit would report failure without having searched.
-MAX_TIME_LIMIT = 86400.0
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
 _MAX_NAME_BYTES = 200
-#: Every coordinate and length of a scene, in metres: a kilometre is far beyond any table, keeps
-#: squares and areas far from overflow, and is where the recording's 32-bit floats still resolve
-#: 0.1 mm (float64 resolves 1e-13 m there, so a MIN_SIZE feature anywhere is exact to 1e-7).
-LENGTH = Limit(1e3, "m")
 #: The pusher's width and depth and a box's sides, in metres (a micron): thinner is no body.
 MIN_SIZE = 1e-6
-#: Every angle of a scene, in degrees: 2777 turns, wrapped to within 1e-10 degrees. Beyond some
-#: 1e16 degrees a float has no digits left below a turn, so the heading it meant is lost.
-ANGLE = Limit(1e6, "degrees")
 #: Friction coefficients read: from all but frictionless to all but a wall (a cone of 89.94 degrees
 #: each side); far beyond them the cone's arithmetic underflows or overflows.
 MU_RANGE = (1e-3, 1e3)
-#: Largest scene file read: a scene is a few kilobytes; a megabyte holds parts of thousands of
-#: vertices and still parses in a few seconds.
-MAX_SCENE_BYTES = 1_000_000
-#: Most values (nodes) a scene file may hold, counting each alias as all of the node it names:
-#: a part of 30000 vertices, or a megabyte of plain numbers, and no more.
-MAX_NODES = 100_000
-#: Deepest nesting of lists and mappings read: a scene's own goes 5 deep (obstacles[0].box.center).
-_MAX_DEPTH = 16
 
 
 @dataclass(frozen=True)
@@ -85,16 +49,6 @@ class Pusher:
     edges: tuple[int, ...]  # the edges that may be pushed
     mu_high: float | None = None  # top of the friction interval, if one was given
     transit: str = DEFAULT_TRANSIT  # how it moves between edges (TRANSITS)
-
-
-@dataclass(frozen=True)
-class PlannerOptions:
-    name: str = DEFAULT_PLANNER
-    time_limit: float = 10.0
-    seed: int = 1
-    regions: str = DEFAULT_REGIONS
-    switch_cost: float = DEFAULT_SWITCH_COST
-    optimize: int = 0  # improvement rounds after the first plan (planner.search.planning.plan)
 
 
 @dataclass(frozen=True)
@@ -155,175 +109,7 @@ def load_scene(path: str | Path) -> Scene:
         If the file cannot be read or any field is missing, unknown or invalid.
     """
     path = Path(path)
-    return parse_scene(_read_yaml(path), default_name=path.stem, path=str(path))
-
-
-def _read_yaml(path: Path) -> Any:
-    try:
-        with path.open("rb") as f:
-            raw = f.read(MAX_SCENE_BYTES + 1)  # no more: a huge file or a device is refused unread
-    except (OSError, ValueError) as err:  # ValueError: a NUL in the path
-        raise SceneError("scene", f"cannot read {shown(str(path))}: {getattr(err, 'strerror', None) or err}") from None
-    if len(raw) > MAX_SCENE_BYTES:
-        raise SceneError("scene", f"{shown(str(path))} is larger than {MAX_SCENE_BYTES} bytes")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as err:
-        raise SceneError("scene", f"{shown(str(path))} is not UTF-8 text (bad byte at offset {err.start})") from None
-    try:
-        return _parse_yaml(text)
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" at {_position(mark)}" if mark else ""
-        problem = getattr(err, "problem", None) or " ".join(str(err).split())  # some messages span two lines
-        kind = "unsupported" if isinstance(err, _Refused) else "malformed"
-        raise SceneError("scene", f"{kind} YAML{where}: {problem}") from None
-
-
-def _parse_yaml(text: str) -> Any:
-    """The document in ``text`` (YAML 1.2 core schema, :class:`_Loader`), once :func:`_check_events`
-    and :func:`_check_keys` have found nothing to refuse."""
-    _check_events(text)
-    loader = _Loader(text)
-    try:
-        node = loader.get_single_node()
-        if node is None:  # an empty file
-            return None
-        _check_keys(node, "scene")
-        return loader.construct_document(node)
-    finally:
-        loader.dispose()
-
-
-class _Refused(yaml.MarkedYAMLError):
-    """Valid YAML that a scene may not use."""
-
-
-def _check_events(text: str) -> None:
-    """Refuse, before anything is built, a document that nests or expands beyond bounds.
-
-    An alias stands for all of the node it names, so a few hundred bytes of aliases of aliases
-    expand to gigabytes: each node's size is counted with its aliases expanded, and a document
-    may hold :data:`MAX_NODES` nodes and nest :data:`_MAX_DEPTH` deep (building it recurses).
-    """
-    done: dict[str, tuple[int, int]] = {}  # anchor -> (nodes, depth) of the node it names
-    stack: list[list] = []  # open lists and mappings: [anchor, nodes so far, depth of the deepest child]
-    # depth: how many lists and mappings a node nests, 0 for a scalar; it sits in len(stack) more.
-    for event in yaml.parse(text, Loader=_Loader):
-        if isinstance(event, yaml.CollectionStartEvent):
-            stack.append([event.anchor, 1, 0])
-            size, depth = 1, 0  # its depth is counted on the stack until it ends
-        elif isinstance(event, yaml.AliasEvent):
-            if event.anchor not in done:  # undefined, or inside the node it names: a loop
-                raise _Refused(problem=f"alias *{event.anchor} does not name a whole node before it",
-                               problem_mark=event.start_mark)
-            size, depth = done[event.anchor]
-        elif isinstance(event, yaml.CollectionEndEvent):
-            anchor, size, deepest = stack.pop()
-            depth = deepest + 1
-            if anchor is not None:
-                done[anchor] = size, depth
-        elif isinstance(event, yaml.ScalarEvent):
-            size, depth = 1, 0
-            if event.anchor is not None:
-                done[event.anchor] = size, depth
-        else:  # stream and document boundaries
-            continue
-        if depth + len(stack) > _MAX_DEPTH:
-            raise _Refused(problem=f"lists and mappings nest more than {_MAX_DEPTH} deep",
-                           problem_mark=event.start_mark)
-        if stack and not isinstance(event, yaml.CollectionStartEvent):
-            stack[-1][1] += size
-            stack[-1][2] = max(stack[-1][2], depth)
-            size = stack[-1][1]
-        if size > MAX_NODES:
-            raise _Refused(problem=f"more than {MAX_NODES} values, counting what aliases stand for",
-                           problem_mark=event.start_mark)
-
-
-def _check_keys(node: yaml.Node, name: str) -> None:
-    """Refuse a key given twice in any mapping under ``node`` (named ``name``): PyYAML would keep the
-    last one silently, and an edit that added a second ``mu:`` would seem to do nothing."""
-    if isinstance(node, yaml.SequenceNode):
-        for i, item in enumerate(node.value):
-            _check_keys(item, f"{name}[{i}]")
-    elif isinstance(node, yaml.MappingNode):
-        first: dict[tuple[str, str], yaml.Mark] = {}
-        for key, value in node.value:
-            if not isinstance(key, yaml.ScalarNode):  # a list or mapping as a key: refused when built
-                continue
-            field = member(name, key.value)
-            if (key.tag, key.value) in first:
-                raise SceneError(field, f"duplicate key (at {_position(first[key.tag, key.value])} "
-                                        f"and {_position(key.start_mark)})")
-            first[key.tag, key.value] = key.start_mark
-            _check_keys(value, field)
-
-
-def _position(mark: yaml.Mark) -> str:
-    return f"line {mark.line + 1}, column {mark.column + 1}"
-
-
-class _Loader(getattr(yaml, "CSafeLoader", yaml.SafeLoader)):  # libyaml's parser, when PyYAML has it: 6 times faster
-    """PyYAML's safe loader reading YAML 1.2's core schema, not YAML 1.1's.
-
-    So ``1e-3`` is a number (YAML 1.1 wants ``1.0e-3``), ``017`` is 17 (not octal 15; octal is
-    ``0o17``), and ``1:30`` (not 90), ``yes``, ``on`` and ``2001-12-14`` are strings; merge keys
-    (``<<``) are plain keys and only the core tags (``!!str``, ``!!int``, ``!!float``, ``!!bool``,
-    ``!!null``, ``!!seq``, ``!!map``) are known.
-    """
-
-    yaml_implicit_resolvers: dict = {}
-    yaml_constructors: dict = {}
-
-    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict:
-        return yaml.constructor.BaseConstructor.construct_mapping(self, node, deep)  # without 1.1's merge keys
-
-
-# YAML 1.2 core schema (§10.3.2); ints before floats, which also match "1".
-_NULL = re.compile(r"(?:~|null|Null|NULL|)\Z")
-_BOOL = re.compile(r"(?:true|True|TRUE|false|False|FALSE)\Z")
-_INT = re.compile(r"(?:[-+]?[0-9]+|0o[0-7]+|0x[0-9a-fA-F]+)\Z")
-_FLOAT = re.compile(r"(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
-                    r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))\Z")
-for _tag, _pattern, _first in (("null", _NULL, ["~", "n", "N", ""]), ("bool", _BOOL, list("tTfF")),
-                               ("int", _INT, list("-+0123456789")), ("float", _FLOAT, list("-+.0123456789"))):
-    _Loader.add_implicit_resolver(f"tag:yaml.org,2002:{_tag}", _pattern, _first)
-
-
-def _scalar(loader: _Loader, node: yaml.ScalarNode, pattern: re.Pattern, kind: str) -> str:
-    """The text of ``node``, which its tag says is a ``kind``: it must read as one by YAML 1.2."""
-    text = loader.construct_scalar(node)
-    if not pattern.match(text):
-        raise yaml.constructor.ConstructorError(problem=f"{shown(text)} is not a YAML 1.2 {kind}",
-                                                problem_mark=node.start_mark)
-    return text
-
-
-def _construct_bool(loader: _Loader, node: yaml.ScalarNode) -> bool:
-    return _scalar(loader, node, _BOOL, "boolean").lower() == "true"
-
-
-def _construct_int(loader: _Loader, node: yaml.ScalarNode) -> int:
-    text = _scalar(loader, node, _INT, "integer")
-    try:
-        return int(text[2:], 8 if text[1] == "o" else 16) if text[:2] in ("0o", "0x") else int(text)
-    except ValueError:  # Python reads at most 4300 digits (sys.get_int_max_str_digits)
-        raise yaml.constructor.ConstructorError(problem=f"an integer of {len(text)} digits is too long",
-                                                problem_mark=node.start_mark) from None
-
-
-def _construct_float(loader: _Loader, node: yaml.ScalarNode) -> float:
-    text = _scalar(loader, node, _FLOAT, "number").lower()
-    return float(text.replace(".inf", "inf").replace(".nan", "nan"))
-
-
-for _tag, _constructor in (("null", yaml.SafeLoader.construct_yaml_null), ("bool", _construct_bool),
-                           ("int", _construct_int), ("float", _construct_float),
-                           ("str", yaml.SafeLoader.construct_yaml_str), ("seq", yaml.SafeLoader.construct_yaml_seq),
-                           ("map", yaml.SafeLoader.construct_yaml_map)):
-    _Loader.add_constructor(f"tag:yaml.org,2002:{_tag}", _constructor)
-_Loader.add_constructor(None, yaml.SafeLoader.construct_undefined)  # any other tag is an error
+    return parse_scene(read_yaml(path, "scene"), default_name=path.stem, path=str(path))
 
 
 def _points(value: Any, name: str) -> np.ndarray:
@@ -484,7 +270,7 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     opts = keys(spec.get("planner", {}), "planner", (),
                 ("name", "time_limit", "seed", "regions", "switch_cost", "optimize"))
     planner = PlannerOptions(
-        name=_one_of(opts.get("name", DEFAULT_PLANNER), PLANNERS, "planner.name"),
+        name=check_planner(opts.get("name", DEFAULT_PLANNER), "planner.name"),
         time_limit=check_time_limit(opts.get("time_limit", PlannerOptions.time_limit), "planner.time_limit"),
         seed=check_seed(opts.get("seed", PlannerOptions.seed), "planner.seed"),
         regions=check_regions(opts.get("regions", DEFAULT_REGIONS), "planner.regions"),
@@ -512,68 +298,3 @@ def _name(value: Any) -> str:
     if len(value.encode()) > _MAX_NAME_BYTES:
         raise SceneError("name", f"must be at most {_MAX_NAME_BYTES} bytes long, got {len(value.encode())}")
     return value
-
-
-def _one_of(value: Any, choices: tuple[str, ...], name: str) -> str:
-    if value not in choices:
-        raise SceneError(name, f"must be one of {', '.join(choices)}, got {shown(value)}")
-    return value
-
-
-def check_regions(value: Any, name: str) -> str:
-    """``value`` as a region method (:data:`REGIONS`); else a :class:`SceneError` naming ``name``."""
-    return _one_of(value, REGIONS, name)
-
-
-def check_transit(value: Any, name: str) -> str:
-    """``value`` as a transit mode (:data:`TRANSITS`); else a :class:`SceneError` naming ``name``."""
-    return _one_of(value, TRANSITS, name)
-
-
-def check_switch_cost(value: Any, name: str) -> float:
-    """``value`` as a switch cost in metres (>= 0); else a :class:`SceneError` naming ``name``.
-
-    >>> check_switch_cost(0, "planner.switch_cost")
-    0.0
-    >>> check_switch_cost(-0.1, "planner.switch_cost")
-    Traceback (most recent call last):
-    ...
-    planner.model.fields.SceneError: planner.switch_cost: must be >= 0, got -0.1
-    """
-    cost = number(value, name, limit=LENGTH)
-    if cost < 0:
-        raise SceneError(name, f"must be >= 0, got {shown(value)}")
-    return cost
-
-
-def check_optimize(value: Any, name: str) -> int:
-    """``value`` as a number of improvement rounds (0..:data:`MAX_OPTIMIZE`); else a
-    :class:`SceneError` naming ``name``.
-
-    >>> check_optimize(3, "planner.optimize")
-    3
-    >>> check_optimize(-1, "--optimize")
-    Traceback (most recent call last):
-    ...
-    planner.model.fields.SceneError: --optimize: must be an integer in 0..100, got -1
-    """
-    rounds = integer(value, name)
-    if not 0 <= rounds <= MAX_OPTIMIZE:
-        raise SceneError(name, f"must be an integer in 0..{MAX_OPTIMIZE}, got {rounds}")
-    return rounds
-
-
-def check_seed(value: Any, name: str) -> int:
-    """``value`` as a planner seed; else a :class:`SceneError` naming ``name`` (a field or a flag)."""
-    seed = integer(value, name)
-    if not 1 <= seed <= MAX_SEED:
-        raise SceneError(name, f"must be an integer in 1..{MAX_SEED}, got {seed}")
-    return seed
-
-
-def check_time_limit(value: Any, name: str) -> float:
-    """``value`` as a planning time limit in seconds; else a :class:`SceneError` naming ``name``."""
-    limit = number(value, name, positive=True)
-    if limit > MAX_TIME_LIMIT:
-        raise SceneError(name, f"must be at most {MAX_TIME_LIMIT:g} s, got {shown(value)}")
-    return limit

@@ -43,8 +43,9 @@ from mechanics import wrap_angle
 from ..model.bodies import pusher_polygon, slider_at, transform_points
 from .one_step import goal_verdicts
 from ..model.plan_file import Plan
-from ..actions.controls import EdgeControls, edge_controls
-from ..model.scene import Scene, SceneError
+from ..actions.controls import controls_or_reason
+from ..model.fields import SceneError
+from ..model.scene import Scene
 from ..search import plan_batch
 from ..world.free_space import ROUNDING_SHRINK, cover, disk_free_space
 from ..world.validity import CollisionModel
@@ -138,16 +139,6 @@ class _Certificates:
         return None
 
 
-def _no_stable_push(scene: Scene) -> tuple[list[EdgeControls] | None, str | None]:
-    """The allowed edges' pushes, or None and certificate 4's reason if no edge has any."""
-    try:
-        return edge_controls(scene), None
-    except SceneError as err:
-        if err.field not in ("pusher.edges", "slider.cf_uncertainty"):
-            raise
-        return None, f"no stable push: {err.problem}"
-
-
 def certify_unreachable(scene: Scene, goal: ArrayLike | None = None, *, regions: bool = True) -> str | None:
     """The reason ``goal`` (default: the scene's, radians) is certainly unreachable from the
     scene's start, or None if no certificate shows it (see the module's list). With
@@ -163,8 +154,13 @@ def certify_unreachable(scene: Scene, goal: ArrayLike | None = None, *, regions:
     goal = _goal(scene.goal if goal is None else goal)
     reason = _Certificates(scene)(goal)
     if reason is None and regions and not scene.within_tolerance(scene.start, goal):
-        reason = _no_stable_push(scene)[1]
+        reason = _no_stable_push_reason(controls_or_reason(scene)[1])
     return reason
+
+
+def _no_stable_push_reason(why: str | None) -> str | None:
+    """Certificate 4's reason, given why no edge has a stable push (None: some edge has one)."""
+    return None if why is None else f"no stable push: {why}"
 
 
 def _goal(pose: ArrayLike) -> np.ndarray:
@@ -200,7 +196,8 @@ def reachability(scene: Scene, goals: ArrayLike | None = None, *, pushes: int | 
     if rows.ndim != 2 or rows.shape[1] != 3 or not np.all(np.isfinite(rows)):
         raise SceneError("goals", f"must be finite (x, y, theta) rows, got an array of shape {rows.shape}")
     certificates = _Certificates(scene)
-    edge_set, no_push = _no_stable_push(scene)
+    edge_set, why = controls_or_reason(scene)
+    no_push = _no_stable_push_reason(why)
     goals = [_goal(row) for row in rows]
     reasons = [certificates(goal) or (no_push if not scene.within_tolerance(scene.start, goal) else None)
                for goal in goals]

@@ -46,8 +46,7 @@ from mechanics import log_pose, wrap_angle
 from ..actions.push import connect
 from ..model.plan_file import Push
 from ..search.goal_region import GoalRegion
-from ..actions.controls import EdgeControls, clearance_margin
-from .reachability import _no_stable_push
+from ..actions.controls import EdgeControls, clearance_margin, controls_or_reason
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
@@ -143,7 +142,7 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
     theta = np.full(nx * ny, np.nan)
     blocked = np.ones(nx * ny, dtype=bool)
 
-    edges, _ = _no_stable_push(scene)
+    edges, _ = controls_or_reason(scene)
     if edges is not None:
         model = CollisionModel(scene, [p.edge for p in edges])
         margin = clearance_margin(scene)

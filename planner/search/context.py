@@ -16,7 +16,9 @@ from ..actions.dubins import DubinsShortcut
 from ..actions.shortcut import JoinShortcut
 from ..actions.transit import TransitPlanner
 from ..model.plan_file import Plan, Push, Transit
-from ..model.scene import PLANNERS, Scene, SceneError, check_optimize, check_regions, check_switch_cost, check_transit
+from ..model.fields import SceneError
+from ..model.options import PLANNERS, check_optimize, check_regions, check_switch_cost, check_transit
+from ..model.scene import Scene
 from ..world.validity import CollisionModel
 from .goal_region import GoalRegion
 

@@ -31,7 +31,8 @@ from mechanics import wrap_angle
 
 from ..actions.controls import RegionTimeout
 from ..model.plan_file import Plan, Push, Transit
-from ..model.scene import MAX_SEED, Scene
+from ..model.options import MAX_SEED
+from ..model.scene import Scene
 from ..model.stop import signals_deferred
 from . import decode
 from .context import PlanningContext, PlanRequest, Prebuilt, cost, length
