@@ -137,9 +137,10 @@ class Scene:
         (a turn by ``a`` moves it ``2 reach sin(a / 2) <= reach a``).
 
         >>> from dataclasses import replace
-        >>> replace(parse_scene({"slider": {"vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]},
+        >>> scene = replace(parse_scene({"slider": {"vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]},
         ...     "pusher": {"width": 0.5, "depth": 0.1, "mu": 0.5}, "workspace": {"min": [-3, -3], "max": [3, 3]},
-        ...     "start": [0, 0, 0], "goal": [1, 0, 0]}), tolerance_angle=0.1).tolerance_slack(2.0).round(12)
+        ...     "start": [0, 0, 0], "goal": [1, 0, 0]}), tolerance_angle=0.1)
+        >>> round(scene.tolerance_slack(2.0), 12)
         0.21
         """
         return self.tolerance_position + reach * self.tolerance_angle
