@@ -20,7 +20,8 @@ atexit.register(_silence_nanobind_leak_report)
 @pytest.fixture(scope="session", autouse=True)
 def region_cache(request, tmp_path_factory):
     """Exact regions are cached on disk (planner.actions.region_cache): keep the tests' copy in pytest's cache
-    folder, not the user's, for this process and the ``plan`` commands it starts."""
+    folder, not the user's, for this process's default cache (made from the environment on first
+    use, after this) and the ``plan`` commands it starts."""
     cache = getattr(request.config, "cache", None)  # None with -p no:cacheprovider
     folder = cache.mkdir("stablepush-regions") if cache else tmp_path_factory.mktemp("stablepush-regions")
     old = os.environ.get("STABLEPUSH_CACHE")

@@ -7,6 +7,8 @@ allowed edges.
 
 from __future__ import annotations
 
+import gc
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -61,3 +63,25 @@ def test_states_and_poses_are_inverse():
         c, s = np.cos(pose[2]), np.sin(pose[2])
         cf = pose[:2] + np.array([[c, -s], [s, c]]) @ scene.slider.cf
         np.testing.assert_allclose(car.state(pose)[:2], cf, atol=1e-12)
+
+
+def test_a_cars_memo_keeps_no_region_alive(tmp_path):
+    """Cars are remembered by region, weakly: controls rebuilt on the same region get the same
+    car, procedure STABLE's regions (made afresh) get theirs, and once nothing else holds a
+    region (its own cache gone) the memo does not keep it."""
+    from dataclasses import replace
+
+    from planner.actions.region_cache import RegionCache
+
+    scene = load_scene(ROOT / "scenes" / "parking.yaml")
+    first = edge_controls(scene, cache=RegionCache(tmp_path))[0]
+    car = edge_car(first, scene.slider.cf)
+    again = edge_car(replace(first), scene.slider.cf)
+    assert again.push is not first and (again.heading == car.heading).all() and again.radius == car.radius
+    stable = edge_controls(replace(scene, planner=replace(scene.planner, regions="stable")))[0]
+    stable_car = edge_car(stable, scene.slider.cf)
+    assert stable.region.contains(stable_car.twist(np.linspace(-1.0, 1.0, 21) / stable_car.radius)).all()
+    region = weakref.ref(first.region)
+    del first, car, again
+    gc.collect()
+    assert region() is None

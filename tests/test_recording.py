@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -22,6 +23,7 @@ from rerun.chunk import RrdReader
 
 import planner
 from mechanics import exp_twist
+from planner.actions.region_cache import RegionCache
 from planner.outputs import recording
 
 RERUN = Path(sys.executable).parent / "rerun"
@@ -253,23 +255,29 @@ def test_a_long_plan_is_capped_and_its_cf_path_thinned(straight, tmp_path):
     np.testing.assert_allclose(drawn[-1], pose[:2], atol=1e-5)
 
 
+class FailingVerification:
+    """Stands in for a Verification whose pushes cannot be read: the ghost is drawn after the
+    file sink has started and the animation has been sent."""
+
+    def __init__(self):
+        self.asked = 0
+
+    @property
+    def pushes(self):
+        self.asked += 1
+        raise RuntimeError("disk on fire")
+
+
 def test_a_failed_write_keeps_the_old_file_and_leaves_no_temporary(straight, tmp_path, monkeypatch):
     scene, plan, _ = straight
     path = tmp_path / "straight.rrd"
     path.write_bytes(b"the previous recording")
-    calls = []
-
-    def fail(*args, **kwargs):  # the animation is sampled after the file sink has started
-        calls.append(args)
-        raise RuntimeError("disk on fire")
-
-    monkeypatch.setattr(recording, "exp_twist", fail)
+    failing = FailingVerification()
     with pytest.raises(RuntimeError, match="disk on fire"):
-        recording.write_recording(path, scene, plan)
-    assert calls
+        recording.write_recording(path, scene, plan, failing)
+    assert failing.asked
     assert path.read_bytes() == b"the previous recording"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["straight.rrd"]
-    monkeypatch.undo()
 
     renamed = []
 
@@ -497,16 +505,30 @@ def test_the_ghost_follows_the_pushes_and_skips_the_transit(switching, tmp_path)
         np.testing.assert_allclose(outline[0], slider[step][1][0], atol=1e-6)
 
 
-def test_a_half_turn_of_the_part_gives_the_twin_edges_analysis(monkeypatch):
+def refuse(*args, **kwargs):
+    """A region computation for a cache that must answer from what it holds."""
+    raise AssertionError("an exact region was computed")
+
+
+def test_a_half_turn_of_the_part_gives_the_twin_edges_analysis(tmp_path):
     """Parking's block: edge 2's analysis is edge 0's turned half round the CF, and equals the one
-    computed for edge 2 itself (the force-status map exactly, the exact regions to 0.1 %)."""
-    scene = planner.load_scene(Path(__file__).resolve().parent.parent / "scenes" / "parking.yaml")
-    monkeypatch.setattr(recording, "_analyses", {})  # none of other tests' recordings
-    recording._analyses[recording._analysis_key(scene, 0)] = recording._compute_analysis(scene, 0)
-    twin, alone = recording._turned_twin(scene, 2), recording._compute_analysis(scene, 2)
+    computed for edge 2 itself (the force-status map exactly, the exact regions to 0.1 %). A cache
+    holding edge 0's analysis and no region gives edge 2's without computing a region; edge 1's
+    it must compute (its twin is edge 3, whose analysis it does not hold)."""
+    scene = planner.load_scene(SCENES / "parking.yaml")
+    computed = RegionCache(tmp_path / "computed")
+    recording.analysis(scene, 0, computed)
+    held = RegionCache(tmp_path / "held", compute=refuse)
+    held.folder.mkdir()
+    for file in computed.folder.glob("analysis-*.json"):  # edge 0's analysis, not its region
+        shutil.copy(file, held.folder)
+    alone = recording.analysis(scene, 2, RegionCache(computed.folder))  # nothing in memory to turn
+    assert recording.analysis(scene, 0, held) is recording.analysis(scene, 0, held)  # read once
+    twin = recording.analysis(scene, 2, held)
     np.testing.assert_allclose(twin.contact, alone.contact, atol=1e-12)
     for name, by_sense in alone.polygons.items():
         for sense, polygon in by_sense.items():
             turned = twin.polygons[name][sense]
             assert turned.symmetric_difference(polygon).area <= 1e-3 * polygon.area + 1e-12, (name, sense)
-    assert recording._turned_twin(scene, 1) is None  # edge 3's analysis is not known yet
+    with pytest.raises(AssertionError, match="an exact region was computed"):
+        recording.analysis(scene, 1, held)

@@ -10,7 +10,10 @@ knowledge means none stable at all).
 
 from __future__ import annotations
 
+import json
 import os
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -21,16 +24,14 @@ import yaml
 from mechanics import DeadlineExceeded, Slider, exact_region
 from planner import SceneError, parse_scene
 from planner.actions.controls import RegionTimeout, edge_controls
-from planner.actions.region_cache import is_cached
+from planner.actions.region_cache import RegionCache, is_cached
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture()
-def empty_cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path))
-    monkeypatch.setattr("planner.actions.region_cache._memory", {})
-    return tmp_path
+def empty_cache(tmp_path):
+    return RegionCache(tmp_path / "cache")
 
 
 def many_edged(n: int = 200) -> dict:
@@ -67,7 +68,7 @@ def test_a_many_edged_part_computes_what_fits_and_says_so(empty_cache):
     assert len(edges) == 200
     start = time.perf_counter()
     with pytest.raises(RegionTimeout) as caught:
-        edge_controls(scene, deadline=start + 2.0)
+        edge_controls(scene, deadline=start + 2.0, cache=empty_cache)
     assert time.perf_counter() - start < 3.0
     done = [p.edge for p in caught.value.pushes]
     pending = caught.value.pending
@@ -76,9 +77,9 @@ def test_a_many_edged_part_computes_what_fits_and_says_so(empty_cache):
     assert set(done) <= set(edges[:len(done) + len(os.sched_getaffinity(0))])
     assert f"edges {pending[0]}, {pending[1]}" in str(caught.value) and "time limit" in str(caught.value)
     p = scene.pusher
-    assert all(is_cached(scene.slider, e, p.mu, p.width) for e in done)
-    assert not any(is_cached(scene.slider, e, p.mu, p.width) for e in pending)
-    assert len(list(empty_cache.iterdir())) == len(done)
+    assert all(is_cached(scene.slider, e, p.mu, p.width, cache=empty_cache) for e in done)
+    assert not any(is_cached(scene.slider, e, p.mu, p.width, cache=empty_cache) for e in pending)
+    assert len(list(empty_cache.folder.iterdir())) == len(done)
 
 
 def test_past_the_deadline_cached_edges_are_still_read(empty_cache):
@@ -86,10 +87,10 @@ def test_past_the_deadline_cached_edges_are_still_read(empty_cache):
     the cached two come back and only the others are pending."""
     spec = yaml.safe_load((ROOT / "scenes" / "corridor.yaml").read_text())
     spec["pusher"]["edges"] = [0, 2]
-    edge_controls(parse_scene(spec, "corridor"))
+    edge_controls(parse_scene(spec, "corridor"), cache=empty_cache)
     spec["pusher"].pop("edges")
     with pytest.raises(RegionTimeout) as caught:
-        edge_controls(parse_scene(spec, "corridor"), deadline=time.perf_counter())
+        edge_controls(parse_scene(spec, "corridor"), deadline=time.perf_counter(), cache=empty_cache)
     assert [p.edge for p in caught.value.pushes] == [0, 2] and caught.value.pending == (1, 3)
 
 
@@ -98,14 +99,14 @@ def test_progress_hears_of_each_region_computed_and_none_cached(empty_cache):
     spec["pusher"]["edges"] = [0, 1, 3]
     scene = parse_scene(spec, "corridor")
     heard = []
-    first = edge_controls(scene, progress=lambda k, n: heard.append((k, n)))
+    first = edge_controls(scene, progress=lambda k, n: heard.append((k, n)), cache=empty_cache)
     assert heard == [(1, 2), (2, 2)]  # edge 3 is edge 1 turned half round the block: not computed
     heard.clear()
-    again = edge_controls(scene, progress=lambda k, n: heard.append((k, n)))
+    again = edge_controls(scene, progress=lambda k, n: heard.append((k, n)), cache=empty_cache)
     assert heard == [] and [p.edge for p in again] == [p.edge for p in first] == [0, 1, 3]
 
 
-def test_no_stable_push_anywhere_is_refused_before_any_region(empty_cache, monkeypatch):
+def test_no_stable_push_anywhere_is_refused_before_any_region(tmp_path):
     """A friction cone too narrow to push through the CF from any allowed edge: procedure STABLE
     is empty on each (Proposition 6), so the exact regions are not computed."""
     spec = yaml.safe_load((ROOT / "scenes" / "battery.yaml").read_text())
@@ -118,38 +119,44 @@ def test_no_stable_push_anywhere_is_refused_before_any_region(empty_cache, monke
     def refuse(*args, **kwargs):
         raise AssertionError("an exact region was computed")
 
-    monkeypatch.setattr("planner.actions.region_cache.exact_region", refuse)
     with pytest.raises(SceneError, match="pusher.edges: no allowed edge has a stable push"):
-        edge_controls(scene)
+        edge_controls(scene, cache=RegionCache(tmp_path, compute=refuse))
 
 
 def test_the_plan_command_honours_its_time_limit_on_a_200_gon(empty_cache, tmp_path):
     """Regions and search share the limit: ``plan --time-limit 5`` ends well within 10 s, with
     one line saying what was not done in time."""
-    import subprocess
-    import sys
-
     scene = tmp_path / "ellipse.yaml"
     scene.write_text(yaml.safe_dump(many_edged()))
     started = time.perf_counter()
     run = subprocess.run([str(Path(sys.executable).parent / "plan"), str(scene), "--time-limit", "5", "--out",
-                          str(tmp_path / "out")], capture_output=True, text=True, timeout=60, cwd=tmp_path)
+                          str(tmp_path / "out")], capture_output=True, text=True, timeout=60, cwd=tmp_path,
+                         env={**os.environ, "STABLEPUSH_CACHE": str(empty_cache.folder)})
     assert time.perf_counter() - started < 10.0
     assert run.returncode in (0, 2), run.stderr
     assert "time limit" in run.stderr and len(run.stderr.strip().splitlines()) == 1, run.stderr
 
 
-def test_no_room_for_the_pusher_is_found_before_any_region(monkeypatch):
-    from planner import plan
-
-    def never(*args, **kwargs):
-        raise AssertionError("an exact region was computed")
-
-    monkeypatch.setattr("planner.actions.region_cache.exact_region", never)
-    monkeypatch.setattr("planner.actions.region_cache._memory", {})
+def test_no_room_for_the_pusher_is_found_before_any_region(tmp_path):
+    """``plan`` in a fresh interpreter whose default cache is an empty folder: it refuses the
+    start before any exact region, which would have been kept in memory and written to the folder."""
     spec = yaml.safe_load((ROOT / "scenes" / "battery.yaml").read_text())
     spec["obstacles"] = [{"box": {"center": [-0.035, 0.0], "size": [0.01, 0.1]}}]  # against the pushed face
-    monkeypatch.setenv("STABLEPUSH_CACHE", "/nonexistent-cache")
-    with pytest.raises(SceneError) as err:
-        plan(parse_scene(spec))
-    assert err.value.field == "start" and "no room" in err.value.problem
+    script = f"""
+import json
+from planner import SceneError, parse_scene, plan
+from planner.actions.region_cache import is_cached
+scene = parse_scene({spec!r})
+try:
+    plan(scene)
+except SceneError as err:
+    p = scene.pusher
+    print(json.dumps([err.field, err.problem, [is_cached(scene.slider, e, p.mu, p.width) for e in p.edges]]))
+"""
+    folder = tmp_path / "cache"
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=120,
+                         env={**os.environ, "STABLEPUSH_CACHE": str(folder)})
+    assert run.returncode == 0, run.stderr
+    field, problem, cached = json.loads(run.stdout)
+    assert field == "start" and "no room" in problem
+    assert cached and not any(cached) and not folder.exists()

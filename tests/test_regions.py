@@ -14,7 +14,8 @@ import yaml
 from mechanics import ExactRegion, Slider, StableSteering, exact_region, stable_region
 from planner import SceneError, load_scene, parse_scene, plan
 from oracle import guaranteed_stable
-from planner.actions.region_cache import compute_regions, edge_region
+from planner.actions.region_cache import (MEMORY_SIZE, RegionCache, cache_folder, compute_regions, default_cache,
+                                          edge_region)
 
 ROOT = Path(__file__).resolve().parent.parent
 BLOCK = Slider([[-0.05, 0.0], [0.05, 0.0], [0.05, 0.06], [-0.05, 0.06]])
@@ -29,32 +30,65 @@ def test_bad_regions_option_names_the_field():
     assert parse_scene(spec).planner.regions == "stable"
 
 
-def test_cached_region_is_the_computed_one(tmp_path, monkeypatch):
-    monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path))
-    monkeypatch.setattr("planner.actions.region_cache._memory", {})
-    first = edge_region(BLOCK, 0, 0.5, 0.08)
+def refuse(*args, **kwargs):
+    """A region computation for a cache that must answer from what it holds."""
+    raise AssertionError("an exact region was computed")
+
+
+def test_cached_region_is_the_computed_one(tmp_path):
+    cache = RegionCache(tmp_path)
+    first = edge_region(BLOCK, 0, 0.5, 0.08, cache=cache)
     assert isinstance(first, ExactRegion) and len(list(tmp_path.iterdir())) == 1
-    monkeypatch.setattr("planner.actions.region_cache._memory", {})
-    again = edge_region(BLOCK, 0, 0.5, 0.08)
+    assert edge_region(BLOCK, 0, 0.5, 0.08, cache=cache) is first  # from memory
+    again = edge_region(BLOCK, 0, 0.5, 0.08, cache=RegionCache(tmp_path, compute=refuse))  # from the file
     assert again is not first and again.polygon.equals_exact(first.polygon, 0.0)
     fresh = exact_region(BLOCK, 0, 0.5, 0.08)
     assert fresh.polygon.equals_exact(first.polygon, 0.0)
-    assert isinstance(edge_region(BLOCK, 0, 0.5, 0.08, "stable"), type(stable_region(BLOCK, 0, 0.5)))
+    stable = edge_region(BLOCK, 0, 0.5, 0.08, "stable", cache=RegionCache(tmp_path, compute=refuse))
+    assert isinstance(stable, type(stable_region(BLOCK, 0, 0.5)))
 
 
-def test_a_broken_or_unwritable_cache_is_ignored(tmp_path, monkeypatch):
-    monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path))
-    monkeypatch.setattr("planner.actions.region_cache._memory", {})
-    good = edge_region(BLOCK, 1, 0.5, None)
+def test_a_broken_or_unwritable_cache_is_ignored(tmp_path):
+    good = edge_region(BLOCK, 1, 0.5, None, cache=RegionCache(tmp_path))
     (cached,) = tmp_path.iterdir()
     cached.write_text('{"polygon": [[0, 0], [1')  # cut short
-    monkeypatch.setattr("planner.actions.region_cache._memory", {})
-    assert edge_region(BLOCK, 1, 0.5, None).polygon.equals_exact(good.polygon, 0.0)
+    with pytest.raises(AssertionError, match="computed"):  # not read as a region: computed again
+        edge_region(BLOCK, 1, 0.5, None, cache=RegionCache(tmp_path, compute=refuse))
+    assert edge_region(BLOCK, 1, 0.5, None, cache=RegionCache(tmp_path)).polygon.equals_exact(good.polygon, 0.0)
+    assert edge_region(BLOCK, 1, 0.5, None, cache=RegionCache(tmp_path, compute=refuse)).polygon.equals_exact(
+        good.polygon, 0.0)  # and written again whole
     blocked = tmp_path / "file"
     blocked.write_text("")
-    monkeypatch.setenv("STABLEPUSH_CACHE", str(blocked / "sub"))  # cannot be made
-    monkeypatch.setattr("planner.actions.region_cache._memory", {})
-    assert edge_region(BLOCK, 1, 0.5, None).polygon.equals_exact(good.polygon, 0.0)
+    unwritable = RegionCache(blocked / "sub")  # cannot be made
+    assert edge_region(BLOCK, 1, 0.5, None, cache=unwritable).polygon.equals_exact(good.polygon, 0.0)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([cached.name, "file"])
+
+
+def test_the_cache_keeps_the_most_recently_used_in_memory(tmp_path):
+    """A cache of two regions: a third drops the least recently used from memory, which is then
+    read from its file, not computed; every file stays."""
+    block = Slider(BLOCK.vertices, cf=[0.01, 0.03])  # no turn carries one edge onto another
+    cache = RegionCache(tmp_path, size=2)
+    zero, one = (edge_region(block, e, 0.5, 0.08, cache=cache) for e in (0, 1))
+    assert edge_region(block, 0, 0.5, 0.08, cache=cache) is zero  # edge 0 now the more recent
+    two = edge_region(block, 2, 0.5, 0.08, cache=cache)
+    cache.compute = refuse
+    assert edge_region(block, 0, 0.5, 0.08, cache=cache) is zero
+    assert edge_region(block, 2, 0.5, 0.08, cache=cache) is two
+    again = edge_region(block, 1, 0.5, 0.08, cache=cache)
+    assert again is not one and again.polygon.equals_exact(one.polygon, 0.0)
+    assert len(list(tmp_path.iterdir())) == 3
+    assert RegionCache(tmp_path).size == MEMORY_SIZE
+
+
+def test_calls_given_no_cache_share_one_made_from_the_environment(region_cache):
+    """The default cache is one object, in the folder the environment named when it was made
+    (this session's, tests/conftest.py), computing with mechanics.exact_region."""
+    assert default_cache() is default_cache()
+    assert default_cache().folder == cache_folder() == region_cache
+    assert default_cache().compute is exact_region and default_cache().size == MEMORY_SIZE
+    region = edge_region(BLOCK, 3, 0.5, 0.08)
+    assert edge_region(BLOCK, 3, 0.5, 0.08, cache=default_cache()) is region
 
 
 def test_stable_regions_plan_only_with_stable_pushes():
@@ -78,17 +112,16 @@ def test_regions_flag_overrides_the_scene(tmp_path):
     assert all(region.contains(s["twist"]) for s in segments)
 
 
-def test_a_turn_of_the_part_gives_its_twin_edge_the_same_region(tmp_path, monkeypatch):
+def test_a_turn_of_the_part_gives_its_twin_edge_the_same_region(tmp_path):
     """A 10 x 6 cm block is carried onto itself by a half turn about its CF, edge 0 onto edge 2:
     only edge 0's region is computed, edge 2 gets the same section of its own push plane. That is
     sound (every sampled push in it sticks for every support distribution, by the test-only LP
     oracle, and turns about a centre beyond the part) and agrees with edge 2's region computed
     on its own. An off-centre CF breaks the symmetry: nothing is shared."""
-    monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path))
-    monkeypatch.setattr("planner.actions.region_cache._memory", {})
     block = Slider([[-0.05, -0.03], [0.05, -0.03], [0.05, 0.03], [-0.05, 0.03]])
     progress: list[tuple[int, int]] = []
-    regions = compute_regions(block, [0, 1, 2, 3], 0.5, 0.05, progress=lambda k, n: progress.append((k, n)))
+    regions = compute_regions(block, [0, 1, 2, 3], 0.5, 0.05, progress=lambda k, n: progress.append((k, n)),
+                              cache=RegionCache(tmp_path))
     assert progress == [(1, 2), (2, 2)] and sorted(regions) == [0, 1, 2, 3]
     twin, alone = regions[2], exact_region(block, 2, 0.5, 0.05)
     assert twin.edge == 2 and twin.polygon.equals(regions[0].polygon)

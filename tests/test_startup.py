@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from mechanics import Slider, exact_region
-from planner.actions.region_cache import compute_regions, is_cached
+from planner.actions.region_cache import RegionCache, compute_regions, is_cached
 
 ROOT = Path(__file__).resolve().parent.parent
 #: The CF off the centre: no turn of the block carries one edge onto another, so each is computed.
@@ -41,10 +41,8 @@ def _fresh(script: str) -> str:
 
 
 @pytest.fixture()
-def empty_cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("STABLEPUSH_CACHE", str(tmp_path / "cache"))
-    monkeypatch.setattr("planner.actions.region_cache._memory", {})
-    return tmp_path / "cache"
+def empty_cache(tmp_path):
+    return RegionCache(tmp_path / "cache")
 
 
 def test_a_plan_run_imports_nothing_it_does_not_use(tmp_path):
@@ -86,10 +84,11 @@ def _noting_process(folder: Path, slider: Slider, edge: int, *args, **kwargs):
     return exact_region(slider, edge, *args, **kwargs)
 
 
-def test_regions_computed_in_parallel_are_the_serial_ones(empty_cache, tmp_path, monkeypatch):
-    monkeypatch.setattr("planner.actions.region_cache.exact_region", functools.partial(_noting_process, tmp_path / "who"))
+def test_regions_computed_in_parallel_are_the_serial_ones(tmp_path):
+    cache = RegionCache(tmp_path / "cache", compute=functools.partial(_noting_process, tmp_path / "who"))
     heard = []
-    got = compute_regions(BLOCK, [0, 1, 2], 0.5, 0.08, progress=lambda k, n: heard.append((k, n)), workers=2)
+    got = compute_regions(BLOCK, [0, 1, 2], 0.5, 0.08, progress=lambda k, n: heard.append((k, n)), workers=2,
+                          cache=cache)
     assert heard == [(1, 3), (2, 3), (3, 3)]
     who = [name.split("-") for name in os.listdir(tmp_path / "who")]
     assert sorted(int(e) for e, _ in who) == [0, 1, 2]
@@ -98,8 +97,8 @@ def test_regions_computed_in_parallel_are_the_serial_ones(empty_cache, tmp_path,
         serial = exact_region(BLOCK, e, 0.5, 0.08)
         assert got[e].polygon.equals_exact(serial.polygon, 0.0)
         assert np.array_equal(got[e].centre, serial.centre) and got[e].stable.edge == e
-        assert is_cached(BLOCK, e, 0.5, 0.08)
-    assert len(list(empty_cache.iterdir())) == 3  # written by this process, atomically: no temporary left
+        assert is_cached(BLOCK, e, 0.5, 0.08, cache=cache)
+    assert len(list(cache.folder.iterdir())) == 3  # written by this process, atomically: no temporary left
 
 
 def test_parallel_regions_keep_the_deadline_and_raise_the_workers_errors(empty_cache):
@@ -108,24 +107,27 @@ def test_parallel_regions_keep_the_deadline_and_raise_the_workers_errors(empty_c
     heard = []
     start = time.perf_counter()
     assert compute_regions(BLOCK, [0, 1, 2], 0.5, 0.08, deadline=start + 0.03,
-                           progress=lambda k, n: heard.append((k, n)), workers=2) == {}
+                           progress=lambda k, n: heard.append((k, n)), workers=2, cache=empty_cache) == {}
     assert time.perf_counter() - start < 0.5
-    assert heard in ([], [(1, 3)], [(1, 3), (2, 3)]) and not empty_cache.exists()
+    assert heard in ([], [(1, 3)], [(1, 3), (2, 3)]) and not empty_cache.folder.exists()
     with pytest.raises(ValueError, match="mu must be > 0"):
-        compute_regions(BLOCK, [0, 1], -0.5, 0.08, workers=2)
+        compute_regions(BLOCK, [0, 1], -0.5, 0.08, workers=2, cache=empty_cache)
 
 
 def test_the_recorder_writes_in_a_child_and_passes_its_errors_back(tmp_path):
     """In a fresh interpreter (rerun not imported), the recording is written by the forked child:
     the parent never imports rerun, the file verifies, and a failure to write comes back as the
-    OSError it is."""
+    OSError it is. The child draws with the recorder's cache: given an empty one, it leaves there
+    the pushed edge's region and analysis."""
     script = f"""
 import sys
 from planner import load_scene, plan
+from planner.actions.region_cache import RegionCache
 from planner.outputs.recorder import recorder
 scene = load_scene("scenes/battery.yaml")
 result = plan(scene, seed=1)
-with recorder(scene) as write:
+cache = RegionCache({str(tmp_path / "cache")!r})
+with recorder(scene, cache) as write:
     write({str(tmp_path / "battery.rrd")!r}, scene, result)
 try:
     with recorder(scene) as write:
@@ -134,6 +136,7 @@ except OSError as err:
     print(type(err).__name__, "rerun" in sys.modules)
 """
     assert _fresh(script).split() == ["FileNotFoundError", "False"]
+    assert sorted(p.name.split("-")[0] for p in (tmp_path / "cache").iterdir()) == ["analysis", "exact"]
     rerun = Path(sys.executable).parent / "rerun"
     if rerun.exists():
         check = subprocess.run([str(rerun), "rrd", "verify", str(tmp_path / "battery.rrd")], capture_output=True,

@@ -25,12 +25,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from weakref import WeakKeyDictionary
 
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import wrap_angle
+from mechanics import ExactRegion, wrap_angle
 
 from .controls import EdgeControls
 
@@ -40,8 +41,10 @@ __all__ = ["EdgeCar", "edge_car"]
 _HEADINGS, _REFINE = 13, 4
 #: Halvings of the curvature interval: the radius to about 1e-9 of itself.
 _BISECTIONS = 32
-#: Cars found, by region (held, so its id stays its own) and CF.
-_found: dict[tuple, tuple[object, tuple[np.ndarray | None, float]]] = {}
+#: The heading and radius of each car found (None, inf: none), by exact region and CF. Exact
+#: regions come from the region cache, the same objects plan after plan, and are hashed by
+#: identity; held weakly, a region's cars go when the cache drops it.
+_found: WeakKeyDictionary[ExactRegion, dict[tuple[float, ...], tuple[np.ndarray | None, float]]] = WeakKeyDictionary()
 #: Margin inside the region's section (push-plane units) that the segment of twists must keep.
 _MARGIN = 1e-3
 
@@ -130,15 +133,15 @@ def edge_car(push: EdgeControls, cf: ArrayLike) -> EdgeCar | None:
     True
     """
     region, cf = push.region, np.asarray(cf, dtype=float)
-    key = (id(region), *cf.tolist())
-    if key in _found and _found[key][0] is region:  # regions are cached objects: so are their cars
-        heading, radius = _found[key][1]
-        return None if heading is None else EdgeCar(push, cf, heading, radius)
-    car = _tightest(push, cf)
-    if len(_found) >= 256:  # STABLE's regions are made afresh for each plan: keep the memo small
-        _found.clear()
-    _found[key] = (region, (None, math.inf) if car is None else (car.heading, car.radius))
-    return car
+    if not isinstance(region, ExactRegion):  # STABLE's regions are made afresh for each plan: nothing to reuse
+        return _tightest(push, cf)
+    cars = _found.setdefault(region, {})
+    key = tuple(cf.tolist())
+    if key not in cars:
+        car = _tightest(push, cf)
+        cars[key] = (None, math.inf) if car is None else (car.heading, car.radius)
+    heading, radius = cars[key]
+    return None if heading is None else EdgeCar(push, cf, heading, radius)
 
 
 def _tightest(push: EdgeControls, cf: np.ndarray) -> EdgeCar | None:

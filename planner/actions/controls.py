@@ -20,7 +20,7 @@ from mechanics import DeadlineExceeded, ExactRegion, StableRegion, StableSteerin
 
 from ..model.bodies import body_outline
 from ..model.plan_file import Push
-from .region_cache import compute_regions, edge_region, is_cached
+from .region_cache import RegionCache, compute_regions, edge_region, is_cached
 from ..model.fields import SceneError
 from ..model.scene import Scene
 
@@ -71,7 +71,7 @@ class RegionTimeout(Exception):
 
     ``pushes`` holds the :class:`EdgeControls` of each other edge that has stable pushes (what
     :func:`edge_controls` would return for those edges alone), ``pending`` the allowed edges not
-    computed. Finished regions are cached (:mod:`.regions`), so a later run goes further.
+    computed. Finished regions are cached (:mod:`.region_cache`), so a later run goes further.
     """
 
     def __init__(self, pushes: list[EdgeControls], pending: tuple[int, ...]):
@@ -82,8 +82,8 @@ class RegionTimeout(Exception):
                          "pushes ready)")
 
 
-def edge_controls(scene: Scene, deadline: float | None = None,
-                progress: Callable[[int, int], None] | None = None) -> list[EdgeControls]:
+def edge_controls(scene: Scene, deadline: float | None = None, progress: Callable[[int, int], None] | None = None,
+                  cache: RegionCache | None = None) -> list[EdgeControls]:
     """An :class:`EdgeControls` for each allowed edge that has stable pushes.
 
     Parameters
@@ -96,6 +96,9 @@ def edge_controls(scene: Scene, deadline: float | None = None,
     progress : callable, optional
         ``progress(k, n)`` is called before computing the ``k``-th (from 1) of the ``n`` regions
         that are not cached; regions read from the cache are not reported.
+    cache : RegionCache, optional
+        Where the exact regions are kept and what computes them
+        (default: :func:`~planner.actions.region_cache.default_cache`).
 
     Raises
     ------
@@ -111,15 +114,15 @@ def edge_controls(scene: Scene, deadline: float | None = None,
     """
     p, slider = scene.pusher, scene.slider
     method, rho = scene.planner.regions, scene.cf_uncertainty
-    todo = [e for e in p.edges if not is_cached(slider, e, p.mu, p.width, method, rho)]
-    computed = compute_regions(slider, todo, p.mu, p.width, rho, deadline, progress)
+    todo = [e for e in p.edges if not is_cached(slider, e, p.mu, p.width, method, rho, cache)]
+    computed = compute_regions(slider, todo, p.mu, p.width, rho, deadline, progress, cache=cache)
     out, pending = [], []
     for e in p.edges:
         if e in todo and e not in computed:
             pending.append(e)
             continue
         try:  # read from the cache, or computed again if its file turned out unreadable
-            region = edge_region(slider, e, p.mu, p.width, method, rho, deadline)
+            region = edge_region(slider, e, p.mu, p.width, method, rho, deadline, cache)
         except DeadlineExceeded:
             pending.append(e)
             continue

@@ -2,10 +2,17 @@
 
 Procedure STABLE is a closed form; the exact region (:mod:`mechanics.exact_region`) costs about a
 tenth of a second of certified linear programmes per edge. It depends only on the part, the edge,
-the friction and the pusher's width, so it is kept in memory for the process and on disk across runs:
-a JSON file per region under ``$STABLEPUSH_CACHE`` (default ``$XDG_CACHE_HOME/stablepush`` or
-``~/.cache/stablepush``), named by a hash of everything it depends on, written atomically. A cache
-that cannot be read or written is ignored: the region is then computed again, never guessed.
+the friction and the pusher's width, so a :class:`RegionCache` keeps it: in memory (the
+:data:`MEMORY_SIZE` items used last, so a process planning many parts stays bounded) and on disk
+across runs, a JSON file per region in the cache's folder, named by a hash of everything it
+depends on (:func:`cache_key`), written atomically. A file that cannot be read or written is
+ignored: the region is then computed again, never guessed. The recording's analyses
+(:mod:`planner.outputs.recording`) are kept in the same cache, as another kind of file.
+
+Every function here takes the cache to use as ``cache``; without one, they share
+:func:`default_cache`, one per process, in the folder the environment names
+(:func:`cache_folder`). Passing a cache is for a caller that wants its own: a test's empty
+folder, or a region computation of its own (:class:`RegionCache`'s ``compute``).
 
 :func:`compute_regions` computes several edges' regions at once, one process per core: the edges
 are independent, and a cold run of a part otherwise waits for each in turn. The processes are
@@ -17,15 +24,18 @@ process would compute, and this process alone writes the cache.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
 import signal
 import time
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import shapely
@@ -35,26 +45,107 @@ from mechanics import DeadlineExceeded, ExactRegion, Slider, StableRegion, exact
 from ..model.fields import SceneError
 from ..model.files import write_atomic
 
-__all__ = ["cache_folder", "cache_key", "compute_regions", "edge_region", "is_cached"]
+__all__ = ["MEMORY_SIZE", "RegionCache", "cache_folder", "cache_key", "compute_regions", "default_cache",
+           "edge_region", "is_cached"]
 
 #: Bump when the exact region's construction (or the recording's analysis) changes, so old cache
 #: files are not used. 3: the support LPs by a batched simplex (its duals can differ where the LP
 #: is degenerate).
 _VERSION = 3
 
-_memory: dict[str, ExactRegion] = {}
+#: Items a :class:`RegionCache` keeps in memory unless told otherwise: every region and analysis
+#: of a 200-edged part twice over, a few megabytes. An item dropped is read again from its file.
+MEMORY_SIZE = 1024
+
+
+class RegionCache:
+    """Exact regions, and other items named by :func:`cache_key`, in memory and in a folder.
+
+    Parameters
+    ----------
+    folder : str or Path
+        Where the files are kept between runs, ``<kind>-<key>.json``; made when the first is
+        written. One that cannot be made or written costs only time: the next run computes again.
+    size : int
+        The most items kept in memory (:data:`MEMORY_SIZE`); the least recently used go first.
+    compute : callable
+        What computes a missing exact region, called as :func:`mechanics.exact_region` (the
+        default): a test's may refuse, or note who called it. :func:`compute_regions` calls it in
+        forked workers, so it must pickle (a module-level function, or a partial of one).
+
+    Examples
+    --------
+    >>> cache = RegionCache("/nonexistent", size=2)
+    >>> cache.put("a", 1); cache.put("b", 2); cache.get("a"); cache.put("c", 3)
+    1
+    >>> cache.get("b"), cache.get("a"), cache.get("c")   # b was the least recently used
+    (None, 1, 3)
+    """
+
+    def __init__(self, folder: str | Path, size: int = MEMORY_SIZE, compute: Callable[..., ExactRegion] = exact_region):
+        self.folder, self.size, self.compute = Path(folder), size, compute
+        self._memory: OrderedDict[str, Any] = OrderedDict()
+
+    def get(self, key: str) -> Any | None:
+        """The item kept in memory as ``key`` (now the most recently used), or None."""
+        item = self._memory.get(key)
+        if item is not None:
+            self._memory.move_to_end(key)
+        return item
+
+    def put(self, key: str, item: Any) -> None:
+        """Keep ``item`` in memory as ``key``, dropping the least recently used beyond :attr:`size`."""
+        self._memory[key] = item
+        self._memory.move_to_end(key)
+        while len(self._memory) > self.size:
+            self._memory.popitem(last=False)
+
+    def holds(self, kind: str, key: str) -> bool:
+        """Whether ``key`` is in memory or has a file (which may yet turn out unreadable)."""
+        return key in self._memory or self._path(kind, key).is_file()
+
+    def read(self, kind: str, key: str) -> Any | None:
+        """The JSON in ``key``'s file, or None if it has none or the file is not JSON (cut short,
+        say); the caller checks that the JSON is what it wrote."""
+        try:
+            return json.loads(self._path(kind, key).read_text())
+        except (OSError, ValueError):
+            return None
+
+    def write(self, kind: str, key: str, data: Any) -> None:
+        """Write ``data`` as JSON to ``key``'s file atomically, or nothing if the folder cannot be
+        written (a read-only home: the next run computes it again)."""
+        path = self._path(kind, key)
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write_atomic(path, json.dumps(data))
+        except OSError:
+            pass
+
+    def _path(self, kind: str, key: str) -> Path:
+        return self.folder / f"{kind}-{key}.json"
 
 
 def cache_folder() -> Path:
-    """Where exact regions are kept between runs."""
+    """Where :func:`default_cache` keeps its files: ``$STABLEPUSH_CACHE``, else
+    ``$XDG_CACHE_HOME/stablepush``, else ``~/.cache/stablepush``."""
     if os.environ.get("STABLEPUSH_CACHE"):
         return Path(os.environ["STABLEPUSH_CACHE"])
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "stablepush"
 
 
+@functools.cache
+def default_cache() -> RegionCache:
+    """The cache of every call given none: one per process, so the planner, the queries and the
+    recording share what each computed. It is made on first use, in :func:`cache_folder` as the
+    environment says then (a later change is not seen), of :data:`MEMORY_SIZE` items, computing
+    with :func:`mechanics.exact_region`; a process forked later (the recorder) has a copy."""
+    return RegionCache(cache_folder())
+
+
 def cache_key(kind: str, slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float,
               **more) -> str:
-    """The name of a cache file of ``kind`` for one edge: a hash of everything it depends on
+    """The name of a cache item of ``kind`` for one edge: a hash of everything it depends on
     (and of :data:`_VERSION`, so a change of the mechanics leaves old files unused)."""
     spec = {"kind": kind, "version": _VERSION, "vertices": slider.vertices.tolist(), "cf": slider.cf.tolist(),
             "edge": int(edge), "mu": float(mu), "width": None if width is None else float(width),
@@ -66,16 +157,12 @@ def _key(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: f
     return cache_key("exact", slider, edge, mu, width, cf_radius)
 
 
-def _path(key: str) -> Path:
-    return cache_folder() / f"exact-{key}.json"
-
-
-def _read(path: Path, stable: StableRegion, cf_radius: float) -> ExactRegion | None:
+def _region(data: object, stable: StableRegion, cf_radius: float) -> ExactRegion | None:
+    """The region a cache file held (``data``, its JSON, None if unread), or None if it is not one."""
     try:
-        data = json.loads(path.read_text())
         polygon = shapely.Polygon(np.asarray(data["polygon"], dtype=float))
         centre = np.asarray(data["centre"], dtype=float)
-    except (OSError, ValueError, KeyError, TypeError):
+    except (ValueError, KeyError, TypeError):
         return None
     if not polygon.is_valid or polygon.area <= 0 or centre.shape != (2,):
         return None
@@ -83,12 +170,13 @@ def _read(path: Path, stable: StableRegion, cf_radius: float) -> ExactRegion | N
 
 
 def is_cached(slider: Slider, edge: int, mu: float, width: float | None = None, method: str = "exact",
-              cf_radius: float = 0.0) -> bool:
-    """Whether :func:`edge_region` would answer without computing an exact region (a file that
-    turns out unreadable is computed all the same)."""
+              cf_radius: float = 0.0, cache: RegionCache | None = None) -> bool:
+    """Whether :func:`edge_region` would answer from ``cache`` (default: :func:`default_cache`)
+    without computing an exact region (a file that turns out unreadable is computed all the same)."""
     if method == "stable" or stable_region(slider, edge, mu, width).is_empty:
         return True
-    return any(key in _memory or _path(key).is_file() for key in _keys_alike(slider, edge, mu, width, cf_radius))
+    cache = default_cache() if cache is None else cache
+    return any(cache.holds("exact", key) for key in _keys_alike(slider, edge, mu, width, cf_radius))
 
 
 def _keys_alike(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float) -> list[str]:
@@ -97,22 +185,24 @@ def _keys_alike(slider: Slider, edge: int, mu: float, width: float | None, cf_ra
     return [_key(slider, (edge - r) % slider.n, mu, width, cf_radius) for r in (0, *slider.turns)]
 
 
-def _known(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float,
+def _known(cache: RegionCache, slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float,
            stable: StableRegion) -> ExactRegion | None:
     """The exact region of ``edge`` from memory or disk, or else of an edge a turn of the part
     carries onto it: that one's section of the push plane, which is this one's (each edge's push
     plane is drawn in its own frame, and the turn carries part, CF, contact and pusher along)."""
     for key in _keys_alike(slider, edge, mu, width, cf_radius):
-        found = _memory.get(key) or _read(_path(key), stable, cf_radius)
+        found = cache.get(key) or _region(cache.read("exact", key), stable, cf_radius)
         if found is not None:
             return replace(found, stable=stable)
     return None
 
 
 def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None, method: str = "exact",
-                cf_radius: float = 0.0, deadline: float | None = None) -> StableRegion | ExactRegion:
-    """The ``method`` (``'stable'`` or ``'exact'``) stable region of ``edge``, cached as above;
-    ``cf_radius`` (exact only) makes it hold for every CF within that distance of the slider's.
+                cf_radius: float = 0.0, deadline: float | None = None,
+                cache: RegionCache | None = None) -> StableRegion | ExactRegion:
+    """The ``method`` (``'stable'`` or ``'exact'``) stable region of ``edge``, kept in ``cache``
+    (default: :func:`default_cache`) as above; ``cf_radius`` (exact only) makes it hold for every
+    CF within that distance of the slider's.
 
     Raises
     ------
@@ -128,39 +218,34 @@ def edge_region(slider: Slider, edge: int, mu: float, width: float | None = None
     stable = stable_region(slider, edge, mu, width)
     if method == "stable" or stable.is_empty:
         return stable
+    cache = default_cache() if cache is None else cache
     key = _key(slider, edge, mu, width, cf_radius)
-    if key in _memory:
-        return _memory[key]
-    region = _known(slider, edge, mu, width, cf_radius, stable)
+    region = cache.get(key) or _known(cache, slider, edge, mu, width, cf_radius, stable)
     if region is None:
-        _keep(key, exact_region(slider, edge, mu, width, cf_radius=cf_radius, deadline=deadline))
+        region = cache.compute(slider, edge, mu, width, cf_radius=cf_radius, deadline=deadline)
+        _keep(cache, key, region)
     else:
-        _memory[key] = region
-    return _memory[key]
+        cache.put(key, region)
+    return region
 
 
-def _keep(key: str, region: ExactRegion) -> None:
+def _keep(cache: RegionCache, key: str, region: ExactRegion) -> None:
     """Keep a freshly computed region in memory and, unless it is degenerate, on disk."""
-    _memory[key] = region
+    cache.put(key, region)
     polygon, centre = region.section()
     if isinstance(polygon, shapely.Polygon) and polygon.area > 0:  # a degenerate one is cheap: not stored
-        path = _path(key)
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            write_atomic(path, json.dumps({"polygon": np.asarray(polygon.exterior.coords).tolist(),
-                                           "centre": centre.tolist()}))
-        except OSError:
-            pass  # a read-only home: compute again next time
+        cache.write("exact", key, {"polygon": np.asarray(polygon.exterior.coords).tolist(), "centre": centre.tolist()})
 
 
 def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: float | None = None,
                     cf_radius: float = 0.0, deadline: float | None = None,
                     progress: Callable[[int, int], None] | None = None,
-                    workers: int | None = None) -> dict[int, ExactRegion]:
-    """Compute the exact regions of ``edges`` (whatever the cache holds) and cache them, up to
-    ``workers`` at a time (default: one per core, at most one per edge) in forked processes. Of
-    edges that a turn of the part carries onto one another (:attr:`mechanics.Slider.turns`), only
-    the first is computed: the others have its region.
+                    workers: int | None = None, cache: RegionCache | None = None) -> dict[int, ExactRegion]:
+    """Compute the exact regions of ``edges`` (whatever the cache holds) with ``cache``'s
+    ``compute``, up to ``workers`` at a time (default: one per core, at most one per edge) in
+    forked processes, and keep them in ``cache`` (default: :func:`default_cache`). Of edges that a
+    turn of the part carries onto one another (:attr:`mechanics.Slider.turns`), only the first is
+    computed: the others have its region.
 
     Edges are begun in order, each as soon as a worker is free, ``progress(k, n)`` being called
     just before the ``k``-th of the ``n`` computed is begun. ``deadline`` (a :func:`time.perf_counter`
@@ -175,6 +260,7 @@ def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: floa
     >>> compute_regions(block, [0, 2], 0.5, 0.08, deadline=time.perf_counter())
     {}
     """
+    cache = default_cache() if cache is None else cache
     first: list[int] = []
     for edge in edges:
         if not any((edge - r) % slider.n in first for r in slider.turns):
@@ -188,7 +274,8 @@ def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: floa
                 edge = waiting.pop(0)
                 if progress is not None:
                     progress(len(first) - len(waiting), len(first))
-                running[pool.submit(exact_region, slider, edge, mu, width, cf_radius=cf_radius, deadline=deadline)] = edge
+                running[pool.submit(cache.compute, slider, edge, mu, width, cf_radius=cf_radius,
+                                     deadline=deadline)] = edge
             if not running:  # past the deadline: the rest are not begun
                 break
             for future in wait(running, return_when=FIRST_COMPLETED).done:
@@ -197,12 +284,12 @@ def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: floa
                     region = future.result()
                 except DeadlineExceeded:
                     continue
-                _keep(_key(slider, edge, mu, width, cf_radius), region)
+                _keep(cache, _key(slider, edge, mu, width, cf_radius), region)
                 out[edge] = region
     for edge in edges:
         if edge not in first and any((twin := (edge - r) % slider.n) in out for r in slider.turns):
-            out[edge] = _memory[_key(slider, edge, mu, width, cf_radius)] = replace(
-                out[twin], stable=stable_region(slider, edge, mu, width))
+            out[edge] = replace(out[twin], stable=stable_region(slider, edge, mu, width))
+            cache.put(_key(slider, edge, mu, width, cf_radius), out[edge])
     return out
 
 

@@ -6,7 +6,10 @@ the parent plans, the child imports rerun and the recording code and draws the m
 the plan may start on, then writes the recording it is sent. On a two-core machine the import costs the command
 nothing. The child is forked only where that is safe: on a platform with ``fork`` and while rerun
 is not yet imported (its threads would not survive a fork); otherwise the recording is written in
-this process, as :func:`planner.outputs.recording.write_recording` does.
+this process, as :func:`planner.outputs.recording.write_recording` does. Either way one
+:class:`~planner.actions.region_cache.RegionCache` serves: the child, forked with a copy of it,
+keeps there the analyses it prepares and draws them from it; the regions the search computes
+meanwhile reach it through the cache's folder.
 
 >>> with recorder(scene) as write:   # doctest: +SKIP
 ...     result = plan(scene)
@@ -15,6 +18,7 @@ this process, as :func:`planner.outputs.recording.write_recording` does.
 
 from __future__ import annotations
 
+import functools
 import multiprocessing
 import os
 import signal
@@ -24,6 +28,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from ..actions.region_cache import RegionCache, default_cache
 from ..model.scene import Scene
 from ..model.stop import Terminated, die_with_parent
 
@@ -33,18 +38,18 @@ __all__ = ["RecordingFailed", "recorder"]
 _GRACE = 5.0
 
 
-def _write_inline(path: str | Path, *args) -> None:
+def _write_inline(cache: RegionCache, path: str | Path, *args) -> None:
     from .recording import write_recording  # rerun takes a third of a second to import
 
     try:
-        write_recording(path, *args)
+        write_recording(path, *args, cache=cache)
     except OSError:
         raise
     except Exception as err:
         raise RecordingFailed.of(err) from err
 
 
-def _child(conn, parents_end, parent: int, scene: Scene) -> None:
+def _child(conn, parents_end, parent: int, scene: Scene, cache: RegionCache) -> None:
     """The forked recorder: import rerun and prepare the recording of ``scene`` now, write it
     when sent the plan. It ends with the parent, however that ends: the parent's end of the pipe
     is closed here (so the parent's exit is an end of file), and a signal comes if the parent is
@@ -57,7 +62,7 @@ def _child(conn, parents_end, parent: int, scene: Scene) -> None:
         try:
             from .recording import prepare  # the import the parent is spared
 
-            prepare(scene, conn.poll)
+            prepare(scene, conn.poll, cache)
         except Exception as err:  # reported when the recording is asked for, with what it says
             failed = RecordingFailed.of(err)
         job = conn.recv()
@@ -65,12 +70,10 @@ def _child(conn, parents_end, parent: int, scene: Scene) -> None:
             conn.send(failed)
             return
         try:
-            _write_inline(*job)
+            _write_inline(cache, *job)
             conn.send(None)
-        except OSError as err:
+        except (OSError, RecordingFailed) as err:
             conn.send(err)
-        except Exception as err:
-            conn.send(RecordingFailed.of(err))
     except (EOFError, BrokenPipeError, Terminated):  # the parent has stopped: so does this process
         return
 
@@ -92,10 +95,13 @@ class RecordingFailed(Exception):
 
 
 @contextmanager
-def recorder(scene: Scene) -> Iterator[Callable[..., None]]:
-    """A function with :func:`planner.outputs.recording.write_recording`'s arguments, writing through a
-    child forked now (module docstring) or else in this process; the child is stopped on leaving.
-    A child also prepares what any recording of ``scene`` needs (:func:`planner.outputs.recording.prepare`).
+def recorder(scene: Scene, cache: RegionCache | None = None) -> Iterator[Callable[..., None]]:
+    """A function with :func:`planner.outputs.recording.write_recording`'s arguments but its
+    ``cache``, writing through a child forked now (module docstring) or else in this process; the
+    child is stopped on leaving. A child also prepares what any recording of ``scene`` needs
+    (:func:`planner.outputs.recording.prepare`). Both read and keep the regions and analyses in
+    ``cache`` (default: :func:`~planner.actions.region_cache.default_cache`); the search's
+    regions reach the child through its folder.
 
     Raises
     ------
@@ -104,12 +110,13 @@ def recorder(scene: Scene) -> Iterator[Callable[..., None]]:
     RecordingFailed
         From the call, if anything else stopped the recording (the recorder process included).
     """
+    cache = default_cache() if cache is None else cache
     if "rerun" in sys.modules or "fork" not in multiprocessing.get_all_start_methods():
-        yield _write_inline
+        yield functools.partial(_write_inline, cache)
         return
     context = multiprocessing.get_context("fork")
     conn, theirs = context.Pipe()
-    child = context.Process(target=_child, args=(theirs, conn, os.getpid(), scene), name="stablepush-recorder",
+    child = context.Process(target=_child, args=(theirs, conn, os.getpid(), scene, cache), name="stablepush-recorder",
                             daemon=True)
     child.start()
     theirs.close()

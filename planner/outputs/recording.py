@@ -70,7 +70,6 @@ above the text log.
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -89,7 +88,7 @@ from mechanics import (ContactConfiguration, Slider, SupportModel, contact_wrenc
 from ..model.bodies import pusher_frame_body
 from ..model.files import write_atomic
 from ..model.plan_file import Plan, Push, Transit
-from ..actions.region_cache import cache_folder, cache_key, edge_region, is_cached
+from ..actions.region_cache import RegionCache, cache_key, default_cache, edge_region, is_cached
 from ..model.scene import Scene
 from ..actions.transit import edge_contact_pose, transit_pieces, transit_poses
 
@@ -97,8 +96,8 @@ if TYPE_CHECKING:  # the simulator behind it imports most of scipy: not needed t
     from ..queries.reachable_set import ReachableSet
     from ..execution.verify import Verification
 
-__all__ = ["ANALYSIS_RAYS", "FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS", "prepare",
-           "write_recording"]
+__all__ = ["ANALYSIS_RAYS", "Analysis", "FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS",
+           "analysis", "prepare", "write_recording"]
 
 #: Animation frames while a body point travels one slider radius (fewer if that exceeds MAX_FRAMES).
 FRAMES_PER_RADIUS = 20
@@ -253,7 +252,7 @@ def _rings(geometry: shapely.Geometry) -> list[np.ndarray]:
     return [np.asarray(g.exterior.coords) for g in parts if isinstance(g, shapely.Polygon) and g.area > 0]
 
 
-class _Analysis(NamedTuple):
+class Analysis(NamedTuple):
     """What ``/analysis`` shows of one edge, in the slider frame: the window, the contact
     segment, and polygons by name ('stable', 'exact': COR regions; 'P', 'U', 'I': force status
     of sticking) and sense (1 CCW, -1 CW)."""
@@ -263,96 +262,99 @@ class _Analysis(NamedTuple):
     polygons: dict[str, dict[int, shapely.Geometry]]
 
 
-#: Analyses computed in this process, by part, edge and pusher (see :func:`prepare`).
-_analyses: dict[str, _Analysis] = {}
-
-
 def _analysis_key(scene: Scene, edge: int) -> str:
     p = scene.pusher
     return cache_key("analysis", scene.slider, edge, p.mu, p.width, scene.cf_uncertainty, rays=ANALYSIS_RAYS)
 
 
-def _analysis(scene: Scene, edge: int) -> _Analysis:
-    """The analysis of ``edge``: from this process's memory, else from the disk cache beside the
-    stable regions (:mod:`planner.actions.region_cache`, as WKB), else computed (0.1 s) and kept in both."""
+def analysis(scene: Scene, edge: int, cache: RegionCache | None = None) -> Analysis:
+    """The analysis of ``edge``, kept in ``cache`` (default:
+    :func:`~planner.actions.region_cache.default_cache`) beside the exact regions, so that
+    :func:`prepare` can compute it ahead of :func:`write_recording`: from the cache's memory, else
+    from its file (the polygons as WKB), else turned from a twin edge's, else computed (0.1 s,
+    with the exact region from ``cache``), and kept in both."""
+    cache = default_cache() if cache is None else cache
     key = _analysis_key(scene, edge)
-    if key in _analyses:
-        return _analyses[key]
-    path = cache_folder() / f"analysis-{key}.json"
-    try:
-        data = json.loads(path.read_text())
-        found = _Analysis(tuple(data["window"]), np.asarray(data["contact"], dtype=float),
-                          {name: {int(sense): shapely.from_wkb(bytes.fromhex(wkb)) for sense, wkb in by.items()}
-                           for name, by in data["polygons"].items()})
-    except (OSError, ValueError, KeyError, TypeError, shapely.errors.GEOSException):
-        found = _turned_twin(scene, edge) or _compute_analysis(scene, edge)
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            write_atomic(path, json.dumps({
-                "window": list(found.window), "contact": found.contact.tolist(),
-                "polygons": {name: {str(sense): shapely.to_wkb(g, hex=True) for sense, g in by.items()}
-                             for name, by in found.polygons.items()}}))
-        except OSError:
-            pass  # a read-only home: compute again next time
-    _analyses[key] = found
+    found = cache.get(key) or _from_json(cache.read("analysis", key))
+    if found is None:
+        found = _turned_twin(scene, edge, cache) or _computed(scene, edge, cache)
+        cache.write("analysis", key, {
+            "window": list(found.window), "contact": found.contact.tolist(),
+            "polygons": {name: {str(sense): shapely.to_wkb(g, hex=True) for sense, g in by.items()}
+                         for name, by in found.polygons.items()}})
+    cache.put(key, found)
     return found
 
 
-def _turned_twin(scene: Scene, edge: int) -> _Analysis | None:
+def _from_json(data: object) -> Analysis | None:
+    """The analysis a cache file held (``data``, its JSON, None if unread), or None if it is not one."""
+    try:
+        return Analysis(tuple(data["window"]), np.asarray(data["contact"], dtype=float),
+                        {name: {int(sense): shapely.from_wkb(bytes.fromhex(wkb)) for sense, wkb in by.items()}
+                         for name, by in data["polygons"].items()})
+    except (ValueError, KeyError, TypeError, AttributeError, shapely.errors.GEOSException):
+        return None
+
+
+def _turned_twin(scene: Scene, edge: int, cache: RegionCache) -> Analysis | None:
     """The analysis of an edge that a quarter or half turn of the part about its CF carries onto
-    ``edge`` (:attr:`mechanics.Slider.turns`), if this process has it, turned with the part; the
-    window, a square about the CF, turns onto itself."""
+    ``edge`` (:attr:`mechanics.Slider.turns`), if ``cache`` has it in memory, turned with the part;
+    the window, a square about the CF, turns onto itself."""
     slider = scene.slider
     for r in slider.turns:
         angle = slider.turn_angle(r)
         if abs(math.remainder(angle, math.pi / 2)) > 1e-9:
             continue
-        twin = _analyses.get(_analysis_key(scene, (edge - r) % slider.n))
+        twin = cache.get(_analysis_key(scene, (edge - r) % slider.n))
         if twin is not None:
             c, s = math.cos(angle), math.sin(angle)
             cf = tuple(slider.cf)
-            return _Analysis(twin.window, (twin.contact - slider.cf) @ np.array([[c, s], [-s, c]]) + slider.cf,
-                             {name: {sense: shapely.affinity.rotate(g, angle, origin=cf, use_radians=True)
-                                     for sense, g in by.items()} for name, by in twin.polygons.items()})
+            return Analysis(twin.window, (twin.contact - slider.cf) @ np.array([[c, s], [-s, c]]) + slider.cf,
+                            {name: {sense: shapely.affinity.rotate(g, angle, origin=cf, use_radians=True)
+                                    for sense, g in by.items()} for name, by in twin.polygons.items()})
     return None
 
 
-def _compute_analysis(scene: Scene, edge: int) -> _Analysis:
+def _computed(scene: Scene, edge: int, cache: RegionCache) -> Analysis:
+    """The analysis of ``edge`` from its regions and force status, the 0.1 s :func:`analysis` saves."""
     slider, p = scene.slider, scene.pusher
     window = (*(slider.cf - 4 * slider.radius).tolist(), *(slider.cf + 4 * slider.radius).tolist())
     # The exact region whatever the plan used (cached): the view compares it with STABLE's.
     polygons = {"stable": edge_region(slider, edge, p.mu, p.width, "stable").cor_polygons(window),
-                "exact": edge_region(slider, edge, p.mu, p.width, "exact", scene.cf_uncertainty).cor_polygons(window)}
+                "exact": edge_region(slider, edge, p.mu, p.width, "exact", scene.cf_uncertainty,
+                                     cache=cache).cor_polygons(window)}
     config = ContactConfiguration.slider_edge(slider, edge, p.mu, p.width)
     support = SupportModel.of_slider(slider, cf_radius=scene.cf_uncertainty)  # as the plan's regions
     status = force_status_regions(contact_wrench_cone(config, "ss"), support, window,
                                   rays=ANALYSIS_RAYS, steps=6, refinements=0)
     polygons |= {label: {sense: status[sense][label] for sense in (1, -1)} for label in _STATUS}
-    return _Analysis(window, np.asarray(config.points, dtype=float), polygons)
+    return Analysis(window, np.asarray(config.points, dtype=float), polygons)
 
 
-def prepare(scene: Scene, wait: Callable[[float], bool]) -> None:
+def prepare(scene: Scene, wait: Callable[[float], bool], cache: RegionCache | None = None) -> None:
     """Compute ahead of :func:`write_recording`, in this process, the analysis of each allowed
-    edge, as soon as its stable region is cached, until ``wait(seconds)`` (which may wait that
-    long) says a plan has come; the first pushed edge is one of them. :mod:`planner.outputs.recorder`
-    runs this beside the search, which caches the regions of a new part first."""
+    edge, as soon as its stable region is in ``cache`` (default:
+    :func:`~planner.actions.region_cache.default_cache`), until ``wait(seconds)`` (which may wait
+    that long) says a plan has come; the first pushed edge is one of them.
+    :mod:`planner.outputs.recorder` runs this beside the search, which caches the regions of a new
+    part first, and then writes the recording with the same cache."""
     p = scene.pusher
     pending = list(p.edges)
     while pending and not wait(0.0):
-        ready = [e for e in pending if is_cached(scene.slider, e, p.mu, p.width, "exact", scene.cf_uncertainty)]
+        ready = [e for e in pending if is_cached(scene.slider, e, p.mu, p.width, "exact", scene.cf_uncertainty, cache)]
         if not ready:
             if wait(_POLL):
                 return
             continue
-        _analysis(scene, ready[0])
+        analysis(scene, ready[0], cache)
         pending.remove(ready[0])
 
 
-def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
+def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan, cache: RegionCache | None) -> None:
     """``/analysis``: the first pushed edge's regions in the slider frame (module docstring)."""
     pushes = [s for s in plan.segments if s.kind == "push"]
     edge = pushes[0].edge
-    window, contact, polygons = _analysis(scene, edge)
+    window, contact, polygons = analysis(scene, edge, cache)
     rec.log("analysis/part", rr.LineStrips2D([_closed(scene.slider.vertices)], colors=_SLIDER, radii=_BOLD),
             static=True)
     rec.log("analysis/contact", rr.LineStrips2D([contact], colors=_DARK, radii=_BOLD), static=True)
@@ -392,7 +394,8 @@ def _log_ghost(rec: rr.RecordingStream, plan: Plan, verification: Verification, 
             static=True)
 
 
-def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
+def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan,
+                cache: RegionCache | None) -> tuple[np.ndarray, np.ndarray]:
     """The animated entities; returns the frames' segment indices and times."""
     frames = _frames(scene, plan, scene.slider.radius / FRAMES_PER_RADIUS)
     index, times, poses = frames.index, frames.times, frames.part
@@ -402,8 +405,8 @@ def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> tuple[np.n
     # Only the pushed edges' regions: they are cached, the plan used them (others may not be done).
     p = scene.pusher
     regions = {e: {sense: _outline(poly) for sense, poly in edge_region(
-        slider, e, p.mu, p.width, scene.planner.regions, scene.cf_uncertainty).cor_polygons(window).items()}
-        for e in {s.edge for s in plan.segments if s.kind == "push"}}
+        slider, e, p.mu, p.width, scene.planner.regions, scene.cf_uncertainty,
+        cache=cache).cor_polygons(window).items()} for e in {s.edge for s in plan.segments if s.kind == "push"}}
     # Per frame: the COR and the regions' outlines, none or one each.
     cor: list[np.ndarray] = []
     stable: dict[int, list[np.ndarray]] = {1: [], -1: []}
@@ -450,7 +453,7 @@ def _log_reach(rec: rr.RecordingStream, reach: ReachableSet) -> None:
 
 
 def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Verification | None = None,
-                    reach: ReachableSet | None = None) -> None:
+                    reach: ReachableSet | None = None, cache: RegionCache | None = None) -> None:
     """Write a rerun recording of ``plan`` for ``scene`` to ``path`` (layout: module docstring).
 
     The recording is made in memory (footer included) and written with
@@ -469,6 +472,9 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         :func:`planner.verify` of ``plan``: adds the simulated ghost and the verdict.
     reach : ReachableSet, optional
         :func:`planner.queries.reachable_set.reachable_set` from the scene's start: adds ``/world/reach``.
+    cache : RegionCache, optional
+        Where the plan's regions and the analysis are found, or kept once computed (default:
+        :func:`~planner.actions.region_cache.default_cache`); :func:`prepare` may have filled it.
 
     Raises
     ------
@@ -493,9 +499,9 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         rec.send_blueprint(blueprint, make_active=False, make_default=True)
         _log_static(rec, scene, plan)
         if plan.segments:
-            index, times = _log_motion(rec, scene, plan)
+            index, times = _log_motion(rec, scene, plan, cache)
             if plan.pushes:
-                _log_analysis(rec, scene, plan)
+                _log_analysis(rec, scene, plan, cache)
             if verification is not None:
                 _log_ghost(rec, plan, verification, index, times)
         if reach is not None:
