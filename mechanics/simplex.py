@@ -69,6 +69,15 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
     >>> (pi @ [1.0, 0]).round(12).tolist(), unbounded.tolist()
     ([2.666666666667], [False])
 
+    A singular basis (two columns alike; rounding can make one of a nearly degenerate part) is
+    not pivoted from: that LP goes to HiGHS, which finds the optimum 2 (3/4 at the second point 0,
+    1/4 at 2, for costs 1 and 5):
+
+    >>> pi, unbounded = batched_simplex(np.array([[0.0, 1.0, 5.0]]), np.array([[1.0, 1, 1], [0, 0, 2]]),
+    ...                                 np.array([1.0, 0.5]), np.array([[0, 1]]))
+    >>> (pi @ [1.0, 0.5]).round(9).tolist(), unbounded.tolist()
+    ([2.0], [False])
+
     Unbounded: ``max s_1`` s.t. ``s_0 - s_1 = 1`` lets ``s_1`` grow without end:
 
     >>> batched_simplex(np.array([[0.0, 1.0]]), np.array([[1.0, -1.0]]), np.array([1.0]), np.array([[0]]))[1]
@@ -81,19 +90,26 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
     unbounded = np.zeros(problems, dtype=bool)
     tol = 1e-12 * (1.0 + np.max(np.abs(np.where(np.isfinite(costs), costs, 0.0)), axis=1))
     open_ = np.arange(problems)
+    handed: list[int] = []
     for pivot in range(limit):
         bland = pivot >= limit // 4
         a = columns if shared else columns[open_]
         cols = (a[:, basis[open_]].transpose(1, 0, 2) if shared
                 else np.take_along_axis(a, basis[open_][:, None, :], axis=2))
         c = costs[open_]
-        pi = np.linalg.solve(np.swapaxes(cols, 1, 2), np.take_along_axis(c, basis[open_], axis=1)[..., None])[..., 0]
+        pi, singular = _solved(np.swapaxes(cols, 1, 2), np.take_along_axis(c, basis[open_], axis=1))
+        if singular.any():  # a basis rounding made singular: that LP goes to HiGHS
+            handed.extend(open_[singular].tolist())
+            keep = ~singular
+            open_, cols, c, pi = open_[keep], cols[keep], c[keep], pi[keep]
+            a = columns if shared else columns[open_]
         duals[open_] = pi
         reduced = c - (pi @ a if shared else np.einsum("pm,pmn->pn", pi, a))
         improving = reduced > tol[open_, None]
         going = improving.any(axis=1)
         if not going.any():
-            return duals, unbounded
+            open_ = np.arange(0)
+            break
         enter = np.argmax(improving if bland else reduced, axis=1)[going]
         open_, cols = open_[going], cols[going]
         entering = a[:, enter].T if shared else a[going][np.arange(len(open_)), :, enter]
@@ -107,9 +123,11 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
         if bland:  # of the tied leaving columns, the lowest
             ratio = np.where(ratio <= ratio.min(axis=1, keepdims=True), basis[open_], np.inf)
         basis[open_, np.argmin(ratio, axis=1)] = enter
+    if not len(open_) and not handed:
+        return duals, unbounded
     from scipy.optimize import linprog  # rarely needed: scipy.optimize takes a third of a second to import
 
-    for p in open_:
+    for p in [*open_.tolist(), *handed]:
         a = columns if shared else columns[p]
         keep = np.isfinite(costs[p])
         res = linprog(rhs, A_ub=-a[:, keep].T, b_ub=-costs[p, keep], bounds=[(None, None)] * m, method="highs")
@@ -120,3 +138,18 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
         else:
             duals[p] = res.x
     return duals, unbounded
+
+
+def _solved(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``x`` with ``a[p] x[p] = b[p]`` for each problem ``p``, and which ``a[p]`` are singular
+    (their ``x`` is left 0)."""
+    try:
+        return np.linalg.solve(a, b[..., None])[..., 0], np.zeros(len(a), dtype=bool)
+    except np.linalg.LinAlgError:  # one singular matrix fails the whole batch: solve them apart
+        x, singular = np.zeros(b.shape), np.zeros(len(a), dtype=bool)
+        for p in range(len(a)):
+            try:
+                x[p] = np.linalg.solve(a[p], b[p])
+            except np.linalg.LinAlgError:
+                singular[p] = True
+        return x, singular

@@ -4,37 +4,45 @@
 the paper's one-step question, :func:`reachability` answers reachable / unreachable (certified) /
 unknown for many goals, :func:`controllability` says what the stable pushes can reach (1996 §2-3),
 :func:`verify` re-simulates a plan (or one read by :func:`load_plan`)
-under many support distributions. Modules: :mod:`.scene` (file format), :mod:`.bodies` (slider +
-pusher geometry), :mod:`.validity` (fcl collision rule), :mod:`.pushes` (stable pushes per edge),
-:mod:`.one_step`, :mod:`.search` (OMPL), :mod:`.plan_file` (JSON), :mod:`.verify` (re-simulation),
-:mod:`.recording` (rerun) and :mod:`.recorder` (written beside the search), :mod:`.cli` (the ``plan``
-command), :mod:`.geodesic` (a lower bound on any plan's length), and the benchmarks :mod:`.bench`,
-:mod:`.quality` and :mod:`.reach_bench`.
+under many support distributions. The subpackages, lowest first (each imports only from those
+before it): :mod:`.model` (scene and plan files), :mod:`.world` (collisions, free space),
+:mod:`.actions` (stable pushes, transits, shortcuts), :mod:`.search` (OMPL), :mod:`.queries`
+(one step, reachability, controllability, bounds), :mod:`.execution` (re-simulation),
+:mod:`.outputs` (recording, pictures) and :mod:`.bench`; :mod:`.cli` is the ``plan`` command.
 """
 
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
-from .model.fields import SceneError
-from .model.options import DEFAULT_PLANNER
-from .model.plan_file import Plan, Push, Transit, load_plan
-from .model.scene import Scene, load_scene, parse_scene
-from .queries.one_step import OneStep, one_step
-from .queries.reachability import Reach, certify_unreachable, reachability
-from .search import plan
-
 if TYPE_CHECKING:
     from .execution.verify import Verification, verify
+    from .model.fields import SceneError
+    from .model.options import DEFAULT_PLANNER
+    from .model.plan_file import Plan, Push, Transit, load_plan
+    from .model.scene import Scene, load_scene, parse_scene
     from .queries.controllability import SceneControllability, controllability
+    from .queries.one_step import OneStep, one_step
+    from .queries.reachability import Reach, certify_unreachable, reachability
+    from .search import plan
 
 __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Reach", "Scene", "SceneError", "Push", "Transit",
            "certify_unreachable", "load_plan", "load_scene", "one_step", "parse_scene", "plan", "reachability",
            "Verification", "verify", "SceneControllability", "controllability"]
 
-#: Public names imported on first use, by module: the controllability report needs scipy and
-#: the re-simulator its own mechanics, which a plan run does not (tests/test_startup.py).
-_ON_FIRST_USE = {"SceneControllability": ".queries.controllability", "controllability": ".queries.controllability",
-                 "Verification": ".execution.verify", "verify": ".execution.verify"}
+#: Every public name is imported on first use, from its module: ``import planner`` itself loads
+#: nothing (the ``plan`` command sets up the process before numpy is loaded, planner.cli), and the
+#: controllability report (scipy) and the re-simulator are loaded only where used
+#: (tests/test_startup.py).
+_ON_FIRST_USE = {
+    "SceneError": ".model.fields", "DEFAULT_PLANNER": ".model.options",
+    "Plan": ".model.plan_file", "Push": ".model.plan_file", "Transit": ".model.plan_file",
+    "load_plan": ".model.plan_file", "Scene": ".model.scene", "load_scene": ".model.scene",
+    "parse_scene": ".model.scene", "OneStep": ".queries.one_step", "one_step": ".queries.one_step",
+    "Reach": ".queries.reachability", "certify_unreachable": ".queries.reachability",
+    "reachability": ".queries.reachability", "plan": ".search",
+    "SceneControllability": ".queries.controllability", "controllability": ".queries.controllability",
+    "Verification": ".execution.verify", "verify": ".execution.verify",
+}
 
 
 def __getattr__(name: str) -> Any:

@@ -27,8 +27,14 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from .model.fields import SceneError, shown
+# One BLAS thread, set before numpy is first loaded (planner's own import loads nothing): the
+# command forks its recorder and region workers, which is safe only in a process with one thread
+# (planner.model.processes), and its matrices are far too small for BLAS threads to pay.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from .model.fields import SceneError, shown  # noqa: E402 (after the environment is set)
 from .model.files import atomic_path, write_atomic
 from .model.plan_file import Plan, load_plan
 from .model.stop import Terminated, raise_on_sigterm
@@ -39,7 +45,9 @@ from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, M
                             PLANNERS, REGIONS, TRANSITS, PlannerOptions, check_optimize, check_seed, check_time_limit)
 from .model.scene import Scene, load_scene
 from .search import plan
-from .execution.verify import Verification, verify
+
+if TYPE_CHECKING:
+    from .execution.verify import Verification
 
 __all__ = ["Inputs", "main", "read_inputs"]
 
@@ -205,8 +213,11 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         if result.note and result.solved:
             print(f"plan: note: {result.note}", file=sys.stderr)
     # The planning seed also draws the random distributions, so a run is repeatable as a whole.
-    check = (verify(scene, result, inputs.verify, seed)
-             if inputs.verify and (result.solved or inputs.given is not None) else None)
+    check = None
+    if inputs.verify and (result.solved or inputs.given is not None):
+        from .execution.verify import verify  # the re-simulator, loaded only for --verify
+
+        check = verify(scene, result, inputs.verify, seed)
     reach = None
     if inputs.reach:  # after planning: the map is about the start, whatever the plan
         from .queries.reachable_set import reachable_set

@@ -3,6 +3,7 @@ and no final output behind, and a write that fails is one error line with nothin
 
 from __future__ import annotations
 
+import json
 import os
 import resource
 import shutil
@@ -12,6 +13,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -135,3 +137,67 @@ def test_a_full_or_read_only_folder_is_one_line_and_leaves_nothing(tmp_path, cas
         assert list(out.iterdir()) == []
     finally:
         subprocess.run(["umount", str(out)], check=True)
+
+
+def _regular(n: int, radius: float) -> list[list[float]]:
+    angles = np.arange(n) * 2 * np.pi / n
+    return (radius * np.c_[np.cos(angles), np.sin(angles)]).round(12).tolist()
+
+
+def test_a_part_of_a_thousand_edges_ends_within_its_time_limit(tmp_path):
+    """Cache keys, symmetry, collision bodies and regions for 1000 edges all count against the
+    limit: a 2 s run ends in under 5 s (it used to run past a minute), with the usual answer."""
+    spec = {"slider": {"vertices": _regular(1000, 0.05)}, "pusher": {"width": 0.02, "depth": 0.01, "mu": 0.5},
+            "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]}, "start": [-0.3, 0.0, 0.0], "goal": [0.3, 0.1, 0.0]}
+    (tmp_path / "gon.yaml").write_text(yaml.safe_dump(spec))
+    began = time.perf_counter()
+    run = start(tmp_path, "gon.yaml", "--time-limit", "2", "--out", "out", cache=tmp_path / "cache")
+    stdout, stderr = run.communicate(timeout=60)
+    assert time.perf_counter() - began < 5.0
+    assert run.returncode in (0, 2), stderr
+    assert len((stdout + stderr).strip().splitlines()) == 1
+
+
+def test_a_sliver_part_gets_a_one_line_answer(tmp_path):
+    """A 10 cm x 1 um part: nearly degenerate support cells (a singular simplex basis once made the
+    recorder die with a traceback). The answer is a plan, or one line naming the slider."""
+    spec = {"slider": {"vertices": [[-0.05, -5e-7], [0.05, -5e-7], [0.05, 5e-7], [-0.05, 5e-7]]},
+            "pusher": {"width": 0.05, "depth": 0.015, "mu": 0.5}, "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]},
+            "start": [-0.3, 0.0, 0.0], "goal": [0.0, 0.3, 0.0]}
+    (tmp_path / "sliver.yaml").write_text(yaml.safe_dump(spec))
+    run = start(tmp_path, "sliver.yaml", "--time-limit", "4", "--out", "out", cache=tmp_path / "cache")
+    stdout, stderr = run.communicate(timeout=60)
+    lines = (stdout + stderr).strip().splitlines()
+    assert len(lines) == 1, stdout + stderr
+    assert run.returncode == 0 or lines[0].startswith("plan: error: slider"), lines
+
+
+def test_a_tolerance_below_what_rounding_resolves_is_refused(tmp_path):
+    spec = {"slider": {"vertices": [[-0.04, -0.03], [0.04, -0.03], [0.04, 0.03], [-0.04, 0.03]]},
+            "pusher": {"width": 0.05, "depth": 0.015, "mu": 0.5}, "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]},
+            "start": [-0.3, 0.0, 0.0], "goal": [0.3, 0.0, 0.0], "tolerance": {"position": 1e-300}}
+    (tmp_path / "tight.yaml").write_text(yaml.safe_dump(spec))
+    run = start(tmp_path, "tight.yaml", "--out", "out", cache=tmp_path / "cache")
+    stdout, stderr = run.communicate(timeout=60)
+    assert run.returncode == 1 and stdout == ""
+    assert stderr.startswith("plan: error: tolerance.position: must be at least 1e-09 m") and stderr.count("\n") == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_concurrent_cold_runs_share_one_cache(tmp_path):
+    """Four runs of one scene started together with an empty cache all solve, give the plan one run
+    gives alone, and leave only whole cache files (each written atomically, none half-written)."""
+    runs = [start(tmp_path, str(SCENES / "parking.yaml"), "--seed", "2", "--out", f"out-{k}", cache=tmp_path / "cache")
+            for k in range(4)]
+    for run in runs:
+        run.communicate(timeout=120)
+        assert run.returncode == 0
+    alone = start(tmp_path, str(SCENES / "parking.yaml"), "--seed", "2", "--out", "alone", cache=tmp_path / "other")
+    alone.communicate(timeout=120)
+    plans = [json.loads((tmp_path / out / "parking.json").read_text()) for out in ("alone", "out-0", "out-1", "out-2",
+                                                                               "out-3")]
+    for p in plans:
+        del p["planning_time_s"]
+    assert all(p == plans[0] for p in plans[1:])
+    files = list((tmp_path / "cache").iterdir())
+    assert files and all(not f.name.endswith(".tmp") and json.loads(f.read_text()) for f in files)

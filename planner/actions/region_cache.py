@@ -28,11 +28,12 @@ import functools
 import hashlib
 import json
 import os
+import queue
 import signal
 import time
+import weakref
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -44,6 +45,7 @@ from mechanics import DeadlineExceeded, ExactRegion, Slider, StableRegion, exact
 
 from ..model.fields import SceneError
 from ..model.files import write_atomic
+from ..model.processes import die_with_parent, fork_context
 
 __all__ = ["MEMORY_SIZE", "RegionCache", "cache_folder", "cache_key", "compute_regions", "default_cache",
            "edge_region", "is_cached"]
@@ -147,10 +149,21 @@ def cache_key(kind: str, slider: Slider, edge: int, mu: float, width: float | No
               **more) -> str:
     """The name of a cache item of ``kind`` for one edge: a hash of everything it depends on
     (and of :data:`_VERSION`, so a change of the mechanics leaves old files unused)."""
-    spec = {"kind": kind, "version": _VERSION, "vertices": slider.vertices.tolist(), "cf": slider.cf.tolist(),
-            "edge": int(edge), "mu": float(mu), "width": None if width is None else float(width),
-            "cf_radius": float(cf_radius)} | more
+    spec = {"kind": kind, "version": _VERSION, "part": _part_digest(slider), "edge": int(edge), "mu": float(mu),
+            "width": None if width is None else float(width), "cf_radius": float(cf_radius)} | more
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
+
+
+_DIGESTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _part_digest(slider: Slider) -> str:
+    """A hash of the part's vertices and CF, made once per part: a key then costs the same for a
+    part of a thousand vertices as for a square (and a thousand edges ask for keys)."""
+    if slider not in _DIGESTS:
+        part = {"vertices": slider.vertices.tolist(), "cf": slider.cf.tolist()}
+        _DIGESTS[slider] = hashlib.sha256(json.dumps(part).encode()).hexdigest()
+    return _DIGESTS[slider]
 
 
 def _key(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float) -> str:
@@ -179,10 +192,21 @@ def is_cached(slider: Slider, edge: int, mu: float, width: float | None = None, 
     return any(cache.holds("exact", key) for key in _keys_alike(slider, edge, mu, width, cf_radius))
 
 
+def _twin(slider: Slider, edge: int) -> int:
+    """The lowest-numbered edge that a turn of the part (:attr:`mechanics.Slider.turns`) carries
+    onto ``edge`` (``edge`` itself, if none): the one computed for all of them.
+
+    >>> square = Slider([[-1, -1], [1, -1], [1, 1], [-1, 1]])
+    >>> [_twin(square, e) for e in range(4)], _twin(Slider([[0, 0], [2, 0], [0, 1]]), 2)
+    ([0, 0, 0, 0], 2)
+    """
+    # The turns are a group (two symmetries make a third): the multiples of the least one, d.
+    return edge % (slider.turns[0] if slider.turns else slider.n)
+
+
 def _keys_alike(slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float) -> list[str]:
-    """The cache keys of ``edge`` and of each edge a turn of the part carries onto it
-    (:attr:`mechanics.Slider.turns`): all have the same region."""
-    return [_key(slider, (edge - r) % slider.n, mu, width, cf_radius) for r in (0, *slider.turns)]
+    """The cache keys of ``edge`` and of its twin (:func:`_twin`): both have the same region."""
+    return [_key(slider, e, mu, width, cf_radius) for e in dict.fromkeys((edge, _twin(slider, edge)))]
 
 
 def _known(cache: RegionCache, slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float,
@@ -244,8 +268,8 @@ def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: floa
     """Compute the exact regions of ``edges`` (whatever the cache holds) with ``cache``'s
     ``compute``, up to ``workers`` at a time (default: one per core, at most one per edge) in
     forked processes, and keep them in ``cache`` (default: :func:`default_cache`). Of edges that a
-    turn of the part carries onto one another (:attr:`mechanics.Slider.turns`), only the first is
-    computed: the others have its region.
+    turn of the part carries onto one another (:attr:`mechanics.Slider.turns`), only the lowest
+    numbered (:func:`_twin`) is computed: the others have its region.
 
     Edges are begun in order, each as soon as a worker is free, ``progress(k, n)`` being called
     just before the ``k``-th of the ``n`` computed is begun. ``deadline`` (a :func:`time.perf_counter`
@@ -261,36 +285,33 @@ def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: floa
     {}
     """
     cache = default_cache() if cache is None else cache
-    first: list[int] = []
-    for edge in edges:
-        if not any((edge - r) % slider.n in first for r in slider.turns):
-            first.append(edge)
+    first = list(dict.fromkeys(_twin(slider, edge) for edge in edges))
     workers = min(len(first), _cores() if workers is None else workers)
     out: dict[int, ExactRegion] = {}
-    with _executor(workers) as pool:
-        waiting, running = list(first), {}
+    with _workers(workers) as pool:
+        waiting, running = list(first), 0
         while waiting or running:
-            while waiting and len(running) < workers and (deadline is None or time.perf_counter() <= deadline):
+            while waiting and running < workers and (deadline is None or time.perf_counter() <= deadline):
                 edge = waiting.pop(0)
                 if progress is not None:
                     progress(len(first) - len(waiting), len(first))
-                running[pool.submit(cache.compute, slider, edge, mu, width, cf_radius=cf_radius,
-                                     deadline=deadline)] = edge
+                pool.submit(edge, cache.compute, slider, edge, mu, width, cf_radius=cf_radius, deadline=deadline)
+                running += 1
             if not running:  # past the deadline: the rest are not begun
                 break
-            for future in wait(running, return_when=FIRST_COMPLETED).done:
-                edge = running.pop(future)
-                try:
-                    region = future.result()
-                except DeadlineExceeded:
-                    continue
-                _keep(cache, _key(slider, edge, mu, width, cf_radius), region)
-                out[edge] = region
+            edge, region = pool.next_done()
+            running -= 1
+            if isinstance(region, DeadlineExceeded):
+                continue
+            if isinstance(region, BaseException):
+                raise region
+            _keep(cache, _key(slider, edge, mu, width, cf_radius), region)
+            out[edge] = region
     for edge in edges:
-        if edge not in first and any((twin := (edge - r) % slider.n) in out for r in slider.turns):
+        if edge not in out and (twin := _twin(slider, edge)) in out:
             out[edge] = replace(out[twin], stable=stable_region(slider, edge, mu, width))
             cache.put(_key(slider, edge, mu, width, cf_radius), out[edge])
-    return out
+    return {edge: out[edge] for edge in edges if edge in out}
 
 
 def _cores() -> int:
@@ -301,32 +322,53 @@ def _cores() -> int:
         return os.cpu_count() or 1
 
 
-class _InProcess(Executor):
-    """An executor that runs each call at once, in this process: one worker is not worth a fork."""
+class _Workers:
+    """Calls run in up to ``n`` worker processes forked now, or, with ``context`` None, at once in
+    this process. Results come back in the order they finish (:meth:`next_done`). Leaving the
+    ``with`` block normally waits for the workers to end; leaving it by an exception (Ctrl-C,
+    SIGTERM, an error) kills them at once, and they die with this process if it is killed."""
 
-    def submit(self, fn: Callable, /, *args, **kwargs) -> Future:
-        future: Future = Future()
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except Exception as err:  # raised by result(), as a worker's would be
-            future.set_exception(err)
-        return future
+    def __init__(self, n: int, context):
+        self._done: queue.SimpleQueue = queue.SimpleQueue()
+        self._pool = None if context is None else context.Pool(n, initializer=_worker_start, initargs=(os.getpid(),))
+
+    def submit(self, key, fn: Callable, /, *args, **kwargs) -> None:
+        """Begin ``fn(*args, **kwargs)``; :meth:`next_done` gives ``(key, result)``, the result
+        being the exception it raised, if it did."""
+        if self._pool is None:
+            try:
+                self._done.put((key, fn(*args, **kwargs)))
+            except Exception as err:
+                self._done.put((key, err))
+            return
+        self._pool.apply_async(fn, args, kwargs, callback=lambda r: self._done.put((key, r)),
+                               error_callback=lambda err: self._done.put((key, err)))
+
+    def next_done(self) -> tuple:
+        return self._done.get()
+
+    def __enter__(self) -> "_Workers":
+        return self
+
+    def __exit__(self, kind, error, trace) -> None:
+        if self._pool is None:
+            return
+        if kind is None:
+            self._pool.close()
+        else:
+            self._pool.terminate()
+        self._pool.join()
 
 
-def _ignore_interrupts() -> None:
-    # Ctrl-C reaches every process of the terminal's group: the parent alone handles it, instead
-    # of each worker printing a traceback. Leaving the executor then waits for the regions still
-    # running, which end by their deadline at the latest.
+def _worker_start(parent: int) -> None:
+    # Ctrl-C reaches every process of the terminal's group: the parent alone handles it (and
+    # kills the workers), instead of each worker printing a traceback. A worker writes nothing, so
+    # SIGKILL is the right end for it when the parent dies.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    die_with_parent(parent, signal.SIGKILL)
 
 
-def _executor(workers: int) -> Executor:
-    """``workers`` forked processes, or this process for one (or where processes cannot fork)."""
-    if workers > 1:
-        import multiprocessing  # only for a cold cache: a warm run is spared importing it
-        from concurrent.futures import ProcessPoolExecutor
-
-        if "fork" in multiprocessing.get_all_start_methods():
-            return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
-                                       initializer=_ignore_interrupts)
-    return _InProcess()
+def _workers(n: int) -> _Workers:
+    """``n`` forked workers, or this process for one, or where forking is not safe now
+    (:func:`planner.model.processes.fork_context`)."""
+    return _Workers(n, fork_context() if n > 1 else None)

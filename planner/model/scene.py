@@ -26,7 +26,7 @@ from .options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEF
                       check_transit)
 from .yaml_file import read_yaml
 
-__all__ = ["MIN_SIZE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene"]
+__all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene"]
 
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
 _MAX_NAME_BYTES = 200
@@ -35,6 +35,10 @@ MIN_SIZE = 1e-6
 #: Friction coefficients read: from all but frictionless to all but a wall (a cone of 89.94 degrees
 #: each side); far beyond them the cone's arithmetic underflows or overflows.
 MU_RANGE = (1e-3, 1e3)
+#: Least goal tolerance, in metres per metre of the table's extent (and in radians): a hundred times
+#: the rounding a plan's composed poses carry (about 1e-11), so that "within tolerance" is decided
+#: by the plan, not by rounding.
+MIN_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -267,6 +271,15 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     tol = keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
     tol_pos = number(tol.get("position", 0.01), "tolerance.position", positive=True, limit=LENGTH)
     tol_ang = math.radians(number(tol.get("angle", 2.0), "tolerance.angle", positive=True, limit=ANGLE))
+    # Plans compose many exponentials: their poses carry rounding of about 1e-11 of the table's size
+    # (and radian). A tolerance below what that resolves could not tell a plan that ends within it.
+    size = max(1.0, float(np.max(np.abs(workspace))))
+    if tol_pos < MIN_TOLERANCE * size:
+        raise SceneError("tolerance.position", f"must be at least {MIN_TOLERANCE * size:g} m (the rounding of a "
+                                               f"plan's poses on this table is about {1e-11 * size:g} m), got {tol_pos:g}")
+    if tol_ang < MIN_TOLERANCE:
+        raise SceneError("tolerance.angle", f"must be at least {math.degrees(MIN_TOLERANCE):g} degrees (the rounding "
+                                            f"of a plan's headings is about 1e-11 rad), got {math.degrees(tol_ang):g}")
     opts = keys(spec.get("planner", {}), "planner", (),
                 ("name", "time_limit", "seed", "regions", "switch_cost", "optimize"))
     planner = PlannerOptions(

@@ -7,22 +7,16 @@ is for Ctrl-C). Python raises a signal's exception wherever the main thread happ
 a callback of OMPL's C++ code it would be swallowed there, so a search runs under
 :func:`signals_deferred`, which only notes the signal and raises its exception once the C++ code
 has returned.
-
-A process the run starts (the recorder, region workers) must not outlive it, however it ends,
-even by SIGKILL, which runs no cleanup: each calls :func:`die_with_parent` first thing.
 """
 
 from __future__ import annotations
 
-import ctypes
-import os
 import signal
-import sys
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["Terminated", "die_with_parent", "raise_on_sigterm", "signals_deferred"]
+__all__ = ["Terminated", "raise_on_sigterm", "signals_deferred", "terminate"]
 
 
 class Terminated(BaseException):
@@ -30,7 +24,8 @@ class Terminated(BaseException):
     ``except Exception`` on the way swallows it."""
 
 
-def _terminate(signum, frame) -> None:
+def terminate(signum, frame) -> None:
+    """A signal handler that raises :class:`Terminated`."""
     raise Terminated
 
 
@@ -41,7 +36,7 @@ def raise_on_sigterm() -> Iterator[None]:
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGTERM, _terminate)
+    previous = signal.signal(signal.SIGTERM, terminate)
     try:
         yield
     finally:
@@ -79,27 +74,3 @@ def signals_deferred() -> Iterator[list[int]]:
     if noted:
         raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated
 
-
-_PR_SET_PDEATHSIG = 1  # linux/prctl.h
-
-
-def die_with_parent(parent: int) -> None:
-    """Make this child process get SIGTERM (raised as :class:`Terminated`) when its parent
-    ``parent`` (a pid) dies, whatever kills it.
-
-    On Linux the kernel sends it (``prctl(PR_SET_PDEATHSIG)``): nothing to poll, and it works while
-    the child is blocked in C code. If the parent died before the call, the child stops at once.
-    Elsewhere a daemon thread watches the parent's pid every 0.2 s and signals the child itself.
-    """
-    signal.signal(signal.SIGTERM, _terminate)
-    if sys.platform.startswith("linux"):
-        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
-    else:
-        def watch() -> None:
-            while os.getppid() == parent:
-                threading.Event().wait(0.2)
-            os.kill(os.getpid(), signal.SIGTERM)
-
-        threading.Thread(target=watch, name="stablepush-parent-watch", daemon=True).start()
-    if os.getppid() != parent:  # it died before the kernel was told
-        raise Terminated

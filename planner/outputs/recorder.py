@@ -4,9 +4,9 @@ Importing rerun takes about 0.3 s, as long as many searches, and drawing the pus
 force-status map another 0.1 s. :func:`recorder` forks a child process before the search; while
 the parent plans, the child imports rerun and the recording code and draws the map of each edge
 the plan may start on, then writes the recording it is sent. On a two-core machine the import costs the command
-nothing. The child is forked only where that is safe: on a platform with ``fork`` and while rerun
-is not yet imported (its threads would not survive a fork); otherwise the recording is written in
-this process, as :func:`planner.outputs.recording.write_recording` does. Either way one
+nothing. The child is forked only where that is safe (:func:`planner.model.processes.fork_context`:
+a platform with ``fork``, this process running one thread, so rerun not imported yet); otherwise
+the recording is written in this process, as :func:`planner.outputs.recording.write_recording` does. Either way one
 :class:`~planner.actions.region_cache.RegionCache` serves: the child, forked with a copy of it,
 keeps there the analyses it prepares and draws them from it; the regions the search computes
 meanwhile reach it through the cache's folder.
@@ -19,7 +19,6 @@ meanwhile reach it through the cache's folder.
 from __future__ import annotations
 
 import functools
-import multiprocessing
 import os
 import signal
 import sys
@@ -30,7 +29,8 @@ from pathlib import Path
 
 from ..actions.region_cache import RegionCache, default_cache
 from ..model.scene import Scene
-from ..model.stop import Terminated, die_with_parent
+from ..model.processes import die_with_parent, fork_context
+from ..model.stop import Terminated
 
 __all__ = ["RecordingFailed", "recorder"]
 
@@ -111,10 +111,10 @@ def recorder(scene: Scene, cache: RegionCache | None = None) -> Iterator[Callabl
         From the call, if anything else stopped the recording (the recorder process included).
     """
     cache = default_cache() if cache is None else cache
-    if "rerun" in sys.modules or "fork" not in multiprocessing.get_all_start_methods():
+    context = None if "rerun" in sys.modules else fork_context()
+    if context is None:
         yield functools.partial(_write_inline, cache)
         return
-    context = multiprocessing.get_context("fork")
     conn, theirs = context.Pipe()
     child = context.Process(target=_child, args=(theirs, conn, os.getpid(), scene, cache), name="stablepush-recorder",
                             daemon=True)

@@ -123,12 +123,15 @@ class CollisionModel:
         # Per body: its convex pieces, outline vertices (as floats) and farthest point from its origin.
         self._bodies: dict[int | str, tuple[list[fcl.CollisionObject], list, float]] = {}
         p = scene.pusher
+        # The part's pieces are made once and shared by every edge's body (each check places the
+        # pieces it uses first): a part of many edges would otherwise cost as many copies.
+        part = [fcl.CollisionObject(_prism(s)) for s in convex_pieces(scene.slider.polygon)]
         for e in edges:
             pusher = pusher_polygon(scene.slider, e, p.width, p.depth)
-            outline = body_outline(scene.slider, e, p.width, p.depth)
-            self._add(e, convex_pieces(scene.slider.polygon) + convex_pieces(pusher), outline)
+            self._add(e, part + [fcl.CollisionObject(_prism(s)) for s in convex_pieces(pusher)],
+                      body_outline(scene.slider, e, p.width, p.depth))
         alone = pusher_frame_body(p.width, p.depth)
-        self._add(_PUSHER, [alone], alone)
+        self._add(_PUSHER, [fcl.CollisionObject(_prism(alone))], alone)
         self._request = fcl.DistanceRequest()
         # Where the CF may be: the disk about it inside the part must stay clear (planner.world.free_space).
         slider = scene.slider
@@ -136,9 +139,8 @@ class CollisionModel:
         self.cf_room = disk_free_space(scene, slider.cf_depth * (1.0 - SCREEN_SHRINK))
         shapely.prepare(self.cf_room)
 
-    def _add(self, key: int | str, shapes: list[np.ndarray], outline: np.ndarray) -> None:
-        self._bodies[key] = ([fcl.CollisionObject(_prism(s)) for s in shapes], outline.tolist(),
-                             float(np.linalg.norm(outline, axis=1).max()))
+    def _add(self, key: int | str, pieces: list[fcl.CollisionObject], outline: np.ndarray) -> None:
+        self._bodies[key] = (pieces, outline.tolist(), float(np.linalg.norm(outline, axis=1).max()))
 
     def clearance(self, pose: ArrayLike, edge: int) -> float:
         """Distance from the body (slider and pusher on ``edge``) to the nearest obstacle or
