@@ -69,16 +69,16 @@ class EdgeControls:
 class RegionTimeout(Exception):
     """The deadline passed before every allowed edge's stable region was computed.
 
-    ``pushes`` holds the :class:`EdgeControls` of each other edge that has stable pushes (what
+    ``controls`` holds the :class:`EdgeControls` of each other edge that has stable pushes (what
     :func:`edge_controls` would return for those edges alone), ``pending`` the allowed edges not
     computed. Finished regions are cached (:mod:`.region_cache`), so a later run goes further.
     """
 
-    def __init__(self, pushes: list[EdgeControls], pending: tuple[int, ...]):
-        self.pushes, self.pending = pushes, pending
+    def __init__(self, controls: list[EdgeControls], pending: tuple[int, ...]):
+        self.controls, self.pending = controls, pending
         named = ", ".join(map(str, pending[:4])) + (f", ... ({len(pending)} in all)" if len(pending) > 4 else "")
         super().__init__(f"the stable regions of edge{'s' if len(pending) > 1 else ''} {named} were not computed "
-                         f"within the time limit ({len(pushes)} edge{'' if len(pushes) == 1 else 's'} with stable "
+                         f"within the time limit ({len(controls)} edge{'' if len(controls) == 1 else 's'} with stable "
                          "pushes ready)")
 
 

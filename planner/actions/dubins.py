@@ -21,6 +21,7 @@ from ompl import base as ob
 from mechanics import wrap_angle
 
 from .car import EdgeCar, edge_car
+from .controls import EdgeControls
 from ..model.plan_file import Push, append_push, rechain
 from ..model.scene import Scene
 from ..world.validity import CollisionModel, advances
@@ -202,16 +203,16 @@ class DubinsShortcut:
     Parameters
     ----------
     scene : Scene
-    pushes : the allowed edges' pushes
+    controls : the allowed edges' controls
     model : CollisionModel
         With a body for each of those edges.
     margin : float
         Clearance every push keeps.
     """
 
-    def __init__(self, scene: Scene, pushes, model: CollisionModel, margin: float):
+    def __init__(self, scene: Scene, controls: list[EdgeControls], model: CollisionModel, margin: float):
         self.cf = scene.slider.cf
-        cars = (edge_car(p, self.cf) for p in pushes)
+        cars = (edge_car(c, self.cf) for c in controls)
         self.curves = {car.push.edge: DubinsCurves(scene, car, model, margin) for car in cars if car is not None}
 
     def __call__(self, segments: list) -> list:

@@ -274,9 +274,10 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     # Plans compose many exponentials: their poses carry rounding of about 1e-11 of the table's size
     # (and radian). A tolerance below what that resolves could not tell a plan that ends within it.
     size = max(1.0, float(np.max(np.abs(workspace))))
-    if tol_pos < MIN_TOLERANCE * size:
-        raise SceneError("tolerance.position", f"must be at least {MIN_TOLERANCE * size:g} m (the rounding of a "
-                                               f"plan's poses on this table is about {1e-11 * size:g} m), got {tol_pos:g}")
+    least = float(f"{MIN_TOLERANCE * size:.3g}")  # the limit as the message shows it
+    if tol_pos < least:
+        raise SceneError("tolerance.position", f"must be at least {least:g} m (the rounding of a plan's poses on "
+                                               f"this table is about {1e-11 * size:g} m), got {tol_pos:g}")
     if tol_ang < MIN_TOLERANCE:
         raise SceneError("tolerance.angle", f"must be at least {math.degrees(MIN_TOLERANCE):g} degrees (the rounding "
                                             f"of a plan's headings is about 1e-11 rad), got {math.degrees(tol_ang):g}")

@@ -141,9 +141,9 @@ class PlanningContext:
             try:
                 controls = edge_controls(scene, self.clock + request.time_limit / 2, progress)
             except RegionTimeout as timeout:
-                if not timeout.pushes:
+                if not timeout.controls:
                     raise
-                controls, self.note = timeout.pushes, str(timeout)
+                controls, self.note = timeout.controls, str(timeout)
         self.controls: list[EdgeControls] = controls
         self.starts = [k for k, c in enumerate(controls) if self.model.is_clear(scene.start, c.edge, self.step / 2)]
         if not self.starts:
