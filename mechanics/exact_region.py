@@ -133,6 +133,8 @@ class ExactRegion:
             return np.zeros(v.shape[:-1], dtype=bool)
         p = self.plane.points(v)
         ok = np.all(np.isfinite(p), axis=-1)
+        if not shapely.is_prepared(self.polygon):  # asked of every search state: prepared, twice as fast
+            shapely.prepare(self.polygon)  # (here, not on construction: an unpickled region comes unprepared)
         inside = shapely.dwithin(self.polygon, shapely.points(np.where(ok[..., None], p, 0.0)), tol)
         return ok & inside
 

@@ -42,6 +42,7 @@ Cheap screens come before the expensive ones, and none changes an answer:
 from __future__ import annotations
 
 import copy
+from collections import OrderedDict
 from collections.abc import Sequence
 
 import numpy as np
@@ -57,13 +58,15 @@ from ..model.scene import Scene
 from ..world.free_space import Components
 from ..world.validity import CollisionModel
 
-__all__ = ["GoalRegion", "TRIES"]
+__all__ = ["GoalRegion", "REMEMBERED", "TRIES"]
 
 _U1 = np.linspace(0.0, 1.0, 12, endpoint=False)  # around the boundary of the stable cone
 _U2 = (0.5, 1.0)  # half way out, and on the boundary (the sharpest turns)
 _LEGS = (1.0, 2.0, 4.0, 8.0)  # waypoint push lengths, in part radii
 #: Waypoints collision-checked per state and edge: this test runs on every new tree state.
 TRIES = 4
+#: Poses whose answers :meth:`GoalRegion.pushes_to` keeps (per edge and set of goals).
+REMEMBERED = 512
 _SAMPLES = np.linspace(0.0, 1.0, 9)[1:-1]  # where along a push the part's CF is screened
 
 
@@ -101,6 +104,7 @@ class GoalRegion:
             tau = np.tile(legs, len(grid))
             self._waypoints.append((exp_twist(self.goals[:, None, :], -w, tau), w, tau))
         self._last_leg: dict[tuple[int, int, int], Push | None] = {}
+        self._asked: OrderedDict[tuple, dict[int, list[Push]]] = OrderedDict()
         self._cf = scene.slider.cf
         self._pieces = Components(model.cf_room)
         self._goal_piece = self._pieces.label(self._cf_at(self.goals))
@@ -155,7 +159,18 @@ class GoalRegion:
 
     def pushes_to(self, pose: ArrayLike, k: int, goals: Sequence[int]) -> dict[int, list[Push]]:
         """Per goal index of ``goals`` that one or two pushes of ``controls[k]`` reach from
-        ``pose``, those pushes (screens 3-5; no tolerance, no switch)."""
+        ``pose``, those pushes (screens 3-5; no tolerance, no switch).
+
+        The answers for the last :data:`REMEMBERED` poses are kept: a switch makes a state at its
+        parent's very pose, and the parent's test has asked every edge already."""
+        key = (tuple(float(v) for v in np.ravel(pose)), k, tuple(goals))
+        if key not in self._asked:
+            if len(self._asked) >= REMEMBERED:
+                self._asked.popitem(last=False)
+            self._asked[key] = self._pushes_to(np.asarray(pose, dtype=float), k, goals)
+        return self._asked[key]
+
+    def _pushes_to(self, pose: np.ndarray, k: int, goals: Sequence[int]) -> dict[int, list[Push]]:
         controls = self.controls[k]
         goals = np.asarray(goals, dtype=int)
         found: dict[int, list[Push]] = {}
