@@ -70,7 +70,7 @@ def test_a_many_edged_part_computes_what_fits_and_says_so(empty_cache):
     with pytest.raises(RegionTimeout) as caught:
         edge_controls(scene, deadline=start + 2.0, cache=empty_cache)
     assert time.perf_counter() - start < 3.0
-    done = [p.edge for p in caught.value.pushes]
+    done = [p.edge for p in caught.value.controls]
     pending = caught.value.pending
     assert len(done) >= 2 and done == sorted(done) and list(pending) == sorted(pending)
     assert sorted(done + list(pending)) == list(edges) and len(pending) > 100
@@ -91,7 +91,7 @@ def test_past_the_deadline_cached_edges_are_still_read(empty_cache):
     spec["pusher"].pop("edges")
     with pytest.raises(RegionTimeout) as caught:
         edge_controls(parse_scene(spec, "corridor"), deadline=time.perf_counter(), cache=empty_cache)
-    assert [p.edge for p in caught.value.pushes] == [0, 2] and caught.value.pending == (1, 3)
+    assert [p.edge for p in caught.value.controls] == [0, 2] and caught.value.pending == (1, 3)
 
 
 def test_progress_hears_of_each_region_computed_and_none_cached(empty_cache):
