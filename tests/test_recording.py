@@ -24,7 +24,7 @@ from rerun.chunk import RrdReader
 import planner
 from mechanics import exp_twist
 from planner.actions.region_cache import RegionCache
-from planner.outputs import recording
+from planner.outputs import analysis, frames, recording
 
 RERUN = Path(sys.executable).parent / "rerun"
 
@@ -145,7 +145,7 @@ def test_the_slider_moves_from_the_start_to_the_plans_final_pose(straight, turn)
     for scene, plan, path in (straight, turn):
         rows = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
         assert [t for t, _ in rows] == list(range(len(rows)))
-        assert 10 <= len(rows) <= recording.MAX_FRAMES
+        assert 10 <= len(rows) <= frames.MAX_FRAMES
         outlines = np.array([strips[0] for _, strips in rows])
         # Smooth: no vertex jumps more than a twentieth of the part's radius (0.05) between frames.
         assert np.linalg.norm(np.diff(outlines, axis=0), axis=-1).max() <= 0.05 / 20 + 1e-6
@@ -240,7 +240,7 @@ def test_a_long_plan_is_capped_and_its_cf_path_thinned(straight, tmp_path):
     path = tmp_path / "long.rrd"
     recording.write_recording(path, scene, plan)
     slider = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
-    assert 0.9 * recording.MAX_FRAMES <= len(slider) <= recording.MAX_FRAMES
+    assert 0.9 * frames.MAX_FRAMES <= len(slider) <= frames.MAX_FRAMES
     times = [t for _, t in rrd_rows(path, "/world/slider", "time", "step")]
     for s, t in zip(segments, np.cumsum([0.0] + durations)):  # each push starts on a frame
         k = int(np.argmin(np.abs(np.array(times) - t * 1e9)))
@@ -248,7 +248,7 @@ def test_a_long_plan_is_capped_and_its_cf_path_thinned(straight, tmp_path):
         np.testing.assert_allclose(slider[k][1][0], closed(placed(SLIDER, s.start)), atol=1e-5)
     np.testing.assert_allclose(slider[-1][1][0], closed(placed(SLIDER, pose)), atol=1e-5)
     cf = rrd_rows(path, "/world/cf_path", "LineStrips2D:strips", "step")
-    assert max(len(strips[0]) for _, strips in cf) <= recording.PATH_POINTS + len(segments) + 1
+    assert max(len(strips[0]) for _, strips in cf) <= frames.PATH_POINTS + len(segments) + 1
     drawn = np.array(cf[-1][1][0])
     for s in segments:  # the path keeps its corners
         assert np.linalg.norm(drawn - s.start[:2], axis=1).min() < 1e-5
@@ -517,18 +517,18 @@ def test_a_half_turn_of_the_part_gives_the_twin_edges_analysis(tmp_path):
     it must compute (its twin is edge 3, whose analysis it does not hold)."""
     scene = planner.load_scene(SCENES / "parking.yaml")
     computed = RegionCache(tmp_path / "computed")
-    recording.analysis(scene, 0, computed)
+    analysis.analysis(scene, 0, computed)
     held = RegionCache(tmp_path / "held", compute=refuse)
     held.folder.mkdir()
     for file in computed.folder.glob("analysis-*.json"):  # edge 0's analysis, not its region
         shutil.copy(file, held.folder)
-    alone = recording.analysis(scene, 2, RegionCache(computed.folder))  # nothing in memory to turn
-    assert recording.analysis(scene, 0, held) is recording.analysis(scene, 0, held)  # read once
-    twin = recording.analysis(scene, 2, held)
+    alone = analysis.analysis(scene, 2, RegionCache(computed.folder))  # nothing in memory to turn
+    assert analysis.analysis(scene, 0, held) is analysis.analysis(scene, 0, held)  # read once
+    twin = analysis.analysis(scene, 2, held)
     np.testing.assert_allclose(twin.contact, alone.contact, atol=1e-12)
     for name, by_sense in alone.polygons.items():
         for sense, polygon in by_sense.items():
             turned = twin.polygons[name][sense]
             assert turned.symmetric_difference(polygon).area <= 1e-3 * polygon.area + 1e-12, (name, sense)
     with pytest.raises(AssertionError, match="an exact region was computed"):
-        recording.analysis(scene, 1, held)
+        analysis.analysis(scene, 1, held)

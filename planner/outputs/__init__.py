@@ -1,5 +1,6 @@
-"""What a person looks at: the rerun recording (:mod:`.recording`), written beside the search by
-a forked process (:mod:`.recorder`), and still pictures (:mod:`.picture`, matplotlib).
+"""What a person looks at: the rerun recording (:mod:`.recording`) of the plan's frames
+(:mod:`.frames`) and of the pushed edge's mechanics (:mod:`.analysis`), written beside the search
+by a forked process (:mod:`.recorder`), and still pictures (:mod:`.picture`, matplotlib).
 
 Allowed imports: every package below it (:mod:`planner.model`, :mod:`planner.world`,
 :mod:`planner.actions`, :mod:`planner.search`, :mod:`planner.queries`,

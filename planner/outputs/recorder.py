@@ -25,6 +25,7 @@ import sys
 import traceback
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from importlib import import_module
 from pathlib import Path
 
 from ..actions.region_cache import RegionCache, default_cache
@@ -60,7 +61,8 @@ def _child(conn, parents_end, parent: int, scene: Scene, cache: RegionCache) -> 
         die_with_parent(parent)
         failed = None
         try:
-            from .recording import prepare  # the import the parent is spared
+            import_module(".recording", __package__)  # rerun and the drawing code: the import the parent is spared
+            from .analysis import prepare
 
             prepare(scene, conn.poll, cache)
         except Exception as err:  # reported when the recording is asked for, with what it says
@@ -99,7 +101,7 @@ def recorder(scene: Scene, cache: RegionCache | None = None) -> Iterator[Callabl
     """A function with :func:`planner.outputs.recording.write_recording`'s arguments but its
     ``cache``, writing through a child forked now (module docstring) or else in this process; the
     child is stopped on leaving. A child also prepares what any recording of ``scene`` needs
-    (:func:`planner.outputs.recording.prepare`). Both read and keep the regions and analyses in
+    (:func:`planner.outputs.analysis.prepare`). Both read and keep the regions and analyses in
     ``cache`` (default: :func:`~planner.actions.region_cache.default_cache`); the search's
     regions reach the child through its folder.
 

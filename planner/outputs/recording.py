@@ -1,4 +1,5 @@
-"""Rerun recording of a plan: the scene, the search tree and the pushes, animated.
+"""Rerun recording of a plan: the scene, the search tree and the pushes, animated (the frames come
+from :mod:`planner.outputs.frames`, the pushed edge's mechanics from :mod:`planner.outputs.analysis`).
 
 :func:`write_recording` writes one ``.rrd`` file (application ``stablepush``, recording id
 ``<scene>-<planner>-seed<seed>``, no wall-clock timeline, so the same plan gives the same file).
@@ -70,71 +71,47 @@ above the text log.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 import shapely
-import shapely.affinity
 from numpy.typing import ArrayLike
 
-from mechanics import (ContactConfiguration, Slider, SupportModel, contact_wrench_cone, exp_twist,
-                       force_status_regions, twist_to_cor)
+from mechanics import twist_to_cor
 
+from ..actions.region_cache import RegionCache, edge_region
+from ..actions.transit import transit_pieces
 from ..model.bodies import pusher_frame_body
 from ..model.files import write_atomic
-from ..model.plan_file import Plan, Push, Transit
-from ..actions.region_cache import RegionCache, cache_key, default_cache, edge_region, is_cached
+from ..model.plan_file import Plan
 from ..model.scene import Scene
-from ..actions.transit import edge_contact_pose, transit_pieces, transit_poses
+from .analysis import STATUS, analysis
+from .frames import FRAMES_PER_RADIUS, frames, history, place
 
 if TYPE_CHECKING:  # the simulator behind it imports most of scipy: not needed to draw a plan
     from ..queries.reachable_set import ReachableSet
     from ..execution.verify import Verification
 
-__all__ = ["ANALYSIS_RAYS", "Analysis", "FRAMES_PER_RADIUS", "GHOST_SAMPLES", "MAX_FRAMES", "PATH_POINTS",
-           "analysis", "prepare", "write_recording"]
+__all__ = ["GHOST_SAMPLES", "write_recording"]
 
-#: Animation frames while a body point travels one slider radius (fewer if that exceeds MAX_FRAMES).
-FRAMES_PER_RADIUS = 20
-#: Most animation frames a recording holds (for plans of fewer than ``MAX_FRAMES - 1`` pushes).
-MAX_FRAMES = 600
-#: About the most points of the CF path drawn in one frame (it is redrawn every frame).
-PATH_POINTS = 100
 #: Most frames per push at which the simulated ghost is drawn (each costs a simulation).
 GHOST_SAMPLES = 10
-#: Rays per sense of the sticking force-status map in ``/analysis`` (about a tenth of a second).
-ANALYSIS_RAYS = 16
-#: Seconds :func:`prepare` waits between looks for a newly cached region.
-_POLL = 0.02
 
 _THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0.5, 1.0, 2.0, 4.0]))
 _GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
 _SLIDER, _GOAL, _CF = [40, 110, 220], [40, 170, 70], [90, 160, 255]
 _CCW, _CW, _COR, _GHOST = [20, 170, 150], [230, 130, 20], [210, 40, 190], [140, 60, 230]
 _LIFTED = [110, 110, 110, 110]  # a faint, see-through grey: the pusher off the table, seen from above
-_STATUS = {"P": [40, 170, 70], "U": [230, 190, 40], "I": [200, 50, 50]}
+_STATUS = dict(zip(STATUS, ([40, 170, 70], [230, 190, 40], [200, 50, 50])))
 
 
 def _closed(points: ArrayLike) -> np.ndarray:
     """A polygon's vertices as a closed strip (the first vertex repeated at the end)."""
     p = np.asarray(points, dtype=float)
     return np.vstack([p, p[:1]])
-
-
-def _place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
-    """Slider-frame ``points`` (shape ``(m, 2)``) placed at each of ``poses`` (shape ``(f, 3)``): ``(f, m, 2)``.
-
-    >>> _place(np.array([[1.0, 0.0]]), np.array([[0.0, 1.0, np.pi / 2]])).round(12).tolist()
-    [[[0.0, 2.0]]]
-    """
-    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
-    x, y = points[:, 0], points[:, 1]
-    return np.stack([c * x - s * y + poses[:, :1], s * x + c * y + poses[:, 1:2]], axis=-1)
 
 
 def _summary(scene: Scene, plan: Plan) -> str:
@@ -153,7 +130,7 @@ def _summary(scene: Scene, plan: Plan) -> str:
 def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
     xmin, ymin, xmax, ymax = scene.workspace
     outline = _closed(scene.slider.vertices)
-    ghosts = _place(outline, np.array([scene.start, scene.goal]))
+    ghosts = place(outline, np.array([scene.start, scene.goal]))
     rec.log("world/workspace", rr.Boxes2D(mins=[xmin, ymin], sizes=[xmax - xmin, ymax - ymin],
                                           colors=_DARK, radii=_LINE), static=True)
     rec.log("world/obstacles", rr.LineStrips2D(
@@ -172,75 +149,6 @@ def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
     rec.log("log", rr.TextLog(_summary(scene, plan), level="INFO" if plan.solved else "WARN"), static=True)
 
 
-class _Frames(NamedTuple):
-    """The animation, one item per frame."""
-
-    index: np.ndarray  # the segment shown
-    times: np.ndarray  # plan time, s
-    part: np.ndarray  # the part's pose
-    pusher: np.ndarray  # the pusher frame's world pose (planner.model.bodies.pusher_frame_body)
-    lifted: np.ndarray  # whether the pusher is in the air
-
-
-def _pusher_on(slider: Slider, edge: int) -> np.ndarray:
-    """The pusher frame's pose in the slider frame while it pushes ``edge``: face centred on the
-    edge's midpoint (:func:`planner.model.bodies.pusher_polygon`), facing the part."""
-    return edge_contact_pose(slider, edge, np.zeros(3))
-
-
-def _sample(slider: Slider, body: np.ndarray, segment: Push | Transit,
-            t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The part's and the pusher's poses and the pusher's being airborne, ``t`` into ``segment``."""
-    if segment.kind == "transit":
-        pusher, lifted = transit_poses(segment, body, t)
-        return np.tile(segment.pose, (len(t), 1)), pusher, lifted
-    part = exp_twist(segment.start, segment.twist, t)
-    local = _pusher_on(slider, segment.edge)
-    pusher = np.column_stack([_place(local[None, :2], part)[:, 0], part[:, 2] + local[2]])
-    return part, pusher, np.zeros(len(t), dtype=bool)
-
-
-def _frames(scene: Scene, plan: Plan, step: float) -> _Frames:
-    """Every animation frame.
-
-    No body point moves more than ``step`` between frames (pushes and transits alike, duration
-    bounds point travel), unless that would take more than ``MAX_FRAMES``: then frames are
-    shared out in proportion to the segments' durations. Every segment gets at least its first
-    frame, and a last frame shows the end of the last, so there are at most
-    ``max(MAX_FRAMES, segments + 1)`` frames.
-    """
-    segments = plan.segments
-    body = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
-    durations = np.array([s.duration for s in segments])
-    counts = np.maximum(np.ceil(durations / step), 1).astype(int)
-    if counts.sum() > MAX_FRAMES - 1:
-        budget = max(MAX_FRAMES - 1 - len(segments), 0)
-        counts = 1 + (budget * durations / durations.sum()).astype(int)
-    index, times, samples = [], [], []
-    clock = 0.0
-    for k, (s, n) in enumerate(zip(segments, counts)):
-        t = np.arange(n) * (s.duration / n)
-        index.append(np.full(n, k))
-        times.append(clock + t)
-        samples.append(_sample(scene.slider, body, s, t))
-        clock += s.duration
-    index.append([len(segments) - 1])
-    times.append([clock])
-    samples.append(_sample(scene.slider, body, segments[-1], np.array([segments[-1].duration])))
-    return _Frames(np.concatenate(index), np.concatenate(times), *map(np.concatenate, zip(*samples)))
-
-
-def _history(points: np.ndarray, index: np.ndarray) -> list[np.ndarray]:
-    """For each frame, the path of ``points`` (one per frame) so far, thinned to at most about
-    ``PATH_POINTS`` points: every few frames plus the first frame of each segment (where the path
-    may turn sharply) and the current one."""
-    keep = np.zeros(len(points), dtype=bool)
-    keep[:: -(-len(points) // PATH_POINTS)] = True
-    keep[np.flatnonzero(np.diff(index, prepend=-1))] = True
-    kept = np.flatnonzero(keep)
-    return [points[np.r_[kept[: np.searchsorted(kept, i)], i]] for i in range(len(points))]
-
-
 def _outline(region: shapely.Geometry) -> np.ndarray | None:
     """Closed outline of a convex COR region, or None if it is empty or has no area."""
     return np.asarray(region.exterior.coords) if isinstance(region, shapely.Polygon) and region.area > 0 else None
@@ -250,104 +158,6 @@ def _rings(geometry: shapely.Geometry) -> list[np.ndarray]:
     """Closed outer rings of every polygon of ``geometry`` with area."""
     parts = getattr(geometry, "geoms", [geometry])
     return [np.asarray(g.exterior.coords) for g in parts if isinstance(g, shapely.Polygon) and g.area > 0]
-
-
-class Analysis(NamedTuple):
-    """What ``/analysis`` shows of one edge, in the slider frame: the window, the contact
-    segment, and polygons by name ('stable', 'exact': COR regions; 'P', 'U', 'I': force status
-    of sticking) and sense (1 CCW, -1 CW)."""
-
-    window: tuple[float, float, float, float]
-    contact: np.ndarray
-    polygons: dict[str, dict[int, shapely.Geometry]]
-
-
-def _analysis_key(scene: Scene, edge: int) -> str:
-    p = scene.pusher
-    return cache_key("analysis", scene.slider, edge, p.mu, p.width, scene.cf_uncertainty, rays=ANALYSIS_RAYS)
-
-
-def analysis(scene: Scene, edge: int, cache: RegionCache | None = None) -> Analysis:
-    """The analysis of ``edge``, kept in ``cache`` (default:
-    :func:`~planner.actions.region_cache.default_cache`) beside the exact regions, so that
-    :func:`prepare` can compute it ahead of :func:`write_recording`: from the cache's memory, else
-    from its file (the polygons as WKB), else turned from a twin edge's, else computed (0.1 s,
-    with the exact region from ``cache``), and kept in both."""
-    cache = default_cache() if cache is None else cache
-    key = _analysis_key(scene, edge)
-    found = cache.get(key) or _from_json(cache.read("analysis", key))
-    if found is None:
-        found = _turned_twin(scene, edge, cache) or _computed(scene, edge, cache)
-        cache.write("analysis", key, {
-            "window": list(found.window), "contact": found.contact.tolist(),
-            "polygons": {name: {str(sense): shapely.to_wkb(g, hex=True) for sense, g in by.items()}
-                         for name, by in found.polygons.items()}})
-    cache.put(key, found)
-    return found
-
-
-def _from_json(data: object) -> Analysis | None:
-    """The analysis a cache file held (``data``, its JSON, None if unread), or None if it is not one."""
-    try:
-        return Analysis(tuple(data["window"]), np.asarray(data["contact"], dtype=float),
-                        {name: {int(sense): shapely.from_wkb(bytes.fromhex(wkb)) for sense, wkb in by.items()}
-                         for name, by in data["polygons"].items()})
-    except (ValueError, KeyError, TypeError, AttributeError, shapely.errors.GEOSException):
-        return None
-
-
-def _turned_twin(scene: Scene, edge: int, cache: RegionCache) -> Analysis | None:
-    """The analysis of an edge that a quarter or half turn of the part about its CF carries onto
-    ``edge`` (:attr:`mechanics.Slider.turns`), if ``cache`` has it in memory, turned with the part;
-    the window, a square about the CF, turns onto itself."""
-    slider = scene.slider
-    for r in slider.turns:
-        angle = slider.turn_angle(r)
-        if abs(math.remainder(angle, math.pi / 2)) > 1e-9:
-            continue
-        twin = cache.get(_analysis_key(scene, (edge - r) % slider.n))
-        if twin is not None:
-            c, s = math.cos(angle), math.sin(angle)
-            cf = tuple(slider.cf)
-            return Analysis(twin.window, (twin.contact - slider.cf) @ np.array([[c, s], [-s, c]]) + slider.cf,
-                            {name: {sense: shapely.affinity.rotate(g, angle, origin=cf, use_radians=True)
-                                    for sense, g in by.items()} for name, by in twin.polygons.items()})
-    return None
-
-
-def _computed(scene: Scene, edge: int, cache: RegionCache) -> Analysis:
-    """The analysis of ``edge`` from its regions and force status, the 0.1 s :func:`analysis` saves."""
-    slider, p = scene.slider, scene.pusher
-    window = (*(slider.cf - 4 * slider.radius).tolist(), *(slider.cf + 4 * slider.radius).tolist())
-    # The exact region whatever the plan used (cached): the view compares it with STABLE's.
-    polygons = {"stable": edge_region(slider, edge, p.mu, p.width, "stable").cor_polygons(window),
-                "exact": edge_region(slider, edge, p.mu, p.width, "exact", scene.cf_uncertainty,
-                                     cache=cache).cor_polygons(window)}
-    config = ContactConfiguration.slider_edge(slider, edge, p.mu, p.width)
-    support = SupportModel.of_slider(slider, cf_radius=scene.cf_uncertainty)  # as the plan's regions
-    status = force_status_regions(contact_wrench_cone(config, "ss"), support, window,
-                                  rays=ANALYSIS_RAYS, steps=6, refinements=0)
-    polygons |= {label: {sense: status[sense][label] for sense in (1, -1)} for label in _STATUS}
-    return Analysis(window, np.asarray(config.points, dtype=float), polygons)
-
-
-def prepare(scene: Scene, wait: Callable[[float], bool], cache: RegionCache | None = None) -> None:
-    """Compute ahead of :func:`write_recording`, in this process, the analysis of each allowed
-    edge, as soon as its stable region is in ``cache`` (default:
-    :func:`~planner.actions.region_cache.default_cache`), until ``wait(seconds)`` (which may wait
-    that long) says a plan has come; the first pushed edge is one of them.
-    :mod:`planner.outputs.recorder` runs this beside the search, which caches the regions of a new
-    part first, and then writes the recording with the same cache."""
-    p = scene.pusher
-    pending = list(p.edges)
-    while pending and not wait(0.0):
-        ready = [e for e in pending if is_cached(scene.slider, e, p.mu, p.width, "exact", scene.cf_uncertainty, cache)]
-        if not ready:
-            if wait(_POLL):
-                return
-            continue
-        analysis(scene, ready[0], cache)
-        pending.remove(ready[0])
 
 
 def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan, cache: RegionCache | None) -> None:
@@ -388,7 +198,7 @@ def _log_ghost(rec: rr.RecordingStream, plan: Plan, verification: Verification, 
     outline = _closed(verification.scene.slider.vertices)
     rec.send_columns("world/ghost", indexes=[rr.TimeColumn("step", sequence=frames),
                                              rr.TimeColumn("time", duration=times[frames])],
-                     columns=rr.LineStrips2D.columns(strips=_place(outline, np.concatenate(poses))))
+                     columns=rr.LineStrips2D.columns(strips=place(outline, np.concatenate(poses))))
     rec.log("world/ghost", rr.LineStrips2D.from_fields(colors=_GHOST, radii=_LINE), static=True)
     rec.log("log/verify", rr.TextLog(verification.summary(), level="INFO" if verification.passed else "WARN"),
             static=True)
@@ -397,8 +207,8 @@ def _log_ghost(rec: rr.RecordingStream, plan: Plan, verification: Verification, 
 def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan,
                 cache: RegionCache | None) -> tuple[np.ndarray, np.ndarray]:
     """The animated entities; returns the frames' segment indices and times."""
-    frames = _frames(scene, plan, scene.slider.radius / FRAMES_PER_RADIUS)
-    index, times, poses = frames.index, frames.times, frames.part
+    shown = frames(scene, plan, scene.slider.radius / FRAMES_PER_RADIUS)
+    index, times, poses = shown.index, shown.times, shown.part
     steps = [rr.TimeColumn("step", sequence=np.arange(len(times))), rr.TimeColumn("time", duration=times)]
     slider = scene.slider
     window = (*(slider.cf - 4 * slider.radius), *(slider.cf + 4 * slider.radius))
@@ -413,21 +223,21 @@ def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan,
     for k, s in enumerate(plan.segments):
         at = poses[index == k]
         centre, sense = twist_to_cor(s.twist)  # a transit's twist is zero: no COR
-        cor += list(_place(centre[None], at)) if sense != 0 else [np.zeros((0, 2))] * len(at)
+        cor += list(place(centre[None], at)) if sense != 0 else [np.zeros((0, 2))] * len(at)
         outlines = regions[s.edge] if s.kind == "push" else dict.fromkeys(stable)  # nothing is pushed
         for side, outline in outlines.items():
             empty = [np.zeros((0, 0, 2))] * len(at)
-            stable[side] += empty if outline is None else list(_place(outline, at)[:, None])
+            stable[side] += empty if outline is None else list(place(outline, at)[:, None])
 
     def send(entity: str, columns: rr.ComponentColumnList, lengths: ArrayLike | None = None) -> None:
         """One row per frame; ``lengths`` (how many items each frame has) splits ``columns`` into them."""
         rec.send_columns(entity, indexes=steps, columns=columns if lengths is None else columns.partition(lengths))
 
-    send("world/slider", rr.LineStrips2D.columns(strips=_place(_closed(slider.vertices), poses)))
-    pusher = _place(_closed(pusher_frame_body(scene.pusher.width, scene.pusher.depth)), frames.pusher)
-    for entity, shown in (("world/pusher", ~frames.lifted), ("world/pusher_lifted", frames.lifted)):
-        send(entity, rr.LineStrips2D.columns(strips=pusher[shown]), shown.astype(int))
-    send("world/cf_path", rr.LineStrips2D.columns(strips=_history(_place(slider.cf[None], poses)[:, 0], index)))
+    send("world/slider", rr.LineStrips2D.columns(strips=place(_closed(slider.vertices), poses)))
+    pusher = place(_closed(pusher_frame_body(scene.pusher.width, scene.pusher.depth)), shown.pusher)
+    for entity, where in (("world/pusher", ~shown.lifted), ("world/pusher_lifted", shown.lifted)):
+        send(entity, rr.LineStrips2D.columns(strips=pusher[where]), where.astype(int))
+    send("world/cf_path", rr.LineStrips2D.columns(strips=history(place(slider.cf[None], poses)[:, 0], index)))
     send("world/cor", rr.Points2D.columns(positions=np.concatenate(cor)), [len(c) for c in cor])
     for name, side in (("ccw", 1), ("cw", -1)):
         send(f"world/stable/{name}", rr.LineStrips2D.columns(strips=[o for row in stable[side] for o in row]),
@@ -474,7 +284,7 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         :func:`planner.queries.reachable_set.reachable_set` from the scene's start: adds ``/world/reach``.
     cache : RegionCache, optional
         Where the plan's regions and the analysis are found, or kept once computed (default:
-        :func:`~planner.actions.region_cache.default_cache`); :func:`prepare` may have filled it.
+        :func:`~planner.actions.region_cache.default_cache`); :func:`~planner.outputs.analysis.prepare` may have filled it.
 
     Raises
     ------
