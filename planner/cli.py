@@ -4,6 +4,8 @@
 and prints a line per push and an overall line with the worst deviation; ``--verify N --plan
 FILE`` verifies a plan file instead of planning, and writes the same outputs (the plan as read,
 and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
+``--trajectory`` also writes the pusher's time-parameterised trajectory of a solved (or loaded)
+plan, ``<name>.trajectory.csv`` (:func:`planner.execution.trajectory.trajectory`, default limits).
 ``--reach N`` (1 or 2) then maps the goal positions reachable from the start in at most N stable
 pushes (:func:`planner.queries.reachable_set.reachable_set`, any heading): ``<name>-reach.png`` in the
 output folder and ``/world/reach`` in the recording.
@@ -47,6 +49,7 @@ from .model.scene import Scene, load_scene
 from .search import plan
 
 if TYPE_CHECKING:
+    from .execution.trajectory import Trajectory
     from .execution.verify import Verification
 
 __all__ = ["Inputs", "main", "read_inputs"]
@@ -107,6 +110,11 @@ def _parser() -> argparse.ArgumentParser:
                    help="after planning, map the goal positions reachable from the start in at most N (1 or 2) "
                         "stable pushes, at any heading: <name>-reach.png in the output folder and /world/reach "
                         "in the recording (planner.queries.reachable_set; seconds per map)")
+    p.add_argument("--trajectory", action="store_true",
+                   help="for a solved (or loaded) plan, also write <name>.trajectory.csv: the pusher's pose and "
+                        "velocity sampled at 100 Hz, jerk-limited, at rest wherever the push or edge changes, no "
+                        "point of it faster than 0.05 m/s or accelerating more than 0.5 m/s^2 "
+                        "(planner.execution.trajectory)")
     return p
 
 
@@ -123,6 +131,7 @@ class Inputs:
     plan_path: str | None  # --plan FILE
     given: Plan | None  # that file's plan, to verify instead of planning
     reach: int | None = None  # --reach N: pushes of the reachable-set map
+    trajectory: bool = False  # --trajectory: write the pusher's trajectory
 
 
 def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
@@ -161,7 +170,7 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--out", f"{shown(str(out))} exists and is not a folder")
     return Inputs(scene, args.planner or scene.planner.name, limit or scene.planner.time_limit,
                   seed or scene.planner.seed, out, args.verify, args.plan,
-                  None if args.plan is None else load_plan(args.plan), args.reach)
+                  None if args.plan is None else load_plan(args.plan), args.reach, args.trajectory)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -218,12 +227,17 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         from .execution.verify import verify  # the re-simulator, loaded only for --verify
 
         check = verify(scene, result, inputs.verify, seed)
+    path = None
+    if inputs.trajectory and (result.solved or inputs.given is not None):
+        from .execution.trajectory import trajectory  # loads ruckig, only for --trajectory
+
+        path = trajectory(scene, result)
     reach = None
     if inputs.reach:  # after planning: the map is about the start, whatever the plan
         from .queries.reachable_set import reachable_set
 
         reach = reachable_set(scene, inputs.reach)
-    _write_outputs(out, scene, result, check, reach, write_recording)
+    _write_outputs(out, scene, result, check, reach, path, write_recording)
     if unreachable:
         print(f"plan: unreachable: {unreachable}", file=sys.stderr)
         return 2
@@ -234,7 +248,8 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
             if inputs.given is not None
             else f"solved: {result.contents()}, path length {result.path_length(scene.slider.cf):.3f} m"
                  f"{_first_found(scene, result)}, planning time {result.planning_time_s:.2f} s")
-    print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{f', {scene.name}-reach.png' if reach else ''}")
+    extra = f"{f', {scene.name}.trajectory.csv' if path else ''}{f', {scene.name}-reach.png' if reach else ''}"
+    print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}")
     if check is None:
         return 0
     print("\n".join([*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]))
@@ -262,9 +277,9 @@ def _fresh_folder(base: Path) -> Path:
 
 
 def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None, reach,
-                   write_recording: Callable[..., None]) -> None:
+                   path: Trajectory | None, write_recording: Callable[..., None]) -> None:
     """Write the recording (with ``check``'s ghost and ``reach``'s map, by ``write_recording``),
-    ``reach``'s PNG if given, and the plan JSON into ``out``, creating it if need be. The plan file
+    ``reach``'s PNG and the trajectory ``path``'s CSV if given, and the plan JSON into ``out``, creating it if need be. The plan file
     comes last: where it is, the run wrote everything it had to."""
     try:
         out.mkdir(parents=True, exist_ok=True)
@@ -274,6 +289,8 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
 
             with atomic_path(out / f"{scene.name}-reach.png") as tmp:
                 write_png(reach, scene, str(tmp))
+        if path is not None:
+            path.write_csv(out / f"{scene.name}.trajectory.csv")
         write_atomic(out / f"{scene.name}.json", result.to_json())
     except OSError as err:
         raise _NotWritten(f"cannot write {shown(str(err.filename or out))}: {err.strerror or err}") from None

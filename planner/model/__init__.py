@@ -2,7 +2,8 @@
 :mod:`.yaml_file`), the planner's options and their checks (:mod:`.options`), checked fields and
 their one-line errors (:mod:`.fields`), the moving bodies in the slider frame (:mod:`.bodies`),
 plans and their JSON format (:mod:`.plan_file`), output files written whole or not at all
-(:mod:`.files`), and how a run is stopped from outside (:mod:`.stop`).
+(:mod:`.files`), how a run is stopped from outside (:mod:`.stop`) and the processes it starts
+beside itself (:mod:`.processes`).
 
 Allowed imports: :mod:`mechanics` and this package only. Everything else in :mod:`planner`
 builds on it.

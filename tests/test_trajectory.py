@@ -1,0 +1,211 @@
+"""Pusher trajectories (planner.execution.trajectory), checked from the CSV they write.
+
+Every check recomputes what it needs from the samples and the plan alone: the pusher's corners
+from the scene, the planned path from the plan's twists and transit poses, the time-optimal
+profile of a straight push in closed form. Limits are checked by finite differences, with 2 %
+for sampling.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mechanics import exp_twist, relative_pose, wrap_angle
+from planner import load_scene, plan
+from planner.actions.transit import AIRBORNE, edge_contact_pose
+from planner.cli import main
+from planner.execution.trajectory import trajectory
+from planner.model.bodies import pusher_frame_body
+from planner.model.plan_file import Plan, Push
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENES = ROOT / "scenes"
+HEADER = "t,x,y,theta,vx,vy,omega,z,contact,segment"
+SPEED, ACCEL, JERK, RATE = 0.05, 0.5, 5.0, 100.0
+SLACK = 1.02  # finite differences of samples 10 ms apart
+
+
+@pytest.fixture(scope="module")
+def runs() -> dict:
+    """Each shipped switching scene with its plan and its trajectory's samples, read from the CSV."""
+    out = {}
+    for name in ("junction", "narrow_junction"):  # a walk round; a lift
+        scene = load_scene(SCENES / f"{name}.yaml")
+        result = plan(scene, seed=1)
+        assert result.solved and result.switches
+        text = trajectory(scene, result, SPEED, ACCEL, JERK, RATE).to_csv()
+        assert text.splitlines()[0] == HEADER
+        out[name] = scene, result, np.loadtxt(io.StringIO(text), delimiter=",", skiprows=1)
+    return out
+
+
+def corner_positions(scene, rows: np.ndarray) -> np.ndarray:
+    """World positions (n, corners, 3) of the pusher's outline corners at each sample."""
+    body = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
+    c, s = np.cos(rows[:, 3])[:, None], np.sin(rows[:, 3])[:, None]
+    x = rows[:, 1:2] + c * body[:, 0] - s * body[:, 1]
+    y = rows[:, 2:3] + s * body[:, 0] + c * body[:, 1]
+    return np.stack([x, y, np.broadcast_to(rows[:, 7:8], x.shape)], axis=-1)
+
+
+def corner_velocities(scene, rows: np.ndarray) -> np.ndarray:
+    """Planar corner velocities (n, corners, 2) from the velocity columns."""
+    body = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
+    c, s = np.cos(rows[:, 3])[:, None], np.sin(rows[:, 3])[:, None]
+    w = rows[:, 6:7]
+    vx = rows[:, 4:5] - w * (s * body[:, 0] + c * body[:, 1])
+    vy = rows[:, 5:6] + w * (c * body[:, 0] - s * body[:, 1])
+    return np.stack([vx, vy], axis=-1)
+
+
+@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+def test_corners_respect_the_speed_and_acceleration_limits(runs, name):
+    scene, _, rows = runs[name]
+    p, dt = corner_positions(scene, rows), np.diff(rows[:, 0])
+    v = np.diff(p, axis=0) / dt[:, None, None]
+    assert np.linalg.norm(v, axis=2).max() <= SPEED * SLACK
+    assert np.linalg.norm(corner_velocities(scene, rows), axis=2).max() <= SPEED * (1 + 1e-9)
+    full = (dt[:-1] > 1e-3) & (dt[1:] > 1e-3)  # the last interval may be very short
+    a = np.diff(v, axis=0)[full] / ((dt[:-1] + dt[1:]) / 2)[full, None, None]
+    assert np.linalg.norm(a, axis=2).max() <= ACCEL * SLACK
+
+
+@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+def test_velocity_is_continuous_and_matches_the_poses(runs, name):
+    scene, _, rows = runs[name]
+    v, dt = corner_velocities(scene, rows), np.diff(rows[:, 0])
+    assert (np.linalg.norm(np.diff(v, axis=0), axis=2).max(axis=1) <= ACCEL * dt * SLACK + 1e-12).all()
+    moved = np.diff(corner_positions(scene, rows)[:, :, :2], axis=0)
+    mean = (v[1:] + v[:-1]) / 2 * dt[:, None, None]  # the trapezoid rule, exact to O(jerk dt^3)
+    assert np.abs(moved - mean).max() <= JERK * dt.max() ** 3
+
+
+def _push_error(scene, push, pose: np.ndarray) -> tuple[float, float]:
+    """How far the pusher pose ``pose`` is from the push's planned pusher path, and its parameter s
+    there: s found from the part pose the pusher pose implies."""
+    local = edge_contact_pose(scene.slider, push.edge, np.zeros(3))
+    theta = pose[2] - local[2]
+    c, s = math.cos(theta), math.sin(theta)
+    part = np.array([pose[0] - c * local[0] + s * local[1], pose[1] - s * local[0] - c * local[1], theta])
+    rel = relative_pose(push.start, part)
+    v, w = push.twist[:2], push.twist[2]
+    if abs(w) < 1e-12:
+        candidates = [float(rel[:2] @ v / (v @ v))]
+    else:
+        turn = 2 * math.pi / abs(w)
+        candidates = [rel[2] / w + m * turn for m in range(-3, 4)]
+    best = (math.inf, 0.0)
+    for s_ in candidates:
+        if -1e-9 <= s_ <= push.duration + 1e-9:
+            on = edge_contact_pose(scene.slider, push.edge, exp_twist(push.start, push.twist, s_))
+            best = min(best, (max(math.dist(on[:2], pose[:2]), abs(float(wrap_angle(on[2] - pose[2])))), s_))
+    return best
+
+
+def _transit_place(transit, pose: np.ndarray) -> tuple[float, int, float]:
+    """How far ``pose`` is from the transit's piecewise-linear path, and the piece and its
+    parameter u in [0, 1] where it is nearest."""
+    path = np.asarray(transit.pusher_path)
+    best = (math.inf, -1, 0.0)
+    for k in range(len(path) - 1):
+        step = path[k + 1] - path[k]
+        step[2] = wrap_angle(step[2])
+        d = pose - path[k]
+        d[2] = wrap_angle(d[2])
+        if math.hypot(*step[:2]) > 1e-12:
+            u = float(d[:2] @ step[:2] / (step[:2] @ step[:2]))
+        else:
+            u = float(d[2] / step[2]) if abs(step[2]) > 1e-12 else 0.0
+        u = min(max(u, 0.0), 1.0)
+        gap = pose - (path[k] + u * step)
+        error = max(math.hypot(*gap[:2]), abs(float(wrap_angle(gap[2]))))
+        best = min(best, (error, k, u))
+    return best
+
+
+@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+def test_every_sample_lies_on_the_planned_path(runs, name):
+    scene, result, rows = runs[name]
+    for row in rows[::5]:  # every fifth sample keeps it quick
+        segment = result.segments[int(row[9])]
+        if segment.kind == "push":
+            error, s = _push_error(scene, segment, row[1:4])
+        else:
+            error = _transit_place(segment, row[1:4])[0]
+        assert error <= 1e-9, (row, segment.kind)
+
+
+@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+def test_rests_at_the_ends_and_at_every_change_of_segment(runs, name):
+    scene, result, rows = runs[name]
+    t, segment = rows[:, 0], rows[:, 9].astype(int)
+    assert t[0] == 0.0 and np.allclose(np.diff(t)[:-1], 1 / RATE) and 0 < t[-1] - t[-2] <= 1 / RATE + 1e-12
+    speed = np.linalg.norm(corner_velocities(scene, rows), axis=2).max(axis=1)
+    assert speed[0] == 0.0 and speed[-1] <= 1e-12
+    change = np.flatnonzero(np.diff(segment)) + 1
+    assert len(change) == len(result.segments) - 1  # every segment of these plans has samples
+    # At rest at the change, somewhere between the two samples: neither can be faster than that allows.
+    assert (speed[change] <= ACCEL / RATE * SLACK).all() and (speed[change - 1] <= ACCEL / RATE * SLACK).all()
+    assert (np.diff(segment) >= 0).all() and segment[0] == 0 and segment[-1] == len(result.segments) - 1
+    kinds = np.array([s.kind == "push" for s in result.segments])
+    assert (rows[:, 8] == kinds[segment]).all()
+    first = result.segments[0]
+    assert np.allclose(rows[0, 1:4], edge_contact_pose(scene.slider, first.edge, first.start), atol=1e-12)
+    last = result.segments[-1]
+    assert _push_error(scene, last, rows[-1, 1:4]) == pytest.approx((0.0, last.duration), abs=1e-9)
+
+
+def test_a_lift_is_off_the_table_only_in_its_flight(runs):
+    scene, result, rows = runs["narrow_junction"]
+    up = rows[:, 7] > 0
+    assert rows[:, 7].min() == 0.0 and 0.02 < rows[:, 7].max() <= 0.05 + 1e-12
+    for row, lifted in zip(rows, up):
+        segment = result.segments[int(row[9])]
+        if segment.kind == "push" or segment.mode != "lift":
+            assert not lifted
+            continue
+        _, piece, u = _transit_place(segment, row[1:4])
+        inside = piece == AIRBORNE and 1e-6 < u < 1 - 1e-6
+        assert lifted == inside or not (1e-3 < u < 1 - 1e-3), (row, piece, u)
+    assert up.any()
+
+
+def _rest_to_rest_time(length: float, v: float, a: float, j: float) -> tuple[str, float]:
+    """The time-optimal jerk-limited rest-to-rest time over ``length``, in closed form."""
+    if v >= a * a / j:  # a is reached on the way to v
+        if length >= v * (v / a + a / j):
+            return "v and a reached", length / v + v / a + a / j
+    elif length >= 2 * v * math.sqrt(v / j):
+        return "v reached, a not", length / v + 2 * math.sqrt(v / j)
+    # v is not reached: peak velocity p below v
+    p = a / 2 * (-(a / j) + math.sqrt((a / j) ** 2 + 4 * length / a))
+    if p >= a * a / j:
+        return "a reached, v not", 2 * (p / a + a / j)
+    return "neither reached", 4 * (length / (2 * j)) ** (1 / 3)
+
+
+@pytest.mark.parametrize("length, jerk, case", [(0.3, 10.0, "v and a reached"), (0.1, 2.0, "v reached, a not"),
+                                                (0.004, 50.0, "a reached, v not"),
+                                                (0.005, 5.0, "neither reached")])
+def test_a_straight_push_takes_the_time_optimal_time(length, jerk, case):
+    scene = load_scene(SCENES / "junction.yaml")
+    push = Push.along(0, np.array(scene.slider.edge(0)), [0.0, 1.0, 0.0], length, scene.start)  # 1 m/s per unit s
+    found, expected = _rest_to_rest_time(length, SPEED, ACCEL, jerk)
+    assert found == case
+    run = trajectory(scene, Plan(None, True, "rrt", 1, 0.0, scene.start, scene.goal, [push]), SPEED, ACCEL, jerk)
+    assert run.duration == pytest.approx(expected, rel=0.05)
+
+
+def test_the_command_writes_the_trajectory_of_a_solved_plan_only(tmp_path, capsys):
+    assert main([str(SCENES / "junction.yaml"), "--trajectory", "--out", str(tmp_path / "solved")]) == 0
+    assert "junction.trajectory.csv" in capsys.readouterr().out
+    text = (tmp_path / "solved" / "junction.trajectory.csv").read_text()
+    assert text.splitlines()[0] == HEADER and len(text.splitlines()) > 100
+    sealed = SCENES / "unreachable" / "sealed.yaml"
+    assert main([str(sealed), "--trajectory", "--out", str(tmp_path / "unsolved")]) == 2
+    assert {p.name for p in (tmp_path / "unsolved").iterdir()} == {"sealed.json", "sealed.rrd"}
