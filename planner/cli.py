@@ -227,17 +227,17 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         from .execution.verify import verify  # the re-simulator, loaded only for --verify
 
         check = verify(scene, result, inputs.verify, seed)
-    path = None
+    motion = None
     if inputs.trajectory and (result.solved or inputs.given is not None):
         from .execution.trajectory import trajectory  # loads ruckig, only for --trajectory
 
-        path = trajectory(scene, result)
+        motion = trajectory(scene, result)
     reach = None
     if inputs.reach:  # after planning: the map is about the start, whatever the plan
         from .queries.reachable_set import reachable_set
 
         reach = reachable_set(scene, inputs.reach)
-    _write_outputs(out, scene, result, check, reach, path, write_recording)
+    _write_outputs(out, scene, result, check, reach, motion, write_recording)
     if unreachable:
         print(f"plan: unreachable: {unreachable}", file=sys.stderr)
         return 2
@@ -248,7 +248,7 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
             if inputs.given is not None
             else f"solved: {result.contents()}, path length {result.path_length(scene.slider.cf):.3f} m"
                  f"{_first_found(scene, result)}, planning time {result.planning_time_s:.2f} s")
-    extra = f"{f', {scene.name}.trajectory.csv' if path else ''}{f', {scene.name}-reach.png' if reach else ''}"
+    extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{f', {scene.name}-reach.png' if reach else ''}"
     print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}")
     if check is None:
         return 0
@@ -277,10 +277,10 @@ def _fresh_folder(base: Path) -> Path:
 
 
 def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None, reach,
-                   path: Trajectory | None, write_recording: Callable[..., None]) -> None:
+                   motion: Trajectory | None, write_recording: Callable[..., None]) -> None:
     """Write the recording (with ``check``'s ghost and ``reach``'s map, by ``write_recording``),
-    ``reach``'s PNG and the trajectory ``path``'s CSV if given, and the plan JSON into ``out``, creating it if need be. The plan file
-    comes last: where it is, the run wrote everything it had to."""
+    ``reach``'s PNG and the trajectory ``motion``'s CSV if given, and the plan JSON into ``out``,
+    creating it if need be. The plan file comes last: where it is, the run wrote everything."""
     try:
         out.mkdir(parents=True, exist_ok=True)
         write_recording(out / f"{scene.name}.rrd", scene, result, check, reach)
@@ -289,8 +289,8 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
 
             with atomic_path(out / f"{scene.name}-reach.png") as tmp:
                 write_png(reach, scene, str(tmp))
-        if path is not None:
-            path.write_csv(out / f"{scene.name}.trajectory.csv")
+        if motion is not None:
+            motion.write_csv(out / f"{scene.name}.trajectory.csv")
         write_atomic(out / f"{scene.name}.json", result.to_json())
     except OSError as err:
         raise _NotWritten(f"cannot write {shown(str(err.filename or out))}: {err.strerror or err}") from None
