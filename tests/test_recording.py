@@ -141,6 +141,19 @@ def test_the_file_is_complete_and_has_every_entity(straight):
     assert RrdReader(str(path)).recordings()[0].recording_id == f"straight-{plan.planner}-seed1"
 
 
+def test_the_file_opens_in_its_own_layout(straight):
+    """The viewer takes the recording's blueprint (the world view named after the scene, the
+    pushed edge's view, the summary) only if the file activates it: a default alone is overridden
+    by the layout the viewer makes up as the data arrives first (seen in the web viewer)."""
+    if not RERUN.exists():
+        pytest.skip(f"no rerun CLI next to {sys.executable}")
+    _, _, path = straight
+    shown = subprocess.run([str(RERUN), "rrd", "print", "-vvv", str(path)], capture_output=True, text=True,
+                           timeout=60).stdout
+    assert "make_active: true, make_default: true" in shown
+    assert all(name in shown for name in ("straight", "pushed edge (slider frame)", "summary"))
+
+
 def test_the_slider_moves_from_the_start_to_the_plans_final_pose(straight, turn):
     for scene, plan, path in (straight, turn):
         rows = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")

@@ -306,7 +306,9 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
     # (a full disk) only in its log, and the caller would take a truncated file for a good one.
     stream = rec.binary_stream()
     try:
-        rec.send_blueprint(blueprint, make_active=False, make_default=True)
+        # Active, not only default: in a stream the data comes first, and the viewer would keep the
+        # layout it makes up for it (seen in the web viewer; tests/test_recording.py checks the file).
+        rec.send_blueprint(blueprint, make_active=True, make_default=True)
         _log_static(rec, scene, plan)
         if plan.segments:
             index, times = _log_motion(rec, scene, plan, cache)
