@@ -69,7 +69,7 @@ from ..model.fields import SceneError
 from ..model.files import write_atomic
 from ..model.plan_file import Plan
 from ..model.scene import Scene
-from .trajectory import trajectory
+from .trajectory import Trajectory, trajectory
 
 __all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Simulation", "feet", "mjcf", "needs_mujoco",
            "simulate", "support_centre", "write_mjcf"]
@@ -334,7 +334,7 @@ class Simulation:
                 f"{sum(r.seconds for r in self.runs):.1f} s")
 
 
-def _planned_part(scene: Scene, plan: Plan, motion) -> np.ndarray:
+def _planned_part(scene: Scene, plan: Plan, motion: Trajectory) -> np.ndarray:
     """The planned part pose at each trajectory sample (module docstring)."""
     out = np.empty((len(motion.t), 3))
     pusher = np.column_stack([motion.x, motion.y, motion.theta])
@@ -352,7 +352,7 @@ def _planned_part(scene: Scene, plan: Plan, motion) -> np.ndarray:
     return out
 
 
-def _run(scene: Scene, plan: Plan, motion, planned: np.ndarray, support: Feet, mu: float | None) -> Run:
+def _run(scene: Scene, plan: Plan, motion: Trajectory, planned: np.ndarray, support: Feet, mu: float | None) -> Run:
     import mujoco  # only when simulating: a plan run without --simulate never loads it
 
     clock = time.perf_counter()
