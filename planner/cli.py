@@ -6,6 +6,10 @@ FILE`` verifies a plan file instead of planning, and writes the same outputs (th
 and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
 ``--trajectory`` also writes the pusher's time-parameterised trajectory of a solved (or loaded)
 plan, ``<name>.trajectory.csv`` (:func:`planner.execution.trajectory.trajectory`, default limits).
+``--simulate N`` runs the whole plan (solved or loaded) open-loop in MuJoCo once per support
+distribution (:func:`planner.execution.mujoco_sim.simulate`; ``--sim-mu``, ``--sim-cf-offset``
+change the simulated friction and centre of pressure, ``--mjcf FILE`` writes the first run's model)
+and prints a line per run and a summary line; MuJoCo is imported only then.
 ``--reach N`` (1 or 2) then maps the goal positions reachable from the start in at most N stable
 pushes (:func:`planner.queries.reachable_set.reachable_set`, any heading): ``<name>-reach.png`` in the
 output folder and ``/world/reach`` in the recording.
@@ -13,7 +17,7 @@ output folder and ``/world/reach`` in the recording.
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
 solved or certified unreachable (:func:`planner.certify_unreachable`, checked before planning; one
 line saying why; nothing is verified), 3 verified and some push slipped beyond the
-tolerance, 4 an output could not be written (one line naming the file), 130 Ctrl-C and 143
+tolerance, or a simulated run missed the goal, slipped or collided, 4 an output could not be written (one line naming the file), 130 Ctrl-C and 143
 SIGTERM (:mod:`planner.model.stop`). Output files are written atomically and checked
 (:mod:`planner.model.files`), so an interrupted or failed run leaves no half-written file.
 :func:`read_inputs` checks everything a run reads before anything is computed or written.
@@ -50,6 +54,7 @@ from .search import plan
 
 if TYPE_CHECKING:
     from .execution.trajectory import Trajectory
+    from .execution.mujoco_sim import Simulation
     from .execution.verify import Verification
 
 __all__ = ["Inputs", "main", "read_inputs"]
@@ -61,7 +66,8 @@ exit codes:
   2    not solved within the time limit, or the goal is certified unreachable (one line
        "plan: unreachable: <reason>", at once); the files are still written, "solved": false
        with the reason; or a usage error of these options
-  3    --verify: a push slips in the simulator
+  3    --verify: a push slips in the simulator; --simulate: a run in MuJoCo misses the goal,
+       slips or collides
   4    an output could not be written: one line "plan: error: cannot write <file>: <OS error>";
        no file is left in its place (a file already there is kept as it was)
   130  interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing is written, no process is left
@@ -105,7 +111,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", metavar="DIR", help="output folder (default: logs/<name>-<timestamp>/)")
     p.add_argument("--verify", type=int, metavar="N",
                    help="re-simulate the plan under N support distributions; exit 3 if a push slips")
-    p.add_argument("--plan", metavar="FILE", help="with --verify: verify this plan file instead of planning")
+    p.add_argument("--plan", metavar="FILE",
+                   help="with --verify or --simulate: check this plan file instead of planning")
     p.add_argument("--reach", type=int, metavar="N",
                    help="after planning, map the goal positions reachable from the start in at most N (1 or 2) "
                         "stable pushes, at any heading: <name>-reach.png in the output folder and /world/reach "
@@ -115,6 +122,16 @@ def _parser() -> argparse.ArgumentParser:
                         "velocity sampled at 100 Hz, jerk-limited, at rest wherever the push or edge changes, no "
                         "point of it faster than 0.05 m/s or accelerating more than 0.5 m/s^2 "
                         "(planner.execution.trajectory)")
+    p.add_argument("--simulate", type=int, metavar="N",
+                   help="run the whole plan open-loop in MuJoCo on N support distributions (a grid, extreme and "
+                        "random foot triangles round the CF); exit 3 if a run misses the goal tolerance, slips or "
+                        "collides (needs the mujoco extra: pip install 'stablepush[mujoco]')")
+    p.add_argument("--sim-mu", type=float, metavar="MU",
+                   help="with --simulate: pusher-part friction of the simulation (default: the planned pusher.mu)")
+    p.add_argument("--sim-cf-offset", type=float, nargs=2, metavar=("DX", "DY"),
+                   help="with --simulate: move the supports' centre of pressure by this offset from the CF "
+                        "(slider frame, m)")
+    p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")
     return p
 
 
@@ -132,6 +149,10 @@ class Inputs:
     given: Plan | None  # that file's plan, to verify instead of planning
     reach: int | None = None  # --reach N: pushes of the reachable-set map
     trajectory: bool = False  # --trajectory: write the pusher's trajectory
+    simulate: int | None = None  # --simulate N: runs in MuJoCo
+    sim_mu: float | None = None  # --sim-mu
+    sim_cf_offset: tuple[float, float] = (0.0, 0.0)  # --sim-cf-offset
+    mjcf: Path | None = None  # --mjcf FILE
 
 
 def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
@@ -150,11 +171,16 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     seed = None if args.seed is None else check_seed(args.seed, "--seed")
     if args.verify is not None and args.verify < 1:
         raise SceneError("--verify", f"must be at least 1 distribution, got {args.verify}")
-    if args.plan is not None and args.verify is None:
-        raise SceneError("--plan", "needs --verify N: a plan file is only read to be verified")
+    if args.plan is not None and args.verify is None and args.simulate is None:
+        raise SceneError("--plan", "needs --verify N or --simulate N: a plan file is only read to be checked")
+    _check_simulation(args)
     if args.reach is not None and args.reach not in (1, 2):
         raise SceneError("--reach", f"must be 1 or 2 pushes, got {args.reach}")
     scene = load_scene(args.scene)
+    if args.sim_cf_offset is not None:
+        from .execution.mujoco_sim import support_centre
+
+        support_centre(scene, args.sim_cf_offset)
     if args.regions:  # the search, the one-step check and the recording all read it from the scene
         scene = replace(scene, planner=replace(scene.planner, regions=args.regions))
     if args.transit:  # and verify checks a plan's lifts against it
@@ -170,7 +196,26 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--out", f"{shown(str(out))} exists and is not a folder")
     return Inputs(scene, args.planner or scene.planner.name, limit or scene.planner.time_limit,
                   seed or scene.planner.seed, out, args.verify, args.plan,
-                  None if args.plan is None else load_plan(args.plan), args.reach, args.trajectory)
+                  None if args.plan is None else load_plan(args.plan), args.reach, args.trajectory, args.simulate,
+                  args.sim_mu, tuple(args.sim_cf_offset or (0.0, 0.0)), None if args.mjcf is None else Path(args.mjcf))
+
+
+def _check_simulation(args: argparse.Namespace) -> None:
+    """Refuse the simulation flags without ``--simulate``, bad values, and ``--simulate`` without MuJoCo."""
+    for flag, value in (("--sim-mu", args.sim_mu), ("--sim-cf-offset", args.sim_cf_offset), ("--mjcf", args.mjcf)):
+        if value is not None and args.simulate is None:
+            raise SceneError(flag, "needs --simulate N")
+    if args.simulate is None:
+        return
+    if args.simulate < 1:
+        raise SceneError("--simulate", f"must be at least 1 distribution, got {args.simulate}")
+    if args.sim_mu is not None and not 0 < args.sim_mu < float("inf"):
+        raise SceneError("--sim-mu", f"must be a positive friction coefficient, got {args.sim_mu}")
+    if args.sim_cf_offset is not None and not all(abs(v) < float("inf") for v in args.sim_cf_offset):
+        raise SceneError("--sim-cf-offset", f"must be finite, got {args.sim_cf_offset}")
+    from .execution.mujoco_sim import needs_mujoco
+
+    needs_mujoco()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -232,12 +277,18 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         from .execution.trajectory import trajectory  # loads ruckig, only for --trajectory
 
         motion = trajectory(scene, result)
+    simulation = None
+    if inputs.simulate and (result.solved or inputs.given is not None):
+        from .execution.mujoco_sim import simulate  # MuJoCo is loaded only for --simulate
+
+        simulation = simulate(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset)
     reach = None
     if inputs.reach:  # after planning: the map is about the start, whatever the plan
         from .queries.reachable_set import reachable_set
 
         reach = reachable_set(scene, inputs.reach)
-    _write_outputs(out, scene, result, check, reach, motion, write_recording)
+    _write_outputs(out, scene, result, check, reach, motion, write_recording,
+                   None if simulation is None else (inputs.mjcf, simulation))
     if unreachable:
         print(f"plan: unreachable: {unreachable}", file=sys.stderr)
         return 2
@@ -250,10 +301,11 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
                  f"{_first_found(scene, result)}, planning time {result.planning_time_s:.2f} s")
     extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{f', {scene.name}-reach.png' if reach else ''}"
     print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}")
-    if check is None:
-        return 0
-    print("\n".join([*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]))
-    return 0 if check.passed else 3
+    if check is not None:
+        print("\n".join([*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]))
+    if simulation is not None:
+        print("\n".join([*simulation.lines(), simulation.summary()]))
+    return 0 if (check is None or check.passed) and (simulation is None or simulation.passed) else 3
 
 
 def _first_found(scene: Scene, result: Plan) -> str:
@@ -277,10 +329,12 @@ def _fresh_folder(base: Path) -> Path:
 
 
 def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None, reach,
-                   motion: Trajectory | None, write_recording: Callable[..., None]) -> None:
+                   motion: Trajectory | None, write_recording: Callable[..., None],
+                   model: tuple[Path | None, Simulation] | None = None) -> None:
     """Write the recording (with ``check``'s ghost and ``reach``'s map, by ``write_recording``),
-    ``reach``'s PNG and the trajectory ``motion``'s CSV if given, and the plan JSON into ``out``,
-    creating it if need be. The plan file comes last: where it is, the run wrote everything."""
+    ``reach``'s PNG and the trajectory ``motion``'s CSV if given, the MJCF of ``model``'s first run
+    to its path if one is given, and the plan JSON into ``out``, creating it if need be. The plan
+    file comes last: where it is, the run wrote everything."""
     try:
         out.mkdir(parents=True, exist_ok=True)
         write_recording(out / f"{scene.name}.rrd", scene, result, check, reach)
@@ -291,6 +345,8 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
                 write_png(reach, scene, str(tmp))
         if motion is not None:
             motion.write_csv(out / f"{scene.name}.trajectory.csv")
+        if model is not None and model[0] is not None:
+            model[1].write_mjcf(model[0], scene)
         write_atomic(out / f"{scene.name}.json", result.to_json())
     except OSError as err:
         raise _NotWritten(f"cannot write {shown(str(err.filename or out))}: {err.strerror or err}") from None

@@ -1,7 +1,8 @@
 """Running a plan: re-simulation of its pushes under many support distributions
-(:mod:`.verify`, the independent quasi-static simulator of :mod:`mechanics.quasistatic`), and the
+(:mod:`.verify`, the independent quasi-static simulator of :mod:`mechanics.quasistatic`), the
 pusher's time-parameterised trajectory a robot follows (:mod:`.trajectory`, jerk-limited time laws
-from ruckig).
+from ruckig), and the whole plan run open-loop along that trajectory in MuJoCo
+(:mod:`.mujoco_sim`; MuJoCo is imported only when a simulation runs).
 
 Allowed imports: :mod:`mechanics`, :mod:`planner.model`, :mod:`planner.world`,
 :mod:`planner.actions` and this package (a plan is executed as it is, never searched again).

@@ -1,0 +1,437 @@
+"""Whole plans run open-loop in MuJoCo: the pusher follows the plan's trajectory blindly.
+
+:mod:`.verify` re-simulates each push with the quasi-static mechanics the planner assumes. Here
+the plan meets a physics engine that assumes none of it: the part is a rigid body with mass on
+the table, the pusher a kinematic body driven along :func:`.trajectory.trajectory` (lifted to
+``z`` in a lift's flight), and every segment runs after the last with no correction.
+
+**The model** (:func:`mjcf`). A table (plane), the workspace walls and the obstacles as prisms
+(non-convex ones as their :func:`~planner.model.bodies.convex_pieces`), the part as one body made
+of the convex pieces of its polygon (thin prisms), and the pusher as a prism of the pusher body's
+outline. The part does not lie on its face: it stands on a few small spherical *feet*, each a
+body of its own that slides vertically in the part and weighs its share ``w_i`` of the support
+(``w_i`` the foot's weight in the distribution, :class:`Feet`), so its normal force on the table,
+hence its friction, is exactly that share; the part's centre of mass is the support's centre (the
+CF, or the CF moved by an offset). So each foot set is one support distribution: the barycentric
+weights of three feet round the centre, or a grid's weights moved to put the centre there
+(:func:`mechanics.quasistatic.grid_support`). The part itself moves in the plane only (x, y and
+heading): a free part rocked on its feet under the pusher's moment about the table, and the
+pusher's friction, which with a vertical face also acts vertically, carried some of its weight,
+so the feet's loads, hence the distribution, were not the ones meant. Only the listed contact
+pairs exist: feet-table (friction :data:`TABLE_MU`), pusher-part (the planned
+``scene.pusher.mu``, or ``mu=``) and part-obstacle (to detect collisions).
+
+The pusher is not a mocap body: contact friction sees a mocap body's velocity as zero, so the
+part's friction against a moving pusher would be computed as if it were still (the part slid
+along the face by a fifth of the push). It is a heavy body on x, y, z and heading joints whose
+positions and velocities are set to the trajectory before every step.
+
+**Quasi-static accuracy.** The trajectory is slow (inertial forces a sixth of friction at most),
+so what matters is that sticking contacts stick and sliding ones slide at the friction limit.
+Elliptic friction cones are MuJoCo's exact Coulomb cones (pyramidal ones, linearised, let a
+three-foot part turn by up to 0.02 rad more than planned on the battery), solved by the Newton
+solver to a tolerance of 1e-10 at every step, with ``impratio`` 10: friction ten times stiffer than
+the normal direction, since MuJoCo's soft friction lets a sticking contact creep in proportion to
+its load (on ``scenes/cluttered.yaml`` the pusher crept 1.4 mm along the face in one push at the
+default 1, 0.3 mm at 10; a smaller step did not help, the no-slip post-pass less). The step, :data:`TIMESTEP` (2 ms), is a tenth of the
+contacts' default time constant (0.02 s), and 1 ms or 0.5 ms change the battery's end by less
+than 0.05 mm; stiffer contacts (time constants of a few steps) made the part chatter and slip by
+millimetres. What remains is the soft contact's penetration of the pusher into the part, about
+0.2 mm, which shows as the runs' deviation and "slip"; the slip threshold :data:`SLIP` is five
+times that.
+
+**What is measured** (:class:`Run`), at every trajectory sample: the part's simulated pose against
+its planned one (during a push, the pusher frame's pose times the inverse of the contact pose; in
+a transit, where the part was left), the pusher face's midpoint in the simulated part frame while
+``contact`` is 1 (it should stay where it was when the push began: moving along the edge is
+slip, away from it separation; measured per push, so that an error the part carries from earlier
+pushes is deviation, not slip), and contacts of the part with walls or obstacles.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike
+
+from mechanics import relative_pose, wrap_angle
+from mechanics.quasistatic import grid_support, tripod_supports
+
+from ..actions.transit import edge_contact_pose
+from ..model.bodies import convex_pieces, pusher_frame_body, transform_points
+from ..model.fields import SceneError
+from ..model.files import write_atomic
+from ..model.plan_file import Plan
+from ..model.scene import Scene
+from .trajectory import Trajectory, trajectory
+
+__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Simulation", "feet", "mjcf", "needs_mujoco",
+           "simulate", "support_centre", "write_mjcf"]
+
+#: The one line ``plan --simulate`` prints (after ``plan: error: --simulate: ``) without MuJoCo.
+MISSING = "needs MuJoCo: pip install 'stablepush[mujoco]'"
+#: Part-table friction coefficient: the plan holds for any, so one fixed value.
+TABLE_MU = 0.5
+#: Integration step, s (module docstring, "Quasi-static accuracy").
+TIMESTEP = 0.002
+#: Slip threshold, m: the pusher's face midpoint may move this far in the part frame while pushing.
+SLIP = 0.001
+#: Part geometry: prism thickness, foot radius (m), mass (kg); obstacle and wall height (m).
+THICKNESS, FOOT, MASS, WALL_HEIGHT = 0.004, 0.001, 0.1, 0.03
+#: Mass of the pusher, kg: far heavier than the part, so a step's contact forces barely move it.
+PUSHER_MASS = 1000.0
+#: Time the part is left to settle on its feet before the pusher moves, s.
+SETTLE = 0.1
+#: Feet of a grid distribution (about).
+GRID_FEET = 9
+
+
+@dataclass(frozen=True)
+class Feet:
+    """A support distribution as feet: points (slider frame) and the centre of mass over them."""
+
+    kind: str
+    points: np.ndarray
+    weights: np.ndarray  # summing to 1, their centre the support's
+    centre: np.ndarray
+
+
+def support_centre(scene: Scene, offset: ArrayLike) -> np.ndarray:
+    """The CF moved by ``offset`` (slider frame), or :class:`SceneError` naming ``--sim-cf-offset``
+    if that is not inside the part (no support on it has its centre there)."""
+    centre = scene.slider.cf + np.asarray(offset, dtype=float)
+    if not scene.slider.polygon.contains(shapely.Point(centre)):
+        raise SceneError("--sim-cf-offset", f"puts the centre of pressure {np.round(centre, 6).tolist()} off the part")
+    return centre
+
+
+def feet(scene: Scene, n: int, seed: int = 1, offset: ArrayLike = (0.0, 0.0)) -> list[Feet]:
+    """``n`` foot sets with their centre at the CF plus ``offset`` (slider frame): a grid of
+    about :data:`GRID_FEET` feet, then alternately an extreme tripod (feet on the part's boundary,
+    :func:`mechanics.quasistatic.tripod_supports`) and a random tripod (feet anywhere on the
+    part), both round the centre and drawn from ``seed``.
+
+    >>> from planner import load_scene
+    >>> [f.kind for f in feet(load_scene("scenes/battery.yaml"), 4)]
+    ['grid', 'extreme', 'random', 'extreme']
+    """
+    if n < 1:
+        raise ValueError(f"need at least one distribution, got {n}")
+    footprint, centre = scene.slider.polygon, support_centre(scene, offset)
+    rng = np.random.default_rng(seed)
+    try:
+        grid = grid_support(footprint, GRID_FEET, cf=centre)
+    except ValueError:  # the centre is outside the grid's hull: the extreme tripods still reach it
+        grid = None
+    out = [Feet("grid", grid.points, grid.weights, centre)] if grid is not None else []
+    minx, miny, maxx, maxy = footprint.bounds
+    while len(out) < n:
+        if len(out) % 2:
+            tripod = tripod_supports(footprint, centre, 1, rng)[0]
+            out.append(Feet("extreme", tripod.points, tripod.weights, centre))
+            continue
+        points = rng.uniform([minx, miny], [maxx, maxy], size=(3, 2))
+        a = np.vstack([points.T, np.ones(3)])
+        if (shapely.contains_xy(footprint, points[:, 0], points[:, 1]).all()
+                and abs(np.linalg.det(a)) > 1e-12 * footprint.area
+                and (weights := np.linalg.solve(a, [*centre, 1.0])).min() >= 0.05):
+            out.append(Feet("random", points, weights, centre))
+    return out
+
+
+def _numbers(values: ArrayLike) -> str:
+    return " ".join(f"{v:.17g}" for v in np.ravel(values))
+
+
+def _prism(name: str, outline: np.ndarray, bottom: float, top: float) -> str:
+    """A mesh asset: the convex prism of ``outline`` between heights ``bottom`` and ``top``."""
+    vertices = np.vstack([np.column_stack([outline, np.full(len(outline), z)]) for z in (bottom, top)])
+    return f'<mesh name="{name}" vertex="{_numbers(vertices)}"/>'
+
+
+def _second_moment(pieces: list[np.ndarray], centre: np.ndarray) -> float:
+    """Polar second moment of area of the pieces about ``centre``, divided by their area."""
+    total = area = 0.0
+    for piece in pieces:
+        p = piece - centre
+        for b, c in zip(p[1:-1], p[2:]):  # a fan of triangles from p[0]
+            u, v = b - p[0], c - p[0]
+            piece_area = 0.5 * abs(float(u[0] * v[1] - u[1] * v[0]))
+            total += piece_area / 6 * (p[0] @ p[0] + b @ b + c @ c + p[0] @ b + b @ c + c @ p[0])
+            area += piece_area
+    return total / area
+
+
+def mjcf(scene: Scene, support: Feet, mu: float | None = None) -> str:
+    """The MuJoCo model (MJCF XML) of ``scene`` with the part on ``support``'s feet and pusher-part
+    friction ``mu`` (default: the planned ``scene.pusher.mu``); module docstring, "The model"."""
+    mu = scene.pusher.mu if mu is None else mu
+    assets, world, pairs = [], [], []
+    xmin, ymin, xmax, ymax = scene.workspace
+    span, wall = max(xmax - xmin, ymax - ymin), 0.05
+    walls = [((xmin - wall / 2, (ymin + ymax) / 2), (wall / 2, (ymax - ymin) / 2 + wall)),
+             ((xmax + wall / 2, (ymin + ymax) / 2), (wall / 2, (ymax - ymin) / 2 + wall)),
+             (((xmin + xmax) / 2, ymin - wall / 2), ((xmax - xmin) / 2 + wall, wall / 2)),
+             (((xmin + xmax) / 2, ymax + wall / 2), ((xmax - xmin) / 2 + wall, wall / 2))]
+    blocks = [f"wall{k}" for k in range(4)]
+    for name, (c, h) in zip(blocks, walls):
+        world.append(f'<geom name="{name}" type="box" pos="{_numbers([*c, WALL_HEIGHT / 2])}" '
+                     f'size="{_numbers([*h, WALL_HEIGHT / 2])}" rgba=".5 .5 .5 1"/>')
+    for i, obstacle in enumerate(scene.obstacles):
+        for j, piece in enumerate(convex_pieces(obstacle)):
+            name = f"obstacle{i}_{j}"
+            assets.append(_prism(name, piece, 0.0, WALL_HEIGHT))
+            world.append(f'<geom name="{name}" type="mesh" mesh="{name}" rgba=".6 .3 .3 1"/>')
+            blocks.append(name)
+    pieces = convex_pieces(scene.slider.polygon)
+    part = []
+    for j, piece in enumerate(pieces):
+        assets.append(_prism(f"part{j}", piece, -THICKNESS / 2, THICKNESS / 2))
+        part.append(f'<geom name="part{j}" type="mesh" mesh="part{j}" rgba=".2 .4 .8 1"/>')
+    for k, (p, w) in enumerate(zip(support.points, support.weights)):
+        # A foot slides vertically in the part and carries its share of the weight to the table.
+        part.append(f'<body name="foot{k}" pos="{_numbers([*p, -THICKNESS / 2 - FOOT])}">'
+                    f'<joint name="foot{k}" type="slide" axis="0 0 1"/>'
+                    f'<inertial pos="0 0 0" mass="{w * MASS:.17g}" diaginertia="1e-9 1e-9 1e-9"/>'
+                    f'<geom name="foot{k}" type="sphere" size="{FOOT}" rgba=".1 .1 .1 1"/></body>')
+        pairs.append(f'<pair geom1="table" geom2="foot{k}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>')
+    inertia = MASS * _second_moment(pieces, support.centre)
+    pose = scene.start
+    height = THICKNESS / 2 + 2 * FOOT
+    pusher = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
+    top = THICKNESS + 2 * FOOT + 0.01
+    for j in range(len(pieces)):
+        pairs.append(f'<pair geom1="pusher" geom2="part{j}" condim="3" friction="{mu} {mu} 0 0 0" />')
+        pairs += [f'<pair geom1="{b}" geom2="part{j}" condim="1"/>' for b in blocks]
+    assets.append(_prism("pusher", pusher, 0.0, top))
+    # The part's frame is the slider frame; gravity acts at the support's centre.
+    return f"""<mujoco model={quoteattr(scene.name)}>
+  <option timestep="{TIMESTEP}" cone="elliptic" impratio="10" solver="Newton" iterations="50" tolerance="1e-10"/>
+  <default>
+    <geom contype="0" conaffinity="0"/>
+  </default>
+  <asset>
+    {chr(10).join('    ' + a for a in assets).strip()}
+  </asset>
+  <worldbody>
+    <geom name="table" type="plane" size="{_numbers([span, span, 0.1])}" pos="{_numbers([(xmin + xmax) / 2, (ymin + ymax) / 2, 0])}" rgba=".9 .9 .85 1"/>
+    {chr(10).join('    ' + w for w in world).strip()}
+    <body name="part" pos="0 0 {height:.17g}">
+      <joint name="part_x" type="slide" axis="1 0 0"/>
+      <joint name="part_y" type="slide" axis="0 1 0"/>
+      <joint name="part_theta" type="hinge" axis="0 0 1"/>
+      <inertial pos="{_numbers([*support.centre, 0])}" mass="{MASS}" diaginertia="{_numbers([inertia / 2, inertia / 2, inertia])}"/>
+      {chr(10).join('      ' + g for g in part).strip()}
+    </body>
+    <body name="pusher" gravcomp="1">
+      <joint name="pusher_x" type="slide" axis="1 0 0"/>
+      <joint name="pusher_y" type="slide" axis="0 1 0"/>
+      <joint name="pusher_z" type="slide" axis="0 0 1"/>
+      <joint name="pusher_theta" type="hinge" axis="0 0 1"/>
+      <inertial pos="0 0 0" mass="{PUSHER_MASS}" diaginertia="{_numbers([PUSHER_MASS * 0.01] * 3)}"/>
+      <geom name="pusher" type="mesh" mesh="pusher" rgba=".1 .1 .1 1"/>
+    </body>
+  </worldbody>
+  <contact>
+    {chr(10).join('    ' + p for p in pairs).strip()}
+  </contact>
+  <keyframe>
+    <key name="start" qpos="{_numbers([*pose, *np.zeros(len(support.points) + 4)])}"/>
+  </keyframe>
+</mujoco>
+"""
+
+
+def write_mjcf(path: str | Path, scene: Scene, support: Feet, mu: float | None = None) -> None:
+    """Write :func:`mjcf` to ``path`` atomically (:func:`planner.model.files.write_atomic`)."""
+    write_atomic(path, mjcf(scene, support, mu))
+
+
+def needs_mujoco() -> None:
+    """Import MuJoCo, or raise :class:`SceneError` naming ``--simulate`` with :data:`MISSING`."""
+    try:
+        import mujoco  # noqa: F401 (only checked here)
+    except ImportError:
+        raise SceneError("--simulate", MISSING) from None
+
+
+@dataclass(frozen=True)
+class Run:
+    """One open-loop run of a whole plan on one foot set.
+
+    Attributes
+    ----------
+    feet : Feet
+    goal_error, final_error : (float, float)
+        Final pose against the scene's goal and against the plan's final pose: distance of the
+        slider frame's origin (m) and wrapped angle (rad).
+    deviation : float
+        Largest distance (m) of the part's CF from its planned position over the samples.
+    slip : float
+        Largest distance (m) the pusher's face midpoint moved in the part frame during a push,
+        from where it was when the push began (slip along the edge, or separation).
+    collisions : int
+        Samples at which the part touched a wall or an obstacle.
+    in_goal : bool
+        The final pose is within the scene's tolerance.
+    seconds, simulated : float
+        Wall time of the run and simulated time, s.
+    """
+
+    feet: Feet
+    goal_error: tuple[float, float]
+    final_error: tuple[float, float]
+    deviation: float
+    slip: float
+    collisions: int
+    in_goal: bool
+    seconds: float
+    simulated: float
+
+    @property
+    def passed(self) -> bool:
+        return self.in_goal and self.slip <= SLIP and not self.collisions
+
+    def line(self, k: int, n: int) -> str:
+        faults = ([] if self.in_goal else ["misses the goal"]) + (["SLIPS"] if self.slip > SLIP else []) + (
+            [f"collides ({self.collisions} samples)"] if self.collisions else [])
+        return (f"simulate {k}/{n} ({self.feet.kind}, {len(self.feet.points)} feet): goal error "
+                f"{self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad; from the plan's end "
+                f"{self.final_error[0]:.2e} m, {self.final_error[1]:.2e} rad; path deviation {self.deviation:.2e} m; "
+                f"slip {self.slip:.2e} m; {self.seconds:.1f} s for {self.simulated:.1f} s: "
+                f"{', '.join(faults) if faults else 'ok'}")
+
+
+@dataclass(frozen=True)
+class Simulation:
+    """Outcome of :func:`simulate`: one :class:`Run` per foot set."""
+
+    runs: tuple[Run, ...]
+    mu: float
+
+    @property
+    def passed(self) -> bool:
+        return all(r.passed for r in self.runs)
+
+    def write_mjcf(self, path: str | Path, scene: Scene) -> None:
+        """Write the first run's model (:func:`mjcf`) to ``path`` atomically."""
+        write_mjcf(path, scene, self.runs[0].feet, self.mu)
+
+    def lines(self) -> list[str]:
+        return [r.line(k, len(self.runs)) for k, r in enumerate(self.runs, 1)]
+
+    def summary(self) -> str:
+        worst = max(r.goal_error[0] for r in self.runs)
+        return (f"simulate: {'passed' if self.passed else 'FAILED'}: {sum(r.passed for r in self.runs)}/{len(self.runs)} "
+                f"runs in the goal without slip or collision (MuJoCo, pusher mu {self.mu:g}, table mu {TABLE_MU:g}); "
+                f"worst goal error {worst:.2e} m, worst slip {max(r.slip for r in self.runs):.2e} m, "
+                f"{sum(r.seconds for r in self.runs):.1f} s")
+
+
+def _planned_part(scene: Scene, plan: Plan, motion: Trajectory) -> np.ndarray:
+    """The planned part pose at each trajectory sample (module docstring)."""
+    out = np.empty((len(motion.t), 3))
+    pusher = np.column_stack([motion.x, motion.y, motion.theta])
+    for k, segment in enumerate(plan.segments):
+        rows = motion.segment == k
+        if segment.kind == "transit":
+            out[rows] = segment.start
+            continue
+        local = edge_contact_pose(scene.slider, segment.edge, np.zeros(3))  # pusher frame in the slider frame
+        theta = pusher[rows, 2] - local[2]
+        c, s = np.cos(theta), np.sin(theta)
+        out[rows, 0] = pusher[rows, 0] - (c * local[0] - s * local[1])
+        out[rows, 1] = pusher[rows, 1] - (s * local[0] + c * local[1])
+        out[rows, 2] = wrap_angle(theta)
+    return out
+
+
+def _run(scene: Scene, plan: Plan, motion: Trajectory, planned: np.ndarray, support: Feet, mu: float | None) -> Run:
+    import mujoco  # only when simulating: a plan run without --simulate never loads it
+
+    clock = time.perf_counter()
+    model = mujoco.MjModel.from_xml_string(mjcf(scene, support, mu))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("start").id)
+    own = {model.geom(f"part{j}").id for j in range(len(convex_pieces(scene.slider.polygon)))}
+    part = model.joint("part_x").qposadr[0] + np.arange(3)
+    blocks = {model.geom(i).id for i in range(model.ngeom) if model.geom(i).name.startswith(("wall", "obstacle"))}
+    theta = np.unwrap(motion.theta)
+    # The pusher's joints are set to the trajectory before every step, position and velocity:
+    # its velocity is what the contact's friction sees (a mocap body's would be zero).
+    path = np.column_stack([motion.x, motion.y, motion.z, theta])
+    speed = np.column_stack([motion.vx, motion.vy, np.gradient(motion.z, motion.t) if len(motion.t) > 1
+                             else np.zeros(1), motion.omega])
+    qpos = model.joint("pusher_x").qposadr[0] + np.arange(4)
+    qvel = model.joint("pusher_x").dofadr[0] + np.arange(4)
+    times = motion.t + SETTLE
+    poses = np.empty((len(times), 3))
+    collisions = 0
+    slip, starts = 0.0, {}
+    for i, t in enumerate(np.concatenate([[0.0], times])):
+        while data.time < t - TIMESTEP / 2:
+            u = data.time - SETTLE
+            data.qpos[qpos] = [np.interp(u, motion.t, column) for column in path.T]
+            data.qvel[qvel] = [np.interp(u, motion.t, column) for column in speed.T] if u >= 0 else 0.0
+            mujoco.mj_step(model, data)
+        if i == 0:
+            continue
+        row = i - 1
+        poses[row] = data.qpos[part]
+        contacts = data.contact[:data.ncon]
+        collisions += any(c.dist < 0 and ({c.geom1, c.geom2} & blocks) and ({c.geom1, c.geom2} & own)
+                          for c in contacts)
+        if motion.contact[row]:
+            # The face midpoint in the part frame, against where it was when this push began.
+            face = relative_pose(poses[row], [motion.x[row], motion.y[row], motion.theta[row]])[:2]
+            start = starts.setdefault(int(motion.segment[row]), face)
+            slip = max(slip, float(np.linalg.norm(face - start)))
+    cf = scene.slider.cf[None]
+    gap = np.array([transform_points(cf, p)[0] for p in poses]) - np.array([transform_points(cf, p)[0] for p in planned])
+    end = poses[-1]
+
+    def error(target: np.ndarray) -> tuple[float, float]:
+        return math.hypot(end[0] - target[0], end[1] - target[1]), abs(float(wrap_angle(end[2] - target[2])))
+
+    return Run(support, error(scene.goal), error(plan.final), float(np.linalg.norm(gap, axis=1).max()), slip,
+               collisions, scene.within_tolerance(end), time.perf_counter() - clock, float(motion.duration))
+
+
+def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
+             cf_offset: ArrayLike = (0.0, 0.0)) -> Simulation:
+    """Run ``plan`` open-loop in MuJoCo once per foot set of :func:`feet` (module docstring).
+
+    Parameters
+    ----------
+    scene, plan : Scene, Plan
+        The scene and a plan for it (solved or loaded).
+    n : int
+        Number of support distributions, >= 1.
+    seed : int
+        Seed of the random foot sets.
+    mu : float, optional
+        Pusher-part friction to simulate with; default the planned ``scene.pusher.mu``.
+    cf_offset : (2,) array_like
+        Moves the support's centre of pressure from the CF, slider frame (m).
+
+    Returns
+    -------
+    Simulation
+
+    Raises
+    ------
+    SceneError
+        If MuJoCo is missing (:data:`MISSING`) or the offset centre is off the part.
+    """
+    needs_mujoco()
+    supports = feet(scene, n, seed, cf_offset)
+    motion = trajectory(scene, plan)
+    planned = _planned_part(scene, plan, motion)
+    return Simulation(tuple(_run(scene, plan, motion, planned, s, mu) for s in supports),
+                      scene.pusher.mu if mu is None else mu)
