@@ -56,7 +56,7 @@ import ruckig
 from mechanics import exp_twist, point_velocity, wrap_angle
 
 from ..actions.transit import AIRBORNE, edge_contact_pose
-from ..model.bodies import pusher_frame_body, transform_points
+from ..model.bodies import place, pusher_frame_body, transform_points
 from ..model.files import write_atomic
 from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene
@@ -160,11 +160,9 @@ def _push_piece(scene: Scene, index: int, push: Push, corners: np.ndarray) -> _P
 
     def at(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         part = exp_twist(push.start, twist, s)
-        c, n = np.cos(part[:, 2]), np.sin(part[:, 2])
-        xy = part[:, :2] + np.column_stack([c * local[0] - n * local[1], n * local[0] + c * local[1]])
-        rate = np.column_stack([c * origin[0] - n * origin[1], n * origin[0] + c * origin[1],
-                                np.full(len(s), twist[2])])
-        pose = np.column_stack([xy, wrap_angle(part[:, 2] + local[2])])
+        turned = np.column_stack([np.zeros((len(s), 2)), part[:, 2]])  # the part's heading alone
+        rate = np.column_stack([place(origin[None], turned)[:, 0], np.full(len(s), twist[2])])
+        pose = np.column_stack([place(local[None, :2], part)[:, 0], wrap_angle(part[:, 2] + local[2])])
         return pose, rate, np.zeros(len(s))
 
     return _Piece(index, True, float(push.duration), speed, abs(float(twist[2])) * speed, at)

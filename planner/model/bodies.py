@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import Slider
 
-__all__ = ["body_outline", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at", "transform_points"]
+__all__ = ["body_outline", "place", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at", "transform_points"]
 
 
 def transform_points(points: ArrayLike, pose: ArrayLike) -> np.ndarray:
@@ -26,6 +26,17 @@ def transform_points(points: ArrayLike, pose: ArrayLike) -> np.ndarray:
     x, y, theta = pose
     c, s = np.cos(theta), np.sin(theta)
     return p @ np.array([[c, s], [-s, c]]) + [x, y]
+
+
+def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """Slider-frame ``points`` (shape ``(m, 2)``) placed at each of ``poses`` (shape ``(f, 3)``): ``(f, m, 2)``.
+
+    >>> place(np.array([[1.0, 0.0]]), np.array([[0.0, 1.0, np.pi / 2]])).round(12).tolist()
+    [[[0.0, 2.0]]]
+    """
+    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
+    x, y = points[:, 0], points[:, 1]
+    return np.stack([c * x - s * y + poses[:, :1], s * x + c * y + poses[:, 1:2]], axis=-1)
 
 
 def slider_at(polygon: shapely.Polygon, pose: ArrayLike) -> shapely.Polygon:

@@ -15,12 +15,11 @@ import numpy as np
 from mechanics import Slider, exp_twist
 
 from ..actions.transit import edge_contact_pose, transit_poses
-from ..model.bodies import pusher_frame_body
+from ..model.bodies import place, pusher_frame_body
 from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene
 
-__all__ = ["FRAMES_PER_RADIUS", "MAX_FRAMES", "PATH_POINTS", "Frames", "frames", "history", "place", "pusher_on",
-           "sample"]
+__all__ = ["FRAMES_PER_RADIUS", "MAX_FRAMES", "PATH_POINTS", "Frames", "frames", "history", "pusher_on", "sample"]
 
 #: Animation frames while a body point travels one slider radius (fewer if that exceeds MAX_FRAMES).
 FRAMES_PER_RADIUS = 20
@@ -28,17 +27,6 @@ FRAMES_PER_RADIUS = 20
 MAX_FRAMES = 600
 #: About the most points of the CF path drawn in one frame (it is redrawn every frame).
 PATH_POINTS = 100
-
-
-def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
-    """Slider-frame ``points`` (shape ``(m, 2)``) placed at each of ``poses`` (shape ``(f, 3)``): ``(f, m, 2)``.
-
-    >>> place(np.array([[1.0, 0.0]]), np.array([[0.0, 1.0, np.pi / 2]])).round(12).tolist()
-    [[[0.0, 2.0]]]
-    """
-    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
-    x, y = points[:, 0], points[:, 1]
-    return np.stack([c * x - s * y + poses[:, :1], s * x + c * y + poses[:, 1:2]], axis=-1)
 
 
 class Frames(NamedTuple):

@@ -84,12 +84,12 @@ from mechanics import twist_to_cor
 
 from ..actions.region_cache import RegionCache, edge_region
 from ..actions.transit import transit_pieces
-from ..model.bodies import pusher_frame_body
+from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
 from ..model.plan_file import Plan
 from ..model.scene import Scene
 from .analysis import STATUS, analysis
-from .frames import FRAMES_PER_RADIUS, frames, history, place
+from .frames import FRAMES_PER_RADIUS, frames, history
 
 if TYPE_CHECKING:  # the simulator behind it imports most of scipy: not needed to draw a plan
     from ..queries.reachable_set import ReachableSet

@@ -17,7 +17,7 @@ from ..actions.shortcut import JoinShortcut
 from ..actions.transit import TransitPlanner
 from ..model.plan_file import Plan, Push, Transit
 from ..model.fields import SceneError
-from ..model.options import PLANNERS, check_optimize, check_regions, check_switch_cost, check_transit
+from ..model.options import check_optimize, check_planner, check_regions, check_switch_cost, check_transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 from .goal_region import GoalRegion
@@ -67,9 +67,7 @@ class PlanRequest:
         if switch_cost is not None:
             opts = replace(opts, switch_cost=check_switch_cost(switch_cost, "switch_cost"))
         pusher = scene.pusher if transit is None else replace(scene.pusher, transit=check_transit(transit, "transit"))
-        name = opts.name if planner is None else planner
-        if name not in PLANNERS:
-            raise SceneError("planner", f"must be one of {', '.join(PLANNERS)}, got {name!r}")
+        name = check_planner(opts.name if planner is None else planner, "planner")
         return cls(replace(scene, planner=opts, pusher=pusher), opts.seed if seed is None else seed,
                    float(opts.time_limit if time_limit is None else time_limit), name,
                    opts.optimize if optimize is None else check_optimize(optimize, "optimize"))
