@@ -15,14 +15,16 @@ each calls :func:`die_with_parent` first thing.
 from __future__ import annotations
 
 import ctypes
-import multiprocessing
 import os
 import signal
 import sys
 import threading
-from multiprocessing.context import BaseContext
+from typing import TYPE_CHECKING
 
 from .stop import Terminated, terminate
+
+if TYPE_CHECKING:
+    from multiprocessing.context import BaseContext
 
 __all__ = ["die_with_parent", "fork_context", "threads"]
 
@@ -41,6 +43,8 @@ def threads() -> int:
 def fork_context() -> BaseContext | None:
     """The ``fork`` start method where forking is safe now: the platform has it and this process
     runs one thread; else None (the caller then works in its own process)."""
+    import multiprocessing  # only where a child is started: a warm in-process plan() is spared it
+
     if "fork" not in multiprocessing.get_all_start_methods() or threads() != 1:
         return None
     return multiprocessing.get_context("fork")
