@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from .model.fields import SceneError, shown  # noqa: E402 (after the environment is set)
-from .model.files import atomic_path, write_atomic
+from .model.files import atomic_path, staged_folder, write_atomic
 from .model.plan_file import Plan, load_plan
 from .model.stop import Terminated, raise_on_sigterm
 from .queries.reachability import certify_unreachable
@@ -334,25 +334,36 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
     """Write the recording (with ``check``'s ghost and ``reach``'s map, by ``write_recording``),
     ``reach``'s PNG and the trajectory ``motion``'s CSV if given, the MJCF of ``model``'s first run
     to its path if one is given, and the plan JSON into ``out``, creating it if need be. The plan
-    file comes last: where it is, the run wrote everything."""
+    file comes last: where it is, the run wrote everything. A new ``out`` appears with all of them
+    at once (:func:`~planner.model.files.staged_folder`)."""
+    stage = out
     try:
-        out.mkdir(parents=True, exist_ok=True)
-        write_recording(out / f"{scene.name}.rrd", scene, result, check, reach)
-        if reach is not None:
-            from .queries.reachable_set import write_png
+        with staged_folder(out) as stage:
+            write_recording(stage / f"{scene.name}.rrd", scene, result, check, reach)
+            if reach is not None:
+                from .queries.reachable_set import write_png
 
-            with atomic_path(out / f"{scene.name}-reach.png") as tmp:
-                write_png(reach, scene, str(tmp))
-        if motion is not None:
-            motion.write_csv(out / f"{scene.name}.trajectory.csv")
-        if model is not None and model[0] is not None:
-            model[1].write_mjcf(model[0], scene)
-        write_atomic(out / f"{scene.name}.json", result.to_json())
+                with atomic_path(stage / f"{scene.name}-reach.png") as tmp:
+                    write_png(reach, scene, str(tmp))
+            if motion is not None:
+                motion.write_csv(stage / f"{scene.name}.trajectory.csv")
+            if model is not None and model[0] is not None:
+                model[1].write_mjcf(_within(model[0], out, stage), scene)
+            write_atomic(stage / f"{scene.name}.json", result.to_json())
     except OSError as err:
-        raise _NotWritten(f"cannot write {shown(str(err.filename or out))}: {err.strerror or err}") from None
+        named = str(err.filename or out).replace(str(stage), str(out), 1)  # the file as the user named it
+        raise _NotWritten(f"cannot write {shown(named)}: {err.strerror or err}") from None
     except RecordingFailed as err:
         raise _NotWritten(f"cannot write {shown(str(out / f'{scene.name}.rrd'))}: the recording failed: {err}") from None
 
+
+
+def _within(path: Path, out: Path, stage: Path) -> Path:
+    """``path``, or where it is written while ``out`` is staged if it lies in ``out``."""
+    try:
+        return stage / Path(path).resolve().relative_to(out.resolve())
+    except ValueError:
+        return Path(path)
 
 if __name__ == "__main__":
     sys.exit(main())

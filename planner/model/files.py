@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["atomic_path", "remove_orphans", "write_atomic"]
+__all__ = ["atomic_path", "remove_orphans", "staged_folder", "write_atomic"]
 
 # ".<final name>.<pid>-<random>.tmp": the pid tells an orphan from a file still being written.
 _TEMPORARY = re.compile(r"\..+\.(\d+)-[A-Za-z0-9_]+\.tmp\Z")
@@ -34,7 +35,8 @@ def _alive(pid: int) -> bool:
 
 
 def remove_orphans(folder: str | Path) -> list[Path]:
-    """Remove the temporary files in ``folder`` whose writer is no longer running, and return them.
+    """Remove the temporary files (and staged folders, :func:`staged_folder`) in ``folder`` whose
+    writer is no longer running, and return them.
 
     >>> import tempfile
     >>> folder = Path(tempfile.mkdtemp())
@@ -54,7 +56,7 @@ def remove_orphans(folder: str | Path) -> list[Path]:
         match = _TEMPORARY.match(path.name)
         if match and not _alive(int(match.group(1))):
             try:
-                path.unlink()
+                shutil.rmtree(path) if path.is_dir() and not path.is_symlink() else path.unlink()
                 removed.append(path)
             except OSError:
                 pass  # another run removed it first, or the folder is read-only: nothing to do
@@ -90,9 +92,7 @@ def atomic_path(path: str | Path, check: Callable[[Path], None] | None = None) -
         yield tmp
         if check is not None:
             check(tmp)
-        umask = os.umask(0)
-        os.umask(umask)
-        tmp.chmod(0o666 & ~umask)  # mkstemp makes files private; outputs are ordinary files
+        tmp.chmod(0o666 & ~_umask())  # mkstemp makes files private; outputs are ordinary files
         with open(tmp, "rb") as f:
             os.fsync(f.fileno())
         os.replace(tmp, path)
@@ -125,3 +125,40 @@ def write_atomic(path: str | Path, data: str | bytes) -> None:
     with atomic_path(path, complete) as tmp:
         with open(tmp, "wb") as f:  # a full disk raises here, or when the file is closed
             f.write(raw)
+
+
+@contextmanager
+def staged_folder(folder: str | Path) -> Iterator[Path]:
+    """Yield where to write the files of ``folder`` so that they appear together: a new folder is
+    written as a temporary one beside it and renamed into place when the block succeeds (removed
+    when it fails); an existing folder is written in place, each file atomically.
+
+    >>> import tempfile
+    >>> out = Path(tempfile.mkdtemp()) / "run"
+    >>> with staged_folder(out) as stage:
+    ...     _ = (stage / "plan.json").write_text("{}")
+    ...     print(out.exists(), stage != out)
+    False True
+    >>> sorted(p.name for p in out.iterdir()), sorted(p.name for p in out.parent.iterdir())
+    (['plan.json'], ['run'])
+    """
+    folder = Path(folder)
+    if folder.is_dir():
+        yield folder
+        return
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    remove_orphans(folder.parent)
+    stage = Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{folder.name}.{os.getpid()}-", suffix=".tmp"))
+    try:
+        yield stage
+        stage.chmod(0o777 & ~_umask())  # mkdtemp makes folders private; outputs are ordinary folders
+        os.rename(stage, folder)
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+
+
+def _umask() -> int:
+    umask = os.umask(0)
+    os.umask(umask)
+    return umask
