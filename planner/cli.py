@@ -287,8 +287,7 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         from .queries.reachable_set import reachable_set
 
         reach = reachable_set(scene, inputs.reach)
-    _write_outputs(out, scene, result, check, reach, motion, write_recording,
-                   None if simulation is None else (inputs.mjcf, simulation))
+    _write_outputs(out, scene, result, check, reach, motion, write_recording, simulation, inputs.mjcf)
     if unreachable:
         print(f"plan: unreachable: {unreachable}", file=sys.stderr)
         return 2
@@ -330,16 +329,16 @@ def _fresh_folder(base: Path) -> Path:
 
 def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None, reach,
                    motion: Trajectory | None, write_recording: Callable[..., None],
-                   model: tuple[Path | None, Simulation] | None = None) -> None:
-    """Write the recording (with ``check``'s ghost and ``reach``'s map, by ``write_recording``),
-    ``reach``'s PNG and the trajectory ``motion``'s CSV if given, the MJCF of ``model``'s first run
-    to its path if one is given, and the plan JSON into ``out``, creating it if need be. The plan
-    file comes last: where it is, the run wrote everything. A new ``out`` appears with all of them
-    at once (:func:`~planner.model.files.staged_folder`)."""
+                   simulation: Simulation | None = None, mjcf: Path | None = None) -> None:
+    """Write the recording (with ``check``'s ghost, ``reach``'s map and ``simulation``'s worst run,
+    by ``write_recording``), ``reach``'s PNG and the trajectory ``motion``'s CSV if given, the MJCF
+    of ``simulation``'s first run to ``mjcf`` if both are given, and the plan JSON into ``out``,
+    creating it if need be. The plan file comes last: where it is, the run wrote everything. A new
+    ``out`` appears with all of them at once (:func:`~planner.model.files.staged_folder`)."""
     stage = out
     try:
         with staged_folder(out) as stage:
-            write_recording(stage / f"{scene.name}.rrd", scene, result, check, reach)
+            write_recording(stage / f"{scene.name}.rrd", scene, result, check, reach, simulation)
             if reach is not None:
                 from .queries.reachable_set import write_png
 
@@ -347,8 +346,8 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
                     write_png(reach, scene, str(tmp))
             if motion is not None:
                 motion.write_csv(stage / f"{scene.name}.trajectory.csv")
-            if model is not None and model[0] is not None:
-                model[1].write_mjcf(_within(model[0], out, stage), scene)
+            if simulation is not None and mjcf is not None:
+                simulation.write_mjcf(_within(mjcf, out, stage), scene)
             write_atomic(stage / f"{scene.name}.json", result.to_json())
     except OSError as err:
         named = str(err.filename or out).replace(str(stage), str(out), 1)  # the file as the user named it

@@ -2,20 +2,27 @@
 
 The battery's seed-1 plan (one push) is run on a few support distributions: as planned it ends
 within the scene's tolerance without slip or collision; with far less pusher friction than planned,
-or the centre of pressure moved well off the CF, some run slips or misses the goal (exit 3).
-Without MuJoCo, ``--simulate`` is bad input with one line saying how to install it.
+or the centre of pressure moved well off the CF, some run slips or misses the goal (exit 3), and
+the recording shows that run's part where the printed line says it ended. A lift on its own
+(narrow_junction's) leaves the part where it was. Without MuJoCo, ``--simulate`` is bad input
+with one line saying how to install it.
 """
 
 from __future__ import annotations
 
+import math
+import re
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from planner import load_scene, plan
 from planner.cli import main
+from planner.model.plan_file import Plan
+from test_recording import rrd_rows
 
 ROOT = Path(__file__).resolve().parents[1]
 BATTERY = str(ROOT / "scenes" / "battery.yaml")
@@ -59,13 +66,32 @@ def test_the_battery_plan_reaches_the_goal_in_mujoco(battery):
 
 def test_plan_simulate_passes_and_writes_a_model_mujoco_reads(tmp_path, capsys):
     model = tmp_path / "battery.xml"
-    code = main([BATTERY, "--simulate", "3", "--mjcf", str(model), "--out", str(tmp_path / "out")])
+    code = main([BATTERY, "--simulate", "3", "--mjcf", str(model), "--trajectory", "--out", str(tmp_path / "out")])
     lines = capsys.readouterr().out.splitlines()
     assert code == 0
     assert [line.split(" (")[0] for line in lines[1:4]] == ["simulate 1/3", "simulate 2/3", "simulate 3/3"]
     assert lines[4].startswith("simulate: passed: 3/3 runs")
     loaded = mujoco.MjModel.from_xml_path(str(model))
-    assert loaded.nkey == 1 and loaded.body("part").id > 0 and loaded.body("pusher").id > 0
+    assert loaded.body("part").id > 0 and loaded.body("pusher").id > 0
+    # Keyframes along the run: the pusher where the trajectory has it at the key's time.
+    csv = np.loadtxt(tmp_path / "out" / "battery.trajectory.csv", delimiter=",", skiprows=1)
+    assert loaded.nkey == math.ceil(csv[-1, 0]) + 1 and loaded.key("start").time[0] == 0.0
+    pusher = loaded.joint("pusher_x").qposadr[0] + np.array([0, 1, 2, 3])
+    for k in range(loaded.nkey):
+        time, qpos = loaded.key(k).time[0], loaded.key(k).qpos
+        row = csv[np.argmin(np.abs(csv[:, 0] - time))]
+        assert abs(row[0] - time) < 1e-9 and np.allclose(qpos[pusher], row[[1, 2, 7, 3]], atol=1e-9)
+
+
+def pose_of(strip: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """The rigid pose that puts the part's ``vertices`` on the closed outline ``strip`` (least squares)."""
+    drawn = np.asarray(strip, dtype=float)[:-1]
+    a, b = vertices - vertices.mean(axis=0), drawn - drawn.mean(axis=0)
+    theta = np.arctan2((a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum(), (a * b).sum())
+    c, s = np.cos(theta), np.sin(theta)
+    origin = drawn.mean(axis=0) - np.array([[c, -s], [s, c]]) @ vertices.mean(axis=0)
+    assert np.abs(drawn - (origin + vertices @ np.array([[c, s], [-s, c]]))).max() < 1e-6  # a rigid copy (rerun keeps float32)
+    return np.array([*origin, theta])
 
 
 @pytest.mark.parametrize("flags", [["--sim-mu", "0.01"], ["--sim-cf-offset", "0", "-0.012"]],
@@ -76,6 +102,35 @@ def test_a_plan_simulated_outside_its_assumptions_fails(tmp_path, capsys, flags)
     assert code == 3
     assert "simulate: FAILED" in out and ("SLIPS" in out or "misses the goal" in out)
     assert (tmp_path / "out" / "battery.json").is_file()
+    # The recording shows the run straying farthest, ending where its line says it ended.
+    runs = [(float(d), float(e)) for e, d in re.findall(r"from the plan's end ([\d.e+-]+) m.*?path deviation ([\d.e+-]+) m",
+                                                      out)]
+    _, ended = max(runs)
+    rrd = tmp_path / "out" / "battery.rrd"
+    shown = [strip for _, (strip,) in rrd_rows(rrd, "/world/simulated", "LineStrips2D:strips", "step")]
+    planned = [strip for _, (strip,) in rrd_rows(rrd, "/world/slider", "LineStrips2D:strips", "step")]
+    assert len(shown) == len(planned) > 2
+    vertices = load_scene(BATTERY).slider.vertices
+    start, first = pose_of(planned[0], vertices), pose_of(shown[0], vertices)
+    assert np.abs(first - start).max() < 1e-3  # both start at the start: the part settled on its feet
+    gap = np.linalg.norm(pose_of(shown[-1], vertices)[:2] - pose_of(planned[-1], vertices)[:2])
+    assert gap == pytest.approx(ended, rel=0.01)
+    (_, summary), = rrd_rows(rrd, "/log/simulate", "TextLog:text")
+    assert summary[0].startswith("simulate: FAILED")
+
+
+def test_a_lift_alone_leaves_the_part_where_it_is():
+    """The pusher rises straight off the part and lands beside it: the part does not move. (Rising
+    while turning once swung the face's ends into it: 1.7 mm and 1.5 degrees.)"""
+    from planner.execution.mujoco_sim import simulate
+
+    scene = load_scene(ROOT / "scenes" / "narrow_junction.yaml")
+    result = plan(scene, seed=1)
+    lift = next(s for s in result.segments if s.kind == "transit" and s.mode == "lift")
+    alone = Plan(None, True, "rrt", 1, 0.0, lift.pose, lift.pose, [lift])
+    (run,) = simulate(scene, alone, n=1).runs
+    assert run.collisions == 0 and run.final_error[0] < 5e-5 and run.final_error[1] < 1e-3
+    assert run.deviation < 5e-5
 
 
 @pytest.mark.parametrize("argv, field", [(["--sim-mu", "0.5"], "--sim-mu"), (["--simulate", "0"], "--simulate"),

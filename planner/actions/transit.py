@@ -39,8 +39,8 @@ from ..model.plan_file import Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
-__all__ = ["AIRBORNE", "ARC_STEP", "TransitPlanner", "contact_pose", "edge_contact_pose", "path_duration", "standoff",
-           "transit_pieces", "transit_poses"]
+__all__ = ["AIRBORNE", "ARC_STEP", "TransitPlanner", "contact_pose", "edge_contact_pose", "path_duration", "piece_times",
+           "standoff", "transit_pieces", "transit_poses"]
 
 #: Largest turn of the pusher between two poses of a walk round a corner of the part.
 ARC_STEP = math.radians(10.0)
@@ -61,6 +61,16 @@ def _piece_times(step: np.ndarray, reach: float) -> np.ndarray:
     return np.hypot(step[:, 0], step[:, 1]) + reach * np.abs(step[:, 2])
 
 
+def piece_times(path: ArrayLike, reach: float) -> np.ndarray:
+    """Time of each piece of ``path`` (pusher poses, linear interpolation) with no point of a body
+    of radius ``reach`` about the pusher's origin faster than 1 m/s: ``|dxy| + reach |dtheta|``.
+
+    >>> piece_times([[0, 0, 0], [0.3, 0.4, 0], [0.3, 0.4, np.pi / 2]], 0.02).round(4).tolist()
+    [0.5, 0.0314]
+    """
+    return _piece_times(_steps(np.asarray(path, dtype=float)), reach)
+
+
 def path_duration(path: ArrayLike, reach: float) -> float:
     """Time to follow ``path`` (pusher poses, linear interpolation) with no point of a body of
     radius ``reach`` about the pusher's origin faster than 1 m/s: ``sum |dxy| + reach |dtheta|``.
@@ -68,7 +78,7 @@ def path_duration(path: ArrayLike, reach: float) -> float:
     >>> path_duration([[0, 0, 0], [0.3, 0.4, 0], [0.3, 0.4, np.pi / 2]], 0.02)
     0.5314...
     """
-    return float(np.sum(_piece_times(_steps(np.asarray(path, dtype=float)), reach)))
+    return float(np.sum(piece_times(path, reach)))
 
 
 def contact_pose(part_pose: ArrayLike, point: ArrayLike, normal: ArrayLike, gap: float = 0.0) -> np.ndarray:

@@ -168,9 +168,15 @@ def _second_moment(pieces: list[np.ndarray], centre: np.ndarray) -> float:
     return total / area
 
 
-def mjcf(scene: Scene, support: Feet, mu: float | None = None) -> str:
-    """The MuJoCo model (MJCF XML) of ``scene`` with the part on ``support``'s feet and pusher-part
-    friction ``mu`` (default: the planned ``scene.pusher.mu``); module docstring, "The model"."""
+def mjcf(scene: Scene, support: Feet, mu: float | None = None, start: ArrayLike | None = None,
+         keys: ArrayLike | None = None) -> str:
+    """The MuJoCo model (MJCF XML) of ``scene`` with the part on ``support``'s feet, starting at
+    ``start`` (default: the scene's start), and pusher-part friction ``mu`` (default: the planned
+    ``scene.pusher.mu``); module docstring, "The model".
+
+    ``keys``, rows ``(t, part x, y, theta, pusher x, y, z, theta)``, become keyframes ``t=<t>``
+    (the first named ``start``) so that a viewer can step along a run; without them the one
+    keyframe ``start`` has the part at ``start`` and the pusher at the world origin."""
     mu = scene.pusher.mu if mu is None else mu
     assets, world, pairs = [], [], []
     xmin, ymin, xmax, ymax = scene.workspace
@@ -202,7 +208,7 @@ def mjcf(scene: Scene, support: Feet, mu: float | None = None) -> str:
                     f'<geom name="foot{k}" type="sphere" size="{FOOT}" rgba=".1 .1 .1 1"/></body>')
         pairs.append(f'<pair geom1="table" geom2="foot{k}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>')
     inertia = MASS * _second_moment(pieces, support.centre)
-    pose = scene.start
+    pose = scene.start if start is None else np.asarray(start, dtype=float)
     height = THICKNESS / 2 + 2 * FOOT
     pusher = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
     top = THICKNESS + 2 * FOOT + 0.01
@@ -242,15 +248,25 @@ def mjcf(scene: Scene, support: Feet, mu: float | None = None) -> str:
     {chr(10).join('    ' + p for p in pairs).strip()}
   </contact>
   <keyframe>
-    <key name="start" qpos="{_numbers([*pose, *np.zeros(len(support.points) + 4)])}"/>
+    {chr(10).join('    ' + k for k in _keyframes(pose, len(support.points), keys)).strip()}
   </keyframe>
 </mujoco>
 """
 
 
-def write_mjcf(path: str | Path, scene: Scene, support: Feet, mu: float | None = None) -> None:
+def _keyframes(start: np.ndarray, feet: int, keys: ArrayLike | None) -> list[str]:
+    """``<key>`` elements: the joints in model order are the part's three, one per foot (at rest:
+    0), then the pusher's four."""
+    if keys is None:
+        return [f'<key name="start" qpos="{_numbers([*start, *np.zeros(feet + 4)])}"/>']
+    return [f'<key name="{"start" if k == 0 else f"t={row[0]:.2f}"}" time="{row[0]:.17g}" '
+            f'qpos="{_numbers([*row[1:4], *np.zeros(feet), *row[4:8]])}"/>' for k, row in enumerate(np.asarray(keys))]
+
+
+def write_mjcf(path: str | Path, scene: Scene, support: Feet, mu: float | None = None,
+               start: ArrayLike | None = None, keys: ArrayLike | None = None) -> None:
     """Write :func:`mjcf` to ``path`` atomically (:func:`planner.model.files.write_atomic`)."""
-    write_atomic(path, mjcf(scene, support, mu))
+    write_atomic(path, mjcf(scene, support, mu, start, keys))
 
 
 def needs_mujoco() -> None:
@@ -282,6 +298,11 @@ class Run:
         The final pose is within the scene's tolerance.
     seconds, simulated : float
         Wall time of the run and simulated time, s.
+    poses : (n, 3) ndarray
+        The part's simulated pose at each trajectory sample.
+    segment_deviation, segment_slip : tuple of float
+        ``deviation`` and ``slip`` of each plan segment alone (slip 0 on a transit), so that a
+        failure can be traced to the push or transit where it began.
     """
 
     feet: Feet
@@ -293,6 +314,9 @@ class Run:
     in_goal: bool
     seconds: float
     simulated: float
+    poses: np.ndarray
+    segment_deviation: tuple[float, ...]
+    segment_slip: tuple[float, ...]
 
     @property
     def passed(self) -> bool:
@@ -303,25 +327,47 @@ class Run:
             [f"collides ({self.collisions} samples)"] if self.collisions else [])
         return (f"simulate {k}/{n} ({self.feet.kind}, {len(self.feet.points)} feet): goal error "
                 f"{self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad; from the plan's end "
-                f"{self.final_error[0]:.2e} m, {self.final_error[1]:.2e} rad; path deviation {self.deviation:.2e} m; "
-                f"slip {self.slip:.2e} m; {self.seconds:.1f} s for {self.simulated:.1f} s: "
+                f"{self.final_error[0]:.2e} m, {self.final_error[1]:.2e} rad; path deviation {self.deviation:.2e} m"
+                f"{_where(self.segment_deviation)}; slip {self.slip:.2e} m{_where(self.segment_slip)}; "
+                f"{self.seconds:.1f} s for {self.simulated:.1f} s: "
                 f"{', '.join(faults) if faults else 'ok'}")
+
+
+def _where(by_segment: tuple[float, ...]) -> str:
+    """`` (segment k)``: the plan segment (from 1) where a per-segment measure is largest."""
+    return f" (segment {int(np.argmax(by_segment)) + 1})" if len(by_segment) > 1 and max(by_segment) > 0 else ""
 
 
 @dataclass(frozen=True)
 class Simulation:
-    """Outcome of :func:`simulate`: one :class:`Run` per foot set."""
+    """Outcome of :func:`simulate`: one :class:`Run` per foot set, and the trajectory they followed."""
 
     runs: tuple[Run, ...]
     mu: float
+    motion: Trajectory
+    start: np.ndarray  # the plan's start, where the part is placed
+    planned: np.ndarray  # the planned part pose at each of motion's samples
+
+    #: Seconds between the keyframes :meth:`write_mjcf` writes along the run.
+    KEY_EVERY = 1.0
+
+    @property
+    def worst(self) -> Run:
+        """The run that strays farthest from the planned path (the first of equals)."""
+        return max(self.runs, key=lambda r: r.deviation)
 
     @property
     def passed(self) -> bool:
         return all(r.passed for r in self.runs)
 
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:
-        """Write the first run's model (:func:`mjcf`) to ``path`` atomically."""
-        write_mjcf(path, scene, self.runs[0].feet, self.mu)
+        """Write the first run's model (:func:`mjcf`) to ``path`` atomically, with keyframes of the
+        planned part and the pusher every :attr:`KEY_EVERY` s of the trajectory and at its end
+        (MuJoCo's viewer steps through them)."""
+        m = self.motion
+        rows = np.unique(np.append(np.searchsorted(m.t, np.arange(0.0, m.duration, self.KEY_EVERY)), len(m.t) - 1))
+        keys = np.column_stack([m.t, self.planned, m.x, m.y, m.z, np.unwrap(m.theta)])[rows]
+        write_mjcf(path, scene, self.runs[0].feet, self.mu, self.start, keys)
 
     def lines(self) -> list[str]:
         return [r.line(k, len(self.runs)) for k, r in enumerate(self.runs, 1)]
@@ -356,7 +402,7 @@ def _run(scene: Scene, plan: Plan, motion: Trajectory, planned: np.ndarray, supp
     import mujoco  # only when simulating: a plan run without --simulate never loads it
 
     clock = time.perf_counter()
-    model = mujoco.MjModel.from_xml_string(mjcf(scene, support, mu))
+    model = mujoco.MjModel.from_xml_string(mjcf(scene, support, mu, plan.start))
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, model.key("start").id)
     own = {model.geom(f"part{j}").id for j in range(len(convex_pieces(scene.slider.polygon)))}
@@ -373,7 +419,7 @@ def _run(scene: Scene, plan: Plan, motion: Trajectory, planned: np.ndarray, supp
     times = motion.t + SETTLE
     poses = np.empty((len(times), 3))
     collisions = 0
-    slip, starts = 0.0, {}
+    slips, starts = np.zeros(len(plan.segments)), {}
     for i, t in enumerate(np.concatenate([[0.0], times])):
         while data.time < t - TIMESTEP / 2:
             u = data.time - SETTLE
@@ -390,17 +436,22 @@ def _run(scene: Scene, plan: Plan, motion: Trajectory, planned: np.ndarray, supp
         if motion.contact[row]:
             # The face midpoint in the part frame, against where it was when this push began.
             face = relative_pose(poses[row], [motion.x[row], motion.y[row], motion.theta[row]])[:2]
-            start = starts.setdefault(int(motion.segment[row]), face)
-            slip = max(slip, float(np.linalg.norm(face - start)))
+            k = int(motion.segment[row])
+            start = starts.setdefault(k, face)
+            slips[k] = max(slips[k], float(np.linalg.norm(face - start)))
     cf = scene.slider.cf[None]
-    gap = np.array([transform_points(cf, p)[0] for p in poses]) - np.array([transform_points(cf, p)[0] for p in planned])
+    gap = np.linalg.norm(np.array([transform_points(cf, p)[0] for p in poses])
+                         - np.array([transform_points(cf, p)[0] for p in planned]), axis=1)
+    by_segment = [motion.segment == k for k in range(len(plan.segments))]
     end = poses[-1]
 
     def error(target: np.ndarray) -> tuple[float, float]:
         return math.hypot(end[0] - target[0], end[1] - target[1]), abs(float(wrap_angle(end[2] - target[2])))
 
-    return Run(support, error(scene.goal), error(plan.final), float(np.linalg.norm(gap, axis=1).max()), slip,
-               collisions, scene.within_tolerance(end), time.perf_counter() - clock, float(motion.duration))
+    deviations = tuple(float(gap[rows].max(initial=0.0)) for rows in by_segment)
+    return Run(support, error(scene.goal), error(plan.final), float(gap.max()), float(slips.max(initial=0.0)),
+               collisions, scene.within_tolerance(end), time.perf_counter() - clock, float(motion.duration), poses,
+               deviations, tuple(float(v) for v in slips))
 
 
 def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
@@ -434,4 +485,4 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
     motion = trajectory(scene, plan)
     planned = _planned_part(scene, plan, motion)
     return Simulation(tuple(_run(scene, plan, motion, planned, s, mu) for s in supports),
-                      scene.pusher.mu if mu is None else mu)
+                      scene.pusher.mu if mu is None else mu, motion, np.asarray(plan.start, dtype=float), planned)

@@ -59,6 +59,15 @@ With a :class:`~planner.execution.verify.Verification` (``plan --verify``), also
   hides under ``/world/slider`` wherever the push sticks;
 * ``/log/verify`` -- ``TextLog``, the verification's summary line (``WARN`` when it failed).
 
+With a :class:`~planner.execution.mujoco_sim.Simulation` (``plan --simulate N``), also:
+
+* ``/world/simulated`` -- the slider's outline as MuJoCo moved it in the run that strayed
+  farthest from the planned path (:attr:`~planner.execution.mujoco_sim.Simulation.worst`), at
+  every frame: the trajectory sample at the frame's plan time
+  (:attr:`~planner.execution.trajectory.Trajectory.plan_time`), so the two outlines part where
+  the run leaves the plan and one hides the other while it follows;
+* ``/log/simulate`` -- ``TextLog``, the simulation's summary line (``WARN`` when it failed).
+
 With a reachable-set map (``plan --reach N``; :mod:`planner.queries.reachable_set`), also:
 
 * ``/world/reach`` -- ``Points2D``, static, one point per reachable cell centre, green for one
@@ -91,9 +100,10 @@ from ..model.scene import Scene
 from .analysis import STATUS, analysis
 from .frames import FRAMES_PER_RADIUS, frames, history
 
-if TYPE_CHECKING:  # the simulator behind it imports most of scipy: not needed to draw a plan
-    from ..queries.reachable_set import ReachableSet
+if TYPE_CHECKING:  # the simulators behind them import scipy or MuJoCo: not needed to draw a plan
+    from ..execution.mujoco_sim import Simulation
     from ..execution.verify import Verification
+    from ..queries.reachable_set import ReachableSet
 
 __all__ = ["GHOST_SAMPLES", "write_recording"]
 
@@ -103,7 +113,7 @@ GHOST_SAMPLES = 10
 _THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0.5, 1.0, 2.0, 4.0]))
 _GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
 _SLIDER, _GOAL, _CF = [40, 110, 220], [40, 170, 70], [90, 160, 255]
-_CCW, _CW, _COR, _GHOST = [20, 170, 150], [230, 130, 20], [210, 40, 190], [140, 60, 230]
+_CCW, _CW, _COR, _GHOST, _SIMULATED = [20, 170, 150], [230, 130, 20], [210, 40, 190], [140, 60, 230], [235, 70, 120]
 _LIFTED = [110, 110, 110, 110]  # a faint, see-through grey: the pusher off the table, seen from above
 _STATUS = dict(zip(STATUS, ([40, 170, 70], [230, 190, 40], [200, 50, 50])))
 
@@ -204,6 +214,20 @@ def _log_ghost(rec: rr.RecordingStream, plan: Plan, verification: Verification, 
             static=True)
 
 
+def _log_simulated(rec: rr.RecordingStream, scene: Scene, simulation: Simulation, times: np.ndarray) -> None:
+    """``/world/simulated`` at every frame, and ``/log/simulate`` (module docstring)."""
+    clock = simulation.motion.plan_time
+    samples = np.clip(np.searchsorted(clock, times + 1e-12, side="right") - 1, 0, len(clock) - 1)
+    strips = place(_closed(scene.slider.vertices), simulation.worst.poses[samples])
+    rec.send_columns("world/simulated", indexes=[rr.TimeColumn("step", sequence=np.arange(len(times))),
+                                                 rr.TimeColumn("time", duration=times)],
+                     columns=rr.LineStrips2D.columns(strips=strips))
+    rec.log("world/simulated", rr.LineStrips2D.from_fields(colors=_SIMULATED, radii=_LINE, labels=["MuJoCo"]),
+            static=True)
+    rec.log("log/simulate", rr.TextLog(simulation.summary(), level="INFO" if simulation.passed else "WARN"),
+            static=True)
+
+
 def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan,
                 cache: RegionCache | None) -> tuple[np.ndarray, np.ndarray]:
     """The animated entities; returns the frames' segment indices and times."""
@@ -263,7 +287,8 @@ def _log_reach(rec: rr.RecordingStream, reach: ReachableSet) -> None:
 
 
 def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Verification | None = None,
-                    reach: ReachableSet | None = None, cache: RegionCache | None = None) -> None:
+                    reach: ReachableSet | None = None, simulation: Simulation | None = None,
+                    cache: RegionCache | None = None) -> None:
     """Write a rerun recording of ``plan`` for ``scene`` to ``path`` (layout: module docstring).
 
     The recording is made in memory (footer included) and written with
@@ -282,6 +307,8 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         :func:`planner.verify` of ``plan``: adds the simulated ghost and the verdict.
     reach : ReachableSet, optional
         :func:`planner.queries.reachable_set.reachable_set` from the scene's start: adds ``/world/reach``.
+    simulation : Simulation, optional
+        :func:`planner.execution.mujoco_sim.simulate` of ``plan``: adds the simulated part and the verdict.
     cache : RegionCache, optional
         Where the plan's regions and the analysis are found, or kept once computed (default:
         :func:`~planner.actions.region_cache.default_cache`); :func:`~planner.outputs.analysis.prepare` may have filled it.
@@ -316,6 +343,8 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
                 _log_analysis(rec, scene, plan, cache)
             if verification is not None:
                 _log_ghost(rec, plan, verification, index, times)
+            if simulation is not None:
+                _log_simulated(rec, scene, simulation, times)
         if reach is not None:
             _log_reach(rec, reach)
         data = stream.read(flush=True)  # the whole recording, footer included
