@@ -107,8 +107,8 @@ def test_a_plan_simulated_outside_its_assumptions_fails(tmp_path, capsys, flags)
                                                       out)]
     _, ended = max(runs)
     rrd = tmp_path / "out" / "battery.rrd"
-    shown = [strip for _, (strip,) in rrd_rows(rrd, "/world/simulated", "LineStrips2D:strips", "step")]
-    planned = [strip for _, (strip,) in rrd_rows(rrd, "/world/slider", "LineStrips2D:strips", "step")]
+    shown = [strip for _, (strip,) in rrd_rows(rrd, "/world/simulated", "LineStrips3D:strips", "step")]
+    planned = [strip for _, (strip,) in rrd_rows(rrd, "/world/slider", "LineStrips3D:strips", "step")]
     assert len(shown) == len(planned) > 2
     vertices = load_scene(BATTERY).slider.vertices
     start, first = pose_of(planned[0], vertices), pose_of(shown[0], vertices)

@@ -35,11 +35,10 @@ COR = [0.0, 0.15]  # inside edge 3's CCW stable region (mu = 0.5): a stable turn
 TURN_START = [0.02, -0.03, math.radians(20.0)]
 TURN = math.radians(30.0)
 
-STATIC = {"/log", "/world/workspace", "/world/obstacles", "/world/start", "/world/goal", "/world/tree",
+STATIC = {"/world", "/log", "/world/workspace", "/world/obstacles", "/world/start", "/world/goal", "/world/tree",
           "/world/transits"}
-ANIMATED = {"/world/slider", "/world/pusher", "/world/pusher_lifted", "/world/cf_path", "/world/cor",
-            "/world/stable/ccw", "/world/stable/cw"}
-ANALYSIS = {"/analysis/part", "/analysis/contact", "/analysis/cor", "/analysis/stable/ccw", "/analysis/stable/cw",
+ANIMATED = {"/world/slider", "/world/pusher", "/world/pusher_lifted", "/world/cf_path", "/world/cor"}
+ANALYSIS = {"/analysis", "/analysis/part", "/analysis/contact", "/analysis/cor", "/analysis/stable/ccw", "/analysis/stable/cw",
             "/analysis/exact/ccw", "/analysis/exact/cw"} | {
             f"/analysis/sticking/{side}/{s}" for side in ("ccw", "cw") for s in "PUI"}
 
@@ -93,13 +92,34 @@ def rrd_rows(path: Path, entity: str, component: str, timeline: str | None = Non
         if component not in names:
             continue
         values = column(batch, component)
+        if component in FLAT:  # drawn flat on the table: the plane's points, the height checked
+            values = [flat(v) for v in values]
         index = column(batch, timeline) if timeline in names else [None] * len(values)
         rows += zip(index, values)
     return sorted(rows, key=lambda r: (r[0] is not None, r[0] or 0))
 
 
+#: Components of points in the table's plane, read back as 2-D points.
+FLAT = {"LineStrips3D:strips", "Points3D:positions"}
+
+
+def flat(value):
+    """A (nested) list of 3-D points as 2-D points, checking each lies within 5 mm of the table."""
+    if value and isinstance(value[0], (int, float)):
+        assert len(value) == 3 and abs(value[2]) <= 0.005, value
+        return value[:2]
+    return [flat(v) for v in value]
+
+
 def entities(path: Path) -> set[str]:
     return {chunk.entity_path for chunk in RrdReader(str(path)).store().stream()} - {"/__properties"}
+
+
+def summary_rows(path: Path) -> list[str]:
+    """The summary panel's rows as the viewer lists them: ``/log``'s text on the ``time`` timeline."""
+    rows = rrd_rows(path, "/log", "TextLog:text", "time")
+    assert rows and all(t == 0 for t, _ in rows)  # on the timeline (a static row is not listed)
+    return [text for _, (text,) in rows]
 
 
 def verify(path: Path) -> None:
@@ -154,9 +174,50 @@ def test_the_file_opens_in_its_own_layout(straight):
     assert all(name in shown for name in ("straight", "pushed edge (slider frame)", "summary"))
 
 
+def blueprint_rows(path: Path) -> dict[str, dict[str, list]]:
+    """The recording's blueprint as the viewer reads it: per blueprint entity, its components."""
+    reader = RrdReader(str(path))
+    (store,) = reader.blueprints()
+    out: dict[str, dict[str, list]] = {}
+    for chunk in reader.store(store=store).stream():
+        batch = chunk.to_record_batch()
+        out.setdefault(chunk.entity_path, {}).update(
+            {n: column(batch, n)[-1] for n in batch.schema.names if ":" in n})
+    return out
+
+
+def test_the_viewer_shows_the_plan_from_above_y_up_beside_a_summary(straight):
+    """Both spatial views look straight down with y up (the world one at the workspace's middle),
+    the summary panel lists the plan's rows, and only the moving entities are on the timelines."""
+    scene, plan, path = straight
+    views = blueprint_rows(path)
+    kinds = {v["ViewBlueprint:space_origin"][0]: v["ViewBlueprint:class_identifier"][0]
+             for v in views.values() if "ViewBlueprint:class_identifier" in v}
+    assert kinds == {"/world": "3D", "/analysis": "3D", "/log": "TextLog"}
+    eyes = {e.rsplit("/", 1)[0]: v for e, v in views.items() if e.endswith("/EyeControls3D")}
+    targets = []
+    for view, eye in eyes.items():
+        (up,), (target,), (position,) = (eye[f"EyeControls3D:{k}"] for k in ("eye_up", "look_target", "position"))
+        assert up == [0.0, 1.0, 0.0] and target[2] == 0.0 and position[2] > 0
+        assert position[:2] == pytest.approx(target[:2])  # straight down
+        targets.append(target[:2])
+    assert len(eyes) == 2 and [0.075, 0.0] in [pytest.approx(t, abs=1e-6) for t in targets]  # the workspace's middle
+    # The one push: 0.12 m along +x, every point at the same speed, no switch.
+    assert summary_rows(path) == ["straight: planner rrt, seed 1: solved with 1 push",
+                                  "CF path length 0.1200 m; cost 0.1200 m (length + 0.25 m per switch)",
+                                  "push time 0.1200 s (every point of the pusher at most 1 m/s)",
+                                  f"search tree: {len(plan.tree)} edges"]
+    timelines = {}
+    for chunk in RrdReader(str(path)).store().stream():
+        names = set(chunk.to_record_batch().schema.names)
+        timelines.setdefault(chunk.entity_path, set()).update(names & {"step", "time"})
+    assert all(timelines[e] == {"step", "time"} for e in ANIMATED | {"/log"})
+    assert all(not timelines[e] for e in (STATIC | ANALYSIS) - {"/log"})
+
+
 def test_the_slider_moves_from_the_start_to_the_plans_final_pose(straight, turn):
     for scene, plan, path in (straight, turn):
-        rows = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
+        rows = rrd_rows(path, "/world/slider", "LineStrips3D:strips", "step")
         assert [t for t, _ in rows] == list(range(len(rows)))
         assert 10 <= len(rows) <= frames.MAX_FRAMES
         outlines = np.array([strips[0] for _, strips in rows])
@@ -166,7 +227,7 @@ def test_the_slider_moves_from_the_start_to_the_plans_final_pose(straight, turn)
         np.testing.assert_allclose(first, closed(placed(SLIDER, scene.start)), atol=1e-5)
         np.testing.assert_allclose(last, closed(placed(SLIDER, plan.final)), atol=1e-5)
         np.testing.assert_allclose(last, closed(placed(SLIDER, scene.goal)), atol=1e-5)
-        cf = rrd_rows(path, "/world/cf_path", "LineStrips2D:strips", "step")
+        cf = rrd_rows(path, "/world/cf_path", "LineStrips3D:strips", "step")
         np.testing.assert_allclose(cf[-1][1][0][-1], plan.final[:2], atol=1e-5)  # the CF is the centroid (0, 0)
         assert len(cf[-1][1][0]) == len(rows)
         times = [t for _, t in rrd_rows(path, "/world/slider", "time", "step")]
@@ -176,8 +237,8 @@ def test_the_slider_moves_from_the_start_to_the_plans_final_pose(straight, turn)
 
 def test_the_pusher_stays_behind_the_pushed_edge(straight):
     _, _, path = straight
-    slider = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
-    pusher = rrd_rows(path, "/world/pusher", "LineStrips2D:strips", "step")
+    slider = rrd_rows(path, "/world/slider", "LineStrips3D:strips", "step")
+    pusher = rrd_rows(path, "/world/pusher", "LineStrips3D:strips", "step")
     for (_, part), (_, face) in zip(slider, pusher):
         body, tool = shapely.Polygon(part[0]), shapely.Polygon(face[0])
         assert tool.area == pytest.approx(0.05 * 0.015, rel=1e-4)
@@ -186,33 +247,36 @@ def test_the_pusher_stays_behind_the_pushed_edge(straight):
 
 def test_the_obstacles_and_the_ghosts_match_the_scene(straight):
     scene, _, path = straight
-    (_, strips), = rrd_rows(path, "/world/obstacles", "LineStrips2D:strips")
-    (_, labels), = rrd_rows(path, "/world/obstacles", "LineStrips2D:labels")
+    (_, strips), = rrd_rows(path, "/world/obstacles", "LineStrips3D:strips")
+    (_, labels), = rrd_rows(path, "/world/obstacles", "LineStrips3D:labels")
     assert labels == ["obstacle 0", "obstacle 1"]
     np.testing.assert_allclose(strips[0], closed(TRIANGLE), atol=1e-6)
     w, h = BOX["size"]
     box = placed([[-w / 2, -h / 2], [w / 2, -h / 2], [w / 2, h / 2], [-w / 2, h / 2]],
                  [*BOX["center"], math.radians(BOX["angle"])])
     np.testing.assert_allclose(strips[1], closed(box), atol=1e-6)
-    (_, goal), = rrd_rows(path, "/world/goal", "LineStrips2D:strips")
+    (_, goal), = rrd_rows(path, "/world/goal", "LineStrips3D:strips")
     np.testing.assert_allclose(goal[0], closed(placed(SLIDER, [0.12, 0.0, 0.0])), atol=1e-6)
-    (_, half), = rrd_rows(path, "/world/workspace", "Boxes2D:half_sizes")
-    np.testing.assert_allclose(half, [[0.275, 0.25]], atol=1e-6)
+    (_, workspace), = rrd_rows(path, "/world/workspace", "LineStrips3D:strips")
+    np.testing.assert_allclose(workspace[0], closed([[-0.2, -0.25], [0.35, -0.25], [0.35, 0.25], [-0.2, 0.25]]),
+                               atol=1e-6)
 
 
 def test_the_centre_of_a_turn_stays_put_and_lies_in_its_stable_region(turn, straight):
     _, _, path = turn
-    cors = rrd_rows(path, "/world/cor", "Points2D:positions", "step")
-    assert len(cors) == len(rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step"))
+    cors = rrd_rows(path, "/world/cor", "Points3D:positions", "step")
+    assert len(cors) == len(rrd_rows(path, "/world/slider", "LineStrips3D:strips", "step"))
     centre = placed([COR], TURN_START)[0]
     np.testing.assert_allclose(np.array([c for _, c in cors]).reshape(-1, 2), [centre] * len(cors), atol=1e-5)
-    ccw = rrd_rows(path, "/world/stable/ccw", "LineStrips2D:strips", "step")
-    cw = rrd_rows(path, "/world/stable/cw", "LineStrips2D:strips", "step")
-    for k in (0, len(ccw) // 2, len(ccw) - 1):
-        assert shapely.Polygon(ccw[k][1][0]).contains(shapely.Point(centre))
-        assert not shapely.Polygon(cw[k][1][0]).contains(shapely.Point(centre))
+    # In the slider frame, where the regions are drawn, it is the turn's COR, in the CCW region only.
+    (_, shown), = rrd_rows(path, "/analysis/cor", "Points3D:positions")
+    np.testing.assert_allclose(shown, [COR], atol=1e-6)
+    (_, ccw), = rrd_rows(path, "/analysis/exact/ccw", "LineStrips3D:strips")
+    (_, cw), = rrd_rows(path, "/analysis/exact/cw", "LineStrips3D:strips")
+    assert any(shapely.Polygon(ring).contains(shapely.Point(COR)) for ring in ccw)
+    assert not any(shapely.Polygon(ring).contains(shapely.Point(COR)) for ring in cw)
     # A translation has no centre of rotation: no point is drawn.
-    assert all(c == [] for _, c in rrd_rows(straight[2], "/world/cor", "Points2D:positions", "step"))
+    assert all(c == [] for _, c in rrd_rows(straight[2], "/world/cor", "Points3D:positions", "step"))
 
 
 def test_an_unsolved_plan_records_the_scene_and_the_tree(tmp_path):
@@ -223,10 +287,9 @@ def test_an_unsolved_plan_records_the_scene_and_the_tree(tmp_path):
     recording.write_recording(path, scene, plan)
     verify(path)
     assert entities(path) == STATIC
-    (_, tree), = rrd_rows(path, "/world/tree", "LineStrips2D:strips")
+    (_, tree), = rrd_rows(path, "/world/tree", "LineStrips3D:strips")
     np.testing.assert_allclose(tree, plan.tree, atol=1e-6)
-    (_, text), = rrd_rows(path, "/log", "TextLog:text")
-    assert "not solved: no plan found" in text[0]
+    assert summary_rows(path) == ["stuck: planner rrt, seed 1: not solved: no plan found", "search tree: 2 edges"]
 
 
 def test_the_same_plan_gives_the_same_file(straight, tmp_path):
@@ -252,7 +315,7 @@ def test_a_long_plan_is_capped_and_its_cf_path_thinned(straight, tmp_path):
     plan = planner.Plan(scene.path, True, "rrt", 1, 0.0, scene.start, pose, segments)
     path = tmp_path / "long.rrd"
     recording.write_recording(path, scene, plan)
-    slider = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
+    slider = rrd_rows(path, "/world/slider", "LineStrips3D:strips", "step")
     assert 0.9 * frames.MAX_FRAMES <= len(slider) <= frames.MAX_FRAMES
     times = [t for _, t in rrd_rows(path, "/world/slider", "time", "step")]
     for s, t in zip(segments, np.cumsum([0.0] + durations)):  # each push starts on a frame
@@ -260,7 +323,7 @@ def test_a_long_plan_is_capped_and_its_cf_path_thinned(straight, tmp_path):
         assert abs(times[k] - t * 1e9) <= 1
         np.testing.assert_allclose(slider[k][1][0], closed(placed(SLIDER, s.start)), atol=1e-5)
     np.testing.assert_allclose(slider[-1][1][0], closed(placed(SLIDER, pose)), atol=1e-5)
-    cf = rrd_rows(path, "/world/cf_path", "LineStrips2D:strips", "step")
+    cf = rrd_rows(path, "/world/cf_path", "LineStrips3D:strips", "step")
     assert max(len(strips[0]) for _, strips in cf) <= frames.PATH_POINTS + len(segments) + 1
     drawn = np.array(cf[-1][1][0])
     for s in segments:  # the path keeps its corners
@@ -308,7 +371,7 @@ def test_a_failed_write_keeps_the_old_file_and_leaves_no_temporary(straight, tmp
 
 
 def strips(path: Path, entity: str) -> list[np.ndarray]:
-    (_, value), = rrd_rows(path, entity, "LineStrips2D:strips")
+    (_, value), = rrd_rows(path, entity, "LineStrips3D:strips")
     return [np.asarray(v, dtype=float) for v in value]
 
 
@@ -325,7 +388,7 @@ def test_the_analysis_shows_the_pushed_edge_in_the_slider_frame(turn):
         exact = shapely.union_all([shapely.Polygon(r) for r in strips(path, f"/analysis/exact/{side}")])
         stable = shapely.union_all([shapely.Polygon(r) for r in strips(path, f"/analysis/stable/{side}")])
         assert stable.area > 0 and exact.buffer(1e-9).contains(stable) and exact.area > 1.05 * stable.area
-    (_, points), = rrd_rows(path, "/analysis/cor", "Points2D:positions")
+    (_, points), = rrd_rows(path, "/analysis/cor", "Points3D:positions")
     np.testing.assert_allclose(points, [COR], atol=1e-9)
     centre = shapely.Point(COR)
     def region(entity):
@@ -409,8 +472,8 @@ def test_the_pusher_follows_the_transit_path_and_is_drawn_lifted_in_the_air(swit
     assert len(frames) >= 10
     start = times[frames[0]]
     assert start == pytest.approx(sum(s.duration for s in plan.segments[:k]), abs=1e-9)
-    table = rrd_rows(path, "/world/pusher", "LineStrips2D:strips", "step")
-    air = rrd_rows(path, "/world/pusher_lifted", "LineStrips2D:strips", "step")
+    table = rrd_rows(path, "/world/pusher", "LineStrips3D:strips", "step")
+    air = rrd_rows(path, "/world/pusher_lifted", "LineStrips3D:strips", "step")
     airborne = 0
     for f in frames:
         pose, piece, u = along(transit.pusher_path, reach, times[f] - start)
@@ -430,28 +493,26 @@ def test_the_part_stands_still_and_nothing_is_pushed_during_a_transit(switching)
     times = frame_times(path)
     k, transit = the_transit(plan)
     frames = segment_frames(plan, times, k)
-    slider = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
+    slider = rrd_rows(path, "/world/slider", "LineStrips3D:strips", "step")
     for f in frames:
         np.testing.assert_allclose(slider[f][1][0], closed(placed(scene.slider.vertices, transit.pose)), atol=1e-6)
-    for entity, component in (("/world/cor", "Points2D:positions"), ("/world/stable/ccw", "LineStrips2D:strips"),
-                              ("/world/stable/cw", "LineStrips2D:strips")):
-        rows = rrd_rows(path, entity, component, "step")
-        assert all(rows[f][1] == [] for f in frames)
+    rows = rrd_rows(path, "/world/cor", "Points3D:positions", "step")
+    assert all(rows[f][1] == [] for f in frames)
     # Pushing again, on the transit's new edge: the pusher touches the part.
     after = segment_frames(plan, times, k + 1)[0]
-    (face,) = rrd_rows(path, "/world/pusher", "LineStrips2D:strips", "step")[after][1]
+    (face,) = rrd_rows(path, "/world/pusher", "LineStrips3D:strips", "step")[after][1]
     assert shapely.Polygon(slider[after][1][0]).distance(shapely.Polygon(face)) < 1e-6
 
 
 def test_lifted_frames_are_on_their_own_entity_only_for_a_lift(switching):
     _, plan, path = switching
-    table = rrd_rows(path, "/world/pusher", "LineStrips2D:strips", "step")
-    air = rrd_rows(path, "/world/pusher_lifted", "LineStrips2D:strips", "step")
+    table = rrd_rows(path, "/world/pusher", "LineStrips3D:strips", "step")
+    air = rrd_rows(path, "/world/pusher_lifted", "LineStrips3D:strips", "step")
     assert [t for t, _ in table] == [t for t, _ in air] == list(range(len(table)))
     assert all(len(a) + len(b) == 1 for (_, a), (_, b) in zip(table, air))  # one pusher per frame
     lifts = [s for s in plan.segments if s.kind == "transit" and s.mode == "lift"]
     assert any(b for _, b in air) == bool(lifts)
-    (_, labels), = rrd_rows(path, "/world/pusher_lifted", "LineStrips2D:labels")
+    (_, labels), = rrd_rows(path, "/world/pusher_lifted", "LineStrips3D:labels")
     assert labels == ["lifted"]
 
 
@@ -463,8 +524,7 @@ def test_the_time_line_runs_through_every_segment(switching):
     for k in range(len(plan.segments)):  # each segment starts on a frame
         assert times[segment_frames(plan, times, k)[0]] == pytest.approx(
             sum(s.duration for s in plan.segments[:k]), abs=1e-9)
-    (_, text), = rrd_rows(path, "/log", "TextLog:text")
-    assert f"solved with {plan.pushes} pushes and 1 switch" in text[0]
+    assert f"solved with {plan.pushes} pushes and 1 switch" in summary_rows(path)[0]
 
 
 def test_a_switching_recording_verifies_and_draws_its_transit(switching):
@@ -472,7 +532,7 @@ def test_a_switching_recording_verifies_and_draws_its_transit(switching):
     verify(path)
     assert entities(path) == STATIC | ANIMATED | ANALYSIS
     _, transit = the_transit(plan)
-    (_, labels), = rrd_rows(path, "/world/transits", "LineStrips2D:labels")
+    (_, labels), = rrd_rows(path, "/world/transits", "LineStrips3D:labels")
     drawn = strips(path, "/world/transits")
     xy = transit.pusher_path[:, :2]
     if transit.mode == "lift":
@@ -507,8 +567,8 @@ def test_the_ghost_follows_the_pushes_and_skips_the_transit(switching, tmp_path)
     recording.write_recording(path, scene, plan, PlannedGhost(scene, plan))
     times = frame_times(path)
     k, _ = the_transit(plan)
-    slider = rrd_rows(path, "/world/slider", "LineStrips2D:strips", "step")
-    ghost = rrd_rows(path, "/world/ghost", "LineStrips2D:strips", "step")
+    slider = rrd_rows(path, "/world/slider", "LineStrips3D:strips", "step")
+    ghost = rrd_rows(path, "/world/ghost", "LineStrips3D:strips", "step")
     steps = {step for step, _ in ghost}
     assert not steps & set(segment_frames(plan, times, k))
     for j in range(len(plan.segments)):

@@ -271,8 +271,8 @@ def test_the_recording_shows_the_worst_run_as_a_ghost(tmp_path):
     write_recording(good, scene, plan, verify(scene, plan, n=6))
     rrd_verify(good)
     assert {"/world/ghost", "/log/verify"} <= entities(good)
-    ghost = rrd_rows(good, "/world/ghost", "LineStrips2D:strips", "step")
-    slider = dict(rrd_rows(good, "/world/slider", "LineStrips2D:strips", "step"))
+    ghost = rrd_rows(good, "/world/ghost", "LineStrips3D:strips", "step")
+    slider = dict(rrd_rows(good, "/world/slider", "LineStrips3D:strips", "step"))
     assert len(ghost) <= 10 * plan.pushes + 1
     for frame, strips in ghost:  # a sticking run is the plan itself
         np.testing.assert_allclose(strips[0], slider[frame][0], atol=1e-6)
@@ -283,7 +283,7 @@ def test_the_recording_shows_the_worst_run_as_a_ghost(tmp_path):
     path = tmp_path / "bad.rrd"
     write_recording(path, scene, bad, check)
     rrd_verify(path)
-    (_, last), = [row for row in rrd_rows(path, "/world/ghost", "LineStrips2D:strips", "step")][-1:]
+    (_, last), = [row for row in rrd_rows(path, "/world/ghost", "LineStrips3D:strips", "step")][-1:]
     pose = check.pushes[0].results[check.pushes[0].worst].final_pose
     c, s = np.cos(pose[2]), np.sin(pose[2])
     np.testing.assert_allclose(last[0], outline @ np.array([[c, s], [-s, c]]) + pose[:2], atol=1e-6)

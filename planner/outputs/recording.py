@@ -3,11 +3,15 @@ from :mod:`planner.outputs.frames`, the pushed edge's mechanics from :mod:`plann
 
 :func:`write_recording` writes one ``.rrd`` file (application ``stablepush``, recording id
 ``<scene>-<planner>-seed<seed>``, no wall-clock timeline, so the same plan gives the same file).
-Everything is in world coordinates, metres; outlines are closed ``LineStrips2D``. Entities:
+Everything is in world coordinates, metres, z up; outlines are closed ``LineStrips3D`` in the
+plane of the table (each kind at its own height of a few millimetres, ``_LAYER``, so that the
+part is drawn over its path and everything over the search tree), points ``Points3D``. They are
+3-D so that a view can show them the right way up (y up, as in the scene files and the README's
+figures): rerun's 2-D views draw y downwards. Entities:
 
 Static (no timeline, always visible)
 
-* ``/world/workspace`` -- ``Boxes2D``, the workspace bounds;
+* ``/world/workspace`` -- the workspace bounds, one closed strip;
 * ``/world/obstacles`` -- one strip per obstacle, labelled ``obstacle <k>`` in scene order;
 * ``/world/start``, ``/world/goal`` -- the slider's outline at the start and goal poses (ghosts);
 * ``/world/tree`` -- one strip per search-tree edge (``Plan.tree``; empty after a one-step plan);
@@ -15,7 +19,10 @@ Static (no timeline, always visible)
   labelled ``transit <k>`` in plan order: one strip for a walk round the part, three for a lift,
   whose middle, airborne, strip is labelled ``transit <k> lifted`` and drawn thin and faint in
   the lifted pusher's colour (no strip for a plan without switches);
-* ``/log`` -- ``TextLog``, one summary line (``WARN`` when not solved).
+* ``/log`` -- ``TextLog``, the summary panel's rows (``WARN`` when not solved): what was solved
+  with how many pushes and switches, the CF path length and the cost (length plus
+  ``switch_cost`` per switch), the push and transit times, the search tree's size. They are on
+  both timelines at 0, not static: a text log view lists only rows of its timeline.
 
 Animated, one row per frame on the timelines ``time`` (plan time in seconds, pushes and transits
 alike: no body point moves faster than 1 m/s) and ``step`` (frame index), only for a plan with
@@ -29,12 +36,10 @@ segments. Frames are ``FRAMES_PER_RADIUS`` per slider radius of point travel, at
   middle piece), thin, faint and labelled ``lifted``; no strip on every other frame;
 * ``/world/cf_path`` -- the path of the centre of friction so far (thinned to about
   ``PATH_POINTS`` points, always through the segments' ends);
-* ``/world/cor`` -- ``Points2D``, the current push's centre of rotation (no point for a
-  translation, whose COR is at infinity, nor during a transit);
-* ``/world/stable/ccw``, ``/world/stable/cw`` -- the pushed edge's stable COR regions, clipped to
-  a square of half-side 4 slider radii about the CF and carried with the slider (no strip where
-  a region is empty, nor during a transit: no edge is pushed then, and the regions of the edge
-  being left would suggest one is).
+* ``/world/cor`` -- ``Points3D``, the current push's centre of rotation, labelled ``COR`` (no
+  point for a translation, whose COR is at infinity, nor during a transit). The stable regions
+  it lies in are drawn in the slider frame only (below): carried with the part in the world
+  they were large outlines easily read as obstacles.
 
 The first pushed edge's mechanics (Lynch 1992's figures 11 and 14 for this part), static, in the
 slider frame, for a plan with a push:
@@ -46,7 +51,7 @@ slider frame, for a plan with a push:
 * ``/analysis/sticking/{ccw,cw}/{P,U,I}`` -- the force status of sticking (both ends) for every
   COR of each sense (:func:`mechanics.force_status_regions`, ``ANALYSIS_RAYS`` rays), for every CF
   of the scene's uncertainty disk;
-* ``/analysis/cor`` -- ``Points2D``, the centres of rotation of the plan's pushes on that edge
+* ``/analysis/cor`` -- ``Points3D``, the centres of rotation of the plan's pushes on that edge
   inside the window (pushes on other edges belong with other regions).
 
 All COR regions are clipped to a square of half-side 4 slider radii about the CF.
@@ -57,7 +62,7 @@ With a :class:`~planner.execution.verify.Verification` (``plan --verify``), also
   distribution (the run deviating most from the plan), from the push's planned start, at up to
   ``GHOST_SAMPLES`` frames per push (the viewer holds it in between, through transits too); it
   hides under ``/world/slider`` wherever the push sticks;
-* ``/log/verify`` -- ``TextLog``, the verification's summary line (``WARN`` when it failed).
+* ``/log/verify`` -- ``TextLog``, the verification's summary row (``WARN`` when it failed).
 
 With a :class:`~planner.execution.mujoco_sim.Simulation` (``plan --simulate N``), also:
 
@@ -66,16 +71,17 @@ With a :class:`~planner.execution.mujoco_sim.Simulation` (``plan --simulate N``)
   every frame: the trajectory sample at the frame's plan time
   (:attr:`~planner.execution.trajectory.Trajectory.plan_time`), so the two outlines part where
   the run leaves the plan and one hides the other while it follows;
-* ``/log/simulate`` -- ``TextLog``, the simulation's summary line (``WARN`` when it failed).
+* ``/log/simulate`` -- ``TextLog``, the simulation's summary row (``WARN`` when it failed).
 
 With a reachable-set map (``plan --reach N``; :mod:`planner.queries.reachable_set`), also:
 
-* ``/world/reach`` -- ``Points2D``, static, one point per reachable cell centre, green for one
+* ``/world/reach`` -- ``Points3D``, static, one point per reachable cell centre, green for one
   push and amber for two.
 
 Styles (colours, line widths in UI points) are logged statically on the animated entities. The
-default blueprint shows ``/world`` in a 2-D view bounded by the workspace beside ``/analysis``,
-above the text log.
+default blueprint shows ``/world`` and, beside it, ``/analysis`` each in a 3-D view looking
+straight down (x to the right, y up; the world view framing the workspace), above the summary
+panel, a text log view of ``/log``.
 """
 
 from __future__ import annotations
@@ -91,7 +97,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import twist_to_cor
 
-from ..actions.region_cache import RegionCache, edge_region
+from ..actions.region_cache import RegionCache
 from ..actions.transit import transit_pieces
 from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
@@ -116,6 +122,28 @@ _SLIDER, _GOAL, _CF = [40, 110, 220], [40, 170, 70], [90, 160, 255]
 _CCW, _CW, _COR, _GHOST, _SIMULATED = [20, 170, 150], [230, 130, 20], [210, 40, 190], [140, 60, 230], [235, 70, 120]
 _LIFTED = [110, 110, 110, 110]  # a faint, see-through grey: the pusher off the table, seen from above
 _STATUS = dict(zip(STATUS, ([40, 170, 70], [230, 190, 40], [200, 50, 50])))
+#: Height of the views' eye over the table, in half-widths of what it must show (the viewer's field of view).
+_EYE = 1.45
+#: Heights (m) at which each kind of drawing lies over the table: a view from straight above
+#: sees them flat, and what lies higher is drawn over what lies lower (the part over its path,
+#: everything over the search tree).
+_LAYER = {"map": -0.002, "tree": -0.001, "scene": 0.0, "path": 0.001, "ghost": 0.0015, "part": 0.002,
+          "marker": 0.003}
+
+
+def _z(points: ArrayLike, layer: str = "scene") -> np.ndarray:
+    """2-D points ``(..., 2)`` at the height of ``layer`` (:data:`_LAYER`) in the plane of the table.
+
+    >>> _z([[1.0, 2.0]], "part").tolist()
+    [[1.0, 2.0, 0.002]]
+    """
+    p = np.asarray(points, dtype=float)
+    return np.concatenate([p, np.full((*p.shape[:-1], 1), _LAYER[layer])], axis=-1)
+
+
+def _zs(strips, layer: str = "scene") -> list[np.ndarray]:
+    """:func:`_z` of each strip of a list (strips may differ in length)."""
+    return [_z(strip, layer) for strip in strips]
 
 
 def _closed(points: ArrayLike) -> np.ndarray:
@@ -124,39 +152,52 @@ def _closed(points: ArrayLike) -> np.ndarray:
     return np.vstack([p, p[:1]])
 
 
-def _summary(scene: Scene, plan: Plan) -> str:
-    """One line; no planning time, so that the same plan always gives the same recording."""
+def _summary(scene: Scene, plan: Plan) -> list[str]:
+    """The summary panel's rows; no planning time, so that the same plan always gives the same
+    recording."""
     head = f"{scene.name}: planner {plan.planner}, seed {plan.seed}"
+    tree = f"search tree: {len(plan.tree)} edges"
     if not plan.solved:
-        return f"{head}: not solved: {plan.reason}; {len(plan.tree)} tree edges"
-    made = plan.contents(" and ")
-    timing = f"push time {sum(s.duration for s in plan.segments if s.kind == 'push'):.4f} s"
+        return [f"{head}: not solved: {plan.reason}", tree]
+    length = plan.path_length(scene.slider.cf)
+    cost = length + plan.switches * scene.planner.switch_cost
+    times = [f"push time {sum(s.duration for s in plan.segments if s.kind == 'push'):.4f} s"]
     if plan.switches:
-        timing += f", transit time {sum(s.duration for s in plan.segments if s.kind == 'transit'):.4f} s"
-    return (f"{head}: solved with {made}, CF path {plan.path_length(scene.slider.cf):.4f} m, {timing}; "
-            f"{len(plan.tree)} tree edges")
+        times.append(f"transit time {sum(s.duration for s in plan.segments if s.kind == 'transit'):.4f} s")
+    return [f"{head}: solved with {plan.contents(' and ')}",
+            f"CF path length {length:.4f} m; cost {cost:.4f} m (length + {scene.planner.switch_cost:g} m per switch)",
+            f"{', '.join(times)} (every point of the pusher at most 1 m/s)", tree]
+
+
+def _log_text(rec: rr.RecordingStream, entity: str, lines: list[str], level: str) -> None:
+    """Rows of the summary panel, at the start of both timelines: a text log shows the rows of
+    its timeline up to the current time, and none logged without one (static)."""
+    zero = [0] * len(lines)
+    rec.send_columns(entity, indexes=[rr.TimeColumn("step", sequence=zero), rr.TimeColumn("time", duration=zero)],
+                     columns=rr.TextLog.columns(text=lines, level=[level] * len(lines)))
 
 
 def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
     xmin, ymin, xmax, ymax = scene.workspace
     outline = _closed(scene.slider.vertices)
     ghosts = place(outline, np.array([scene.start, scene.goal]))
-    rec.log("world/workspace", rr.Boxes2D(mins=[xmin, ymin], sizes=[xmax - xmin, ymax - ymin],
-                                          colors=_DARK, radii=_LINE), static=True)
-    rec.log("world/obstacles", rr.LineStrips2D(
-        [_closed(o.exterior.coords[:-1]) for o in scene.obstacles], colors=_RED, radii=_BOLD,
+    rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+    box = _closed([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax]])
+    rec.log("world/workspace", rr.LineStrips3D([_z(box)], colors=_DARK, radii=_LINE), static=True)
+    rec.log("world/obstacles", rr.LineStrips3D(
+        _zs(_closed(o.exterior.coords[:-1]) for o in scene.obstacles), colors=_RED, radii=_BOLD,
         labels=[f"obstacle {k}" for k in range(len(scene.obstacles))]), static=True)
-    rec.log("world/start", rr.LineStrips2D(ghosts[:1], colors=_GREY, radii=_LINE, labels="start"), static=True)
-    rec.log("world/goal", rr.LineStrips2D(ghosts[1:], colors=_GOAL, radii=_LINE, labels="goal"), static=True)
-    rec.log("world/tree", rr.LineStrips2D(np.asarray(plan.tree, dtype=float).reshape(-1, 2, 2),
-                                          colors=_GREY, radii=_THIN, draw_order=-1.0), static=True)
+    rec.log("world/start", rr.LineStrips3D(_z(ghosts[:1]), colors=_GREY, radii=_LINE, labels="start"), static=True)
+    rec.log("world/goal", rr.LineStrips3D(_z(ghosts[1:]), colors=_GOAL, radii=_LINE, labels="goal"), static=True)
+    rec.log("world/tree", rr.LineStrips3D(_z(np.asarray(plan.tree, dtype=float).reshape(-1, 2, 2), "tree"),
+                                          colors=_GREY, radii=_THIN), static=True)
     pieces = [(k, xy, up) for k, t in enumerate(s for s in plan.segments if s.kind == "transit")
               for xy, up in transit_pieces(t)]
-    rec.log("world/transits", rr.LineStrips2D(
-        [xy for _, xy, _ in pieces], colors=[_LIFTED if up else _DARK for *_, up in pieces],
+    rec.log("world/transits", rr.LineStrips3D(
+        [_z(xy, "path") for _, xy, _ in pieces], colors=[_LIFTED if up else _DARK for *_, up in pieces],
         radii=[_THIN if up else _LINE for *_, up in pieces],
         labels=[f"transit {k + 1}{' lifted' if up else ''}" for k, _, up in pieces]), static=True)
-    rec.log("log", rr.TextLog(_summary(scene, plan), level="INFO" if plan.solved else "WARN"), static=True)
+    _log_text(rec, "log", _summary(scene, plan), "INFO" if plan.solved else "WARN")
 
 
 def _outline(region: shapely.Geometry) -> np.ndarray | None:
@@ -175,20 +216,24 @@ def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan, cache: Regi
     pushes = [s for s in plan.segments if s.kind == "push"]
     edge = pushes[0].edge
     window, contact, polygons = analysis(scene, edge, cache)
-    rec.log("analysis/part", rr.LineStrips2D([_closed(scene.slider.vertices)], colors=_SLIDER, radii=_BOLD),
-            static=True)
-    rec.log("analysis/contact", rr.LineStrips2D([contact], colors=_DARK, radii=_BOLD), static=True)
+    rec.log("analysis", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+    rec.log("analysis/part", rr.LineStrips3D([_z(_closed(scene.slider.vertices), "part")], colors=_SLIDER,
+                                             radii=_BOLD), static=True)
+    rec.log("analysis/contact", rr.LineStrips3D([_z(contact, "part")], colors=_DARK, radii=_BOLD), static=True)
     for name, width in (("stable", _BOLD), ("exact", _LINE)):
         for side, colour in (("ccw", _CCW), ("cw", _CW)):
             rings = _rings(polygons[name][1 if side == "ccw" else -1])
-            rec.log(f"analysis/{name}/{side}", rr.LineStrips2D(rings, colors=colour, radii=width), static=True)
+            rec.log(f"analysis/{name}/{side}", rr.LineStrips3D(_zs(rings, "path"), colors=colour, radii=width),
+                    static=True)
     for side, sense in (("ccw", 1), ("cw", -1)):
         for label, colour in _STATUS.items():
             rings = _rings(polygons[label][sense])
-            rec.log(f"analysis/sticking/{side}/{label}", rr.LineStrips2D(rings, colors=colour, radii=_THIN), static=True)
+            rec.log(f"analysis/sticking/{side}/{label}", rr.LineStrips3D(_zs(rings), colors=colour, radii=_THIN),
+                    static=True)
     cors = [c for c, sense in map(twist_to_cor, (s.twist for s in pushes if s.edge == edge)) if sense != 0]
     inside = [c for c in cors if shapely.box(*window).contains(shapely.Point(c))]  # far ones would zoom the view out
-    rec.log("analysis/cor", rr.Points2D(inside or np.zeros((0, 2)), colors=_COR, radii=_DOT), static=True)
+    rec.log("analysis/cor", rr.Points3D(_z(inside or np.zeros((0, 2)), "marker"), colors=_COR, radii=_DOT),
+            static=True)
 
 
 def _log_ghost(rec: rr.RecordingStream, plan: Plan, verification: Verification, index: np.ndarray,
@@ -208,10 +253,9 @@ def _log_ghost(rec: rr.RecordingStream, plan: Plan, verification: Verification, 
     outline = _closed(verification.scene.slider.vertices)
     rec.send_columns("world/ghost", indexes=[rr.TimeColumn("step", sequence=frames),
                                              rr.TimeColumn("time", duration=times[frames])],
-                     columns=rr.LineStrips2D.columns(strips=place(outline, np.concatenate(poses))))
-    rec.log("world/ghost", rr.LineStrips2D.from_fields(colors=_GHOST, radii=_LINE), static=True)
-    rec.log("log/verify", rr.TextLog(verification.summary(), level="INFO" if verification.passed else "WARN"),
-            static=True)
+                     columns=rr.LineStrips3D.columns(strips=_z(place(outline, np.concatenate(poses)), "ghost")))
+    rec.log("world/ghost", rr.LineStrips3D.from_fields(colors=_GHOST, radii=_LINE), static=True)
+    _log_text(rec, "log/verify", [verification.summary()], "INFO" if verification.passed else "WARN")
 
 
 def _log_simulated(rec: rr.RecordingStream, scene: Scene, simulation: Simulation, times: np.ndarray) -> None:
@@ -221,58 +265,42 @@ def _log_simulated(rec: rr.RecordingStream, scene: Scene, simulation: Simulation
     strips = place(_closed(scene.slider.vertices), simulation.worst.poses[samples])
     rec.send_columns("world/simulated", indexes=[rr.TimeColumn("step", sequence=np.arange(len(times))),
                                                  rr.TimeColumn("time", duration=times)],
-                     columns=rr.LineStrips2D.columns(strips=strips))
-    rec.log("world/simulated", rr.LineStrips2D.from_fields(colors=_SIMULATED, radii=_LINE, labels=["MuJoCo"]),
+                     columns=rr.LineStrips3D.columns(strips=_z(strips, "ghost")))
+    rec.log("world/simulated", rr.LineStrips3D.from_fields(colors=_SIMULATED, radii=_LINE, labels=["MuJoCo"]),
             static=True)
-    rec.log("log/simulate", rr.TextLog(simulation.summary(), level="INFO" if simulation.passed else "WARN"),
-            static=True)
+    _log_text(rec, "log/simulate", [simulation.summary()], "INFO" if simulation.passed else "WARN")
 
 
-def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan,
-                cache: RegionCache | None) -> tuple[np.ndarray, np.ndarray]:
+def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
     """The animated entities; returns the frames' segment indices and times."""
     shown = frames(scene, plan, scene.slider.radius / FRAMES_PER_RADIUS)
     index, times, poses = shown.index, shown.times, shown.part
     steps = [rr.TimeColumn("step", sequence=np.arange(len(times))), rr.TimeColumn("time", duration=times)]
     slider = scene.slider
-    window = (*(slider.cf - 4 * slider.radius), *(slider.cf + 4 * slider.radius))
-    # Only the pushed edges' regions: they are cached, the plan used them (others may not be done).
-    p = scene.pusher
-    regions = {e: {sense: _outline(poly) for sense, poly in edge_region(
-        slider, e, p.mu, p.width, scene.planner.regions, scene.cf_uncertainty,
-        cache=cache).cor_polygons(window).items()} for e in {s.edge for s in plan.segments if s.kind == "push"}}
-    # Per frame: the COR and the regions' outlines, none or one each.
+    # Per frame: the current push's COR, none or one (a transit's twist is zero: no COR).
     cor: list[np.ndarray] = []
-    stable: dict[int, list[np.ndarray]] = {1: [], -1: []}
     for k, s in enumerate(plan.segments):
         at = poses[index == k]
-        centre, sense = twist_to_cor(s.twist)  # a transit's twist is zero: no COR
+        centre, sense = twist_to_cor(s.twist)
         cor += list(place(centre[None], at)) if sense != 0 else [np.zeros((0, 2))] * len(at)
-        outlines = regions[s.edge] if s.kind == "push" else dict.fromkeys(stable)  # nothing is pushed
-        for side, outline in outlines.items():
-            empty = [np.zeros((0, 0, 2))] * len(at)
-            stable[side] += empty if outline is None else list(place(outline, at)[:, None])
 
     def send(entity: str, columns: rr.ComponentColumnList, lengths: ArrayLike | None = None) -> None:
         """One row per frame; ``lengths`` (how many items each frame has) splits ``columns`` into them."""
         rec.send_columns(entity, indexes=steps, columns=columns if lengths is None else columns.partition(lengths))
 
-    send("world/slider", rr.LineStrips2D.columns(strips=place(_closed(slider.vertices), poses)))
-    pusher = place(_closed(pusher_frame_body(scene.pusher.width, scene.pusher.depth)), shown.pusher)
+    send("world/slider", rr.LineStrips3D.columns(strips=_z(place(_closed(slider.vertices), poses), "part")))
+    pusher = _z(place(_closed(pusher_frame_body(scene.pusher.width, scene.pusher.depth)), shown.pusher), "part")
     for entity, where in (("world/pusher", ~shown.lifted), ("world/pusher_lifted", shown.lifted)):
-        send(entity, rr.LineStrips2D.columns(strips=pusher[where]), where.astype(int))
-    send("world/cf_path", rr.LineStrips2D.columns(strips=history(place(slider.cf[None], poses)[:, 0], index)))
-    send("world/cor", rr.Points2D.columns(positions=np.concatenate(cor)), [len(c) for c in cor])
-    for name, side in (("ccw", 1), ("cw", -1)):
-        send(f"world/stable/{name}", rr.LineStrips2D.columns(strips=[o for row in stable[side] for o in row]),
-             [len(row) for row in stable[side]])
+        send(entity, rr.LineStrips3D.columns(strips=pusher[where]), where.astype(int))
+    send("world/cf_path", rr.LineStrips3D.columns(strips=_zs(history(place(slider.cf[None], poses)[:, 0], index),
+                                                                "path")))
+    send("world/cor", rr.Points3D.columns(positions=_z(np.concatenate(cor), "marker")), [len(c) for c in cor])
     for entity, color, radius in (("world/slider", _SLIDER, _BOLD), ("world/pusher", _DARK, _BOLD),
-                                  ("world/cf_path", _CF, _LINE), ("world/stable/ccw", _CCW, _LINE),
-                                  ("world/stable/cw", _CW, _LINE)):
-        rec.log(entity, rr.LineStrips2D.from_fields(colors=color, radii=radius), static=True)
-    rec.log("world/pusher_lifted", rr.LineStrips2D.from_fields(colors=_LIFTED, radii=_THIN, labels=["lifted"]),
+                                  ("world/cf_path", _CF, _LINE)):
+        rec.log(entity, rr.LineStrips3D.from_fields(colors=color, radii=radius), static=True)
+    rec.log("world/pusher_lifted", rr.LineStrips3D.from_fields(colors=_LIFTED, radii=_THIN, labels=["lifted"]),
             static=True)
-    rec.log("world/cor", rr.Points2D.from_fields(colors=_COR, radii=_DOT), static=True)
+    rec.log("world/cor", rr.Points3D.from_fields(colors=_COR, radii=_DOT, labels=["COR"]), static=True)
     return index, times
 
 
@@ -282,8 +310,16 @@ def _log_reach(rec: rr.RecordingStream, reach: ReachableSet) -> None:
 
     centres, counts = reach_points(reach)
     colours = {k: [int(c[i:i + 2], 16) for i in (1, 3, 5)] for k, c in COLOURS.items()}
-    rec.log("world/reach", rr.Points2D(centres, colors=[colours[int(k)] for k in counts],
-                                       radii=0.35 * min(reach.cell), draw_order=-2.0), static=True)
+    rec.log("world/reach", rr.Points3D(_z(centres, "map"), colors=[colours[int(k)] for k in counts],
+                                       radii=0.35 * min(reach.cell)), static=True)
+
+
+def _top_view(origin: str, name: str, x: float, y: float, half: float) -> rrb.Spatial3DView:
+    """A 3-D view looking straight down at ``(x, y)`` from high enough to see ``half`` round it, x
+    to the right and y up: rerun's 2-D views draw y downwards whatever the view coordinates say
+    (its issue #1387), and a pushing plan drawn upside down reads wrongly (a left turn looks right)."""
+    return rrb.Spatial3DView(origin=origin, name=name, line_grid=False, eye_controls=rrb.EyeControls3D(
+        kind=rrb.Eye3DKind.Orbital, position=[x, y, _EYE * half], look_target=[x, y, 0.0], eye_up=[0.0, 1.0, 0.0]))
 
 
 def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Verification | None = None,
@@ -319,14 +355,14 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         If the file cannot be written whole (a full disk, say), naming ``path``.
     """
     xmin, ymin, xmax, ymax = scene.workspace
+    cf, radius = scene.slider.cf, scene.slider.radius
     blueprint = rrb.Blueprint(rrb.Vertical(
         rrb.Horizontal(
-            rrb.Spatial2DView(origin="/world", name=scene.name,
-                              visual_bounds=rrb.VisualBounds2D(x_range=[xmin, xmax], y_range=[ymin, ymax])),
-            rrb.Spatial2DView(origin="/analysis", name="pushed edge (slider frame)"),
+            _top_view("/world", scene.name, (xmin + xmax) / 2, (ymin + ymax) / 2, max(xmax - xmin, ymax - ymin) / 2),
+            _top_view("/analysis", "pushed edge (slider frame)", *cf, 6 * radius),
             column_shares=[3, 2]),
         rrb.TextLogView(origin="/log", name="summary"),
-        row_shares=[6, 1]))
+        row_shares=[3, 1]))
     rec = rr.RecordingStream("stablepush", recording_id=f"{scene.name}-{plan.planner}-seed{plan.seed}")
     rec.set_log_time_enabled(False)
     # Into memory, then written by this process: rerun's own file sink reports a failed write
@@ -338,7 +374,7 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         rec.send_blueprint(blueprint, make_active=True, make_default=True)
         _log_static(rec, scene, plan)
         if plan.segments:
-            index, times = _log_motion(rec, scene, plan, cache)
+            index, times = _log_motion(rec, scene, plan)
             if plan.pushes:
                 _log_analysis(rec, scene, plan, cache)
             if verification is not None:
