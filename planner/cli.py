@@ -62,10 +62,11 @@ __all__ = ["Inputs", "main", "read_inputs"]
 _EPILOG = f"""\
 exit codes:
   0    solved (and verified, with --verify)
-  1    bad input: one line "plan: error: <field>: <problem>", nothing written
+  1    bad input, in the scene (a goal in an obstacle, say) or in an option's value (--reach 3):
+       one line "plan: error: <field>: <problem>", nothing written
   2    not solved within the time limit, or the goal is certified unreachable (one line
-       "plan: unreachable: <reason>", at once); the files are still written, "solved": false
-       with the reason; or a usage error of these options
+       "plan: unreachable: <reason> (outputs in <dir>)", at once); the files are still written,
+       "solved": false with the reason; or a usage error (an unknown option, a missing value)
   3    --verify: a push slips in the simulator; --simulate: a run in MuJoCo misses the goal,
        slips or collides
   4    an output could not be written: one line "plan: error: cannot write <file>: <OS error>";
@@ -289,7 +290,7 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         reach = reachable_set(scene, inputs.reach)
     _write_outputs(out, scene, result, check, reach, motion, write_recording, simulation, inputs.mjcf)
     if unreachable:
-        print(f"plan: unreachable: {unreachable}", file=sys.stderr)
+        print(f"plan: unreachable: {unreachable} (outputs in {out})", file=sys.stderr)
         return 2
     if not result.solved and inputs.given is None:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
@@ -299,11 +300,14 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
             else f"solved: {result.contents()}, path length {result.path_length(scene.slider.cf):.3f} m"
                  f"{_first_found(scene, result)}, planning time {result.planning_time_s:.2f} s")
     extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{f', {scene.name}-reach.png' if reach else ''}"
-    print(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}")
+    lines = [f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}"]
     if check is not None:
-        print("\n".join([*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]))
+        lines += [*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]
     if simulation is not None:
-        print("\n".join([*simulation.lines(), simulation.summary()]))
+        lines += [*simulation.lines(), simulation.summary()]
+    if len(lines) > 1:  # the last line says where the files are, whatever came before it
+        lines[-1] += f" (outputs in {out})"
+    print("\n".join(lines))
     return 0 if (check is None or check.passed) and (simulation is None or simulation.passed) else 3
 
 

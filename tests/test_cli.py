@@ -11,6 +11,7 @@ milliseconds); a few run the real command to show that no traceback or stray lin
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import json
 import math
@@ -388,7 +389,7 @@ def test_a_sealed_goal_exits_2_at_once_saying_why(tmp_path):
     run = run_plan(str(SCENES / "unreachable" / "sealed.yaml"), "--out", "out", cwd=tmp_path)
     assert run.returncode == 2 and time.perf_counter() - clock < 10.0  # interpreter start-up included
     assert run.stderr.splitlines() == ["plan: unreachable: component: the goal is cut off from the start for the "
-                                       "part's inscribed disk (radius 0.03 m)"]
+                                       "part's inscribed disk (radius 0.03 m) (outputs in out)"]
     data = plan_json(tmp_path / "out" / "sealed.json")
     assert data["solved"] is False and data["segments"] == [] and data["reason"].startswith("component")
     assert data["planning_time_s"] < 1.0
@@ -550,3 +551,25 @@ def test_ctrl_c_during_the_search_ends_as_interrupted(tmp_path):
     out, err = run.communicate(timeout=30)  # well before the time limit
     assert (run.returncode, out, err) == (130, "", "plan: interrupted\n")
     assert not (tmp_path / "out").exists()
+
+
+def test_a_mistyped_key_gets_a_did_you_mean(tmp_path, capsys):
+    text = (SCENES / "junction.yaml").read_text().replace("workspace:", "worksapce:")
+    (tmp_path / "typo.yaml").write_text(text)
+    assert main([str(tmp_path / "typo.yaml"), "--out", str(tmp_path / "out")]) == 1
+    assert capsys.readouterr().err == "plan: error: worksapce: unknown key; did you mean workspace?\n"
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("argv, code, line", [
+    (["--reach", "3"], 1, "plan: error: --reach: must be 1 or 2 pushes, got 3"),
+    (["--no-such-option"], 2, "plan: error: unrecognized arguments: --no-such-option"),
+    (["--seed"], 2, "plan: error: argument --seed: expected one argument")])
+def test_exit_codes_of_option_errors_are_as_help_says(tmp_path, capsys, argv, code, line):
+    """A bad value of an option is bad input (1); argparse's usage errors are 2 (``plan --help``)."""
+    with pytest.raises(SystemExit) if code == 2 else contextlib.nullcontext() as stopped:
+        result = main([str(SCENES / "junction.yaml"), "--out", str(tmp_path / "out"), *argv])
+    assert (stopped.value.code if code == 2 else result) == code
+    assert capsys.readouterr().err.splitlines()[-1] == line
+    assert not (tmp_path / "out").exists()
+

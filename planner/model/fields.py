@@ -9,6 +9,7 @@ anything left that could break the line.
 
 from __future__ import annotations
 
+import difflib
 import re
 import reprlib
 import sys
@@ -86,12 +87,25 @@ def member(name: str, key: Any) -> str:
 
 
 def keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> dict:
-    """``value`` as a mapping with all of ``required`` and nothing but those and ``optional``."""
+    """``value`` as a mapping with all of ``required`` and nothing but those and ``optional``; an
+    unknown key's error names the known key it most resembles, if one is close.
+
+    >>> keys({"worksapce": 1}, "scene", ("workspace", "start"))
+    Traceback (most recent call last):
+    ...
+    planner.model.fields.SceneError: worksapce: unknown key; did you mean workspace?
+    >>> keys({"colour": 1}, "pusher", ("width",), ("mu",))
+    Traceback (most recent call last):
+    ...
+    planner.model.fields.SceneError: pusher.colour: unknown key (known: width, mu)
+    """
     if not isinstance(value, dict):
         raise SceneError(name, f"must be a mapping with keys {', '.join(required + optional)}")
     for key in value:
         if key not in required + optional:
-            raise SceneError(member(name, key), "unknown key")
+            close = difflib.get_close_matches(str(key), required + optional, n=1)
+            hint = f"; did you mean {close[0]}?" if close else f" (known: {', '.join(required + optional)})"
+            raise SceneError(member(name, key), f"unknown key{hint}")
     for key in required:
         if key not in value:
             raise SceneError(member(name, key), "missing")

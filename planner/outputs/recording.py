@@ -123,7 +123,7 @@ _CCW, _CW, _COR, _GHOST, _SIMULATED = [20, 170, 150], [230, 130, 20], [210, 40, 
 _LIFTED = [110, 110, 110, 110]  # a faint, see-through grey: the pusher off the table, seen from above
 _STATUS = dict(zip(STATUS, ([40, 170, 70], [230, 190, 40], [200, 50, 50])))
 #: Height of the views' eye over the table, in half-widths of what it must show (the viewer's field of view).
-_EYE = 1.45
+_EYE = 1.7
 #: Heights (m) at which each kind of drawing lies over the table: a view from straight above
 #: sees them flat, and what lies higher is drawn over what lies lower (the part over its path,
 #: everything over the search tree).
