@@ -17,6 +17,20 @@ def _silence_nanobind_leak_report() -> None:
 atexit.register(_silence_nanobind_leak_report)
 
 
+def pytest_configure(config):
+    config.addinivalue_line("markers", "slow: took 0.3 s or more here (tests/slow_tests.txt); "
+                                       "-m 'not slow' is the quick subset")
+
+
+def pytest_collection_modifyitems(config, items):
+    from slow_tests import marked  # tests/ is on the path: conftest.py's folder
+
+    slow = marked()
+    for item in items:
+        if item.nodeid in slow:
+            item.add_marker(pytest.mark.slow)
+
+
 @pytest.fixture(scope="session", autouse=True)
 def region_cache(request, tmp_path_factory):
     """Exact regions are cached on disk (planner.actions.region_cache): keep the tests' copy in pytest's cache
