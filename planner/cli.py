@@ -354,7 +354,10 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
                 simulation.write_mjcf(_within(mjcf, out, stage), scene)
             write_atomic(stage / f"{scene.name}.json", result.to_json())
     except OSError as err:
-        named = str(err.filename or out).replace(str(stage), str(out), 1)  # the file as the user named it
+        named = str(err.filename or out)
+        if Path(named).parent == out.parent and Path(named).name.startswith(f".{out.name}."):
+            named = str(out)  # the staged folder itself could not be made: the user named its target
+        named = named.replace(str(stage), str(out), 1)  # a file as the user named it
         raise _NotWritten(f"cannot write {shown(named)}: {err.strerror or err}") from None
     except RecordingFailed as err:
         raise _NotWritten(f"cannot write {shown(str(out / f'{scene.name}.rrd'))}: the recording failed: {err}") from None

@@ -13,8 +13,10 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import errno
 import json
 import math
+import os
 import re
 import signal
 import subprocess
@@ -573,3 +575,17 @@ def test_exit_codes_of_option_errors_are_as_help_says(tmp_path, capsys, argv, co
     assert capsys.readouterr().err.splitlines()[-1] == line
     assert not (tmp_path / "out").exists()
 
+
+
+def test_an_output_folder_that_cannot_be_made_is_named_as_given(tmp_path, capsys, monkeypatch):
+    """The folder is staged under a temporary name beside it; where that cannot be made (a folder
+    the user may not write, /proc, ...), the line names the folder asked for, not the stage."""
+    out = tmp_path / "out"
+
+    def refused(dir, prefix, suffix):
+        raise PermissionError(errno.EACCES, "Permission denied", os.path.join(dir, f"{prefix}x{suffix}"))
+
+    monkeypatch.setattr(files.tempfile, "mkdtemp", refused)
+    assert main([str(SCENES / "battery.yaml"), "--out", str(out)]) == 4
+    assert capsys.readouterr().err == f"plan: error: cannot write {str(out)!r}: Permission denied\n"
+    assert not out.exists()
