@@ -171,7 +171,8 @@ def _summary(scene: Scene, plan: Plan) -> list[str]:
 
 def _log_text(rec: rr.RecordingStream, entity: str, lines: list[str], level: str) -> None:
     """Rows of the summary panel, at the start of both timelines: a text log shows the rows of
-    its timeline up to the current time, and none logged without one (static)."""
+    its timeline up to the current time, and none logged without one (static;
+    docs/stack.md, "What the viewer shows")."""
     zero = [0] * len(lines)
     rec.send_columns(entity, indexes=[rr.TimeColumn("step", sequence=zero), rr.TimeColumn("time", duration=zero)],
                      columns=rr.TextLog.columns(text=lines, level=[level] * len(lines)))
@@ -317,7 +318,8 @@ def _log_reach(rec: rr.RecordingStream, reach: ReachableSet) -> None:
 def _top_view(origin: str, name: str, x: float, y: float, half: float) -> rrb.Spatial3DView:
     """A 3-D view looking straight down at ``(x, y)`` from high enough to see ``half`` round it, x
     to the right and y up: rerun's 2-D views draw y downwards whatever the view coordinates say
-    (its issue #1387), and a pushing plan drawn upside down reads wrongly (a left turn looks right)."""
+    (its issue #1387), and a pushing plan drawn upside down reads wrongly (a left turn looks right;
+    docs/stack.md, "What the viewer shows")."""
     return rrb.Spatial3DView(origin=origin, name=name, line_grid=False, eye_controls=rrb.EyeControls3D(
         kind=rrb.Eye3DKind.Orbital, position=[x, y, _EYE * half], look_target=[x, y, 0.0], eye_up=[0.0, 1.0, 0.0]))
 
