@@ -31,7 +31,7 @@ def slow(log: str) -> list[str]:
     """
     spent: Counter[str] = Counter()
     for line in log.splitlines():
-        if m := re.match(r"\s*([\d.]+)s (?:setup|call|teardown)\s+(\S+)", line):
+        if m := re.match(r"\s*([\d.]+)s (?:setup|call|teardown)\s+(.+?)\s*$", line):  # ids may hold spaces
             spent[m.group(2)] += float(m.group(1))
     return sorted(name for name, seconds in spent.items() if seconds >= THRESHOLD)
 
