@@ -43,6 +43,7 @@ class PushGoal(ob.GoalSampleableRegion):
 
     def distanceGoal(self, state) -> float:
         key = pose_of(state)
+        state = None  # see pose_of
         x, y, theta, k = key
         if k >= len(self.region.controls):  # the marker of a blocked switch
             return math.inf
@@ -60,9 +61,12 @@ class PushGoal(ob.GoalSampleableRegion):
         self._samples += 1
         n = len(self.region.controls)
         goal = self.region.goals[self.active[(self._samples // n) % len(self.active)]]
-        state[0].setXY(float(goal[0]), float(goal[1]))
-        state[0].setYaw(float(goal[2]))
-        state[1].value = self._samples % n
+        try:
+            state[0].setXY(float(goal[0]), float(goal[1]))
+            state[0].setYaw(float(goal[2]))
+            state[1].value = self._samples % n
+        finally:
+            state = None  # see pose_of
 
     def maxSampleCount(self) -> int:
         return 1

@@ -52,8 +52,11 @@ class PoseProjection(ob.ProjectionEvaluator):
         pass  # OMPL infers them from samples (setting them here fails before setup: docs/stack.md, "Projection cell sizes")
 
     def project(self, state, out) -> None:
-        p = state[0]
-        out[0], out[1], out[2] = p.getX(), p.getY(), p.getYaw() * self.radius
+        try:
+            p = state[0]
+            out[0], out[1], out[2] = p.getX(), p.getY(), p.getYaw() * self.radius
+        finally:
+            state = out = p = None  # see pose_of
 
 
 def switch_target(u: float, n: int) -> int | None:
@@ -68,9 +71,21 @@ def switch_target(u: float, n: int) -> int | None:
 
 
 def pose_of(state) -> tuple[float, float, float, int]:
-    """``(x, y, theta, k)`` of a search state, copied out of C++."""
-    p = state[0]
-    return p.getX(), p.getY(), p.getYaw(), state[1].value
+    """``(x, y, theta, k)`` of a search state, copied out of C++.
+
+    Every function handed an OMPL state (or a component of one) drops its references before it
+    returns, as this one does. A frame can outlive its call (a sampling profiler such as
+    dask.distributed's holds every thread's frames, so do tracebacks), and with it the frame's
+    locals; a wrapper kept alive so outlives the state OMPL frees, and nanobind, which finds
+    wrappers by address, hands it back for the next state or component allocated there, whatever
+    its type (``'CompoundState' object has no attribute 'value'``)
+    (docs/stack.md, "Stale state wrappers").
+    """
+    try:
+        p = state[0]
+        return p.getX(), p.getY(), p.getYaw(), state[1].value
+    finally:
+        state = p = None
 
 
 def space_information(scene: Scene, controls: list[EdgeControls], model: CollisionModel, step: float,
@@ -110,29 +125,33 @@ def space_information(scene: Scene, controls: list[EdgeControls], model: Collisi
         return cache[key]
 
     def propagate(start, control, duration, result) -> None:
-        p, k = start[0], start[1].value
-        r = result[0]
-        target = None if transits is None else switch_target(control[2], len(controls))
-        if target is not None:
-            # A switch: the part stays; the pusher must find its way round (every step of the
-            # control after the first is a switch to the edge it is already on, i.e. nothing).
-            r.setXY(p.getX(), p.getY())
-            r.setYaw(p.getYaw())
-            free = target == k or transits.find((p.getX(), p.getY(), p.getYaw()), controls[k].edge,
-                                                controls[target].edge) is not None
-            result[1].value = target if free else blocked
-            return
-        dx, dy, dth = step_of(k, control[0], control[1], duration)
-        x, y, yaw = p.getX(), p.getY(), p.getYaw()
-        c, s = math.cos(yaw), math.sin(yaw)
-        r.setXY(x + c * dx - s * dy, y + s * dx + c * dy)
-        r.setYaw((yaw + dth + math.pi) % (2 * math.pi) - math.pi)
-        result[1].value = k
+        try:
+            x, y, yaw, k = pose_of(start)
+            r = result[0]
+            target = None if transits is None else switch_target(control[2], len(controls))
+            if target is not None:
+                # A switch: the part stays; the pusher must find its way round (every step of the
+                # control after the first is a switch to the edge it is already on, i.e. nothing).
+                r.setXY(x, y)
+                r.setYaw(yaw)
+                free = target == k or transits.find((x, y, yaw), controls[k].edge,
+                                                    controls[target].edge) is not None
+                result[1].value = target if free else blocked
+                return
+            dx, dy, dth = step_of(k, control[0], control[1], duration)
+            c, s = math.cos(yaw), math.sin(yaw)
+            r.setXY(x + c * dx - s * dy, y + s * dx + c * dy)
+            r.setYaw((yaw + dth + math.pi) % (2 * math.pi) - math.pi)
+            result[1].value = k
+        finally:
+            start = control = result = r = None  # see pose_of
 
     def is_valid(state) -> bool:
-        p, k = state[0], state[1].value
-        return k < blocked and si.satisfiesBounds(state) and model.is_clear(
-            (p.getX(), p.getY(), p.getYaw()), controls[k].edge, step / 2)
+        try:
+            x, y, yaw, k = pose_of(state)
+            return k < blocked and si.satisfiesBounds(state) and model.is_clear((x, y, yaw), controls[k].edge, step / 2)
+        finally:
+            state = None  # see pose_of
 
     si.setStatePropagator(propagate)
     si.setStateValidityChecker(is_valid)
