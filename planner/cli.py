@@ -297,8 +297,8 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         return 2
     head = (f"loaded {inputs.plan_path}: {result.contents()}{'' if result.solved else ' (not solved)'}"
             if inputs.given is not None
-            else f"solved: {result.contents()}, path length {result.path_length(scene.slider.cf):.3f} m"
-                 f"{_first_found(scene, result)}, planning time {result.planning_time_s:.2f} s")
+            else f"solved: {result.contents()}, cost {result.cost:.3f} m, length {result.length:.3f} m, "
+                 f"planning time {result.planning_time_s:.2f} s{_first_found(result)}")
     extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{f', {scene.name}-reach.png' if reach else ''}"
     lines = [f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}"]
     if check is not None:
@@ -311,10 +311,18 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
     return 0 if (check is None or check.passed) and (simulation is None or simulation.passed) else 3
 
 
-def _first_found(scene: Scene, result: Plan) -> str:
-    """`` (first found 1.234 m)`` when improvement rounds shortened the plan, else nothing."""
-    improved = result.first_length is not None and result.first_length > result.path_length(scene.slider.cf)
-    return f" (first found {result.first_length:.3f} m)" if improved else ""
+def _first_found(result: Plan) -> str:
+    """What the first plan cost and when it was found, when improvement rounds found better ones
+    (cost against time: the answer only got better), else nothing.
+
+    >>> plan = Plan(None, True, "rrt", 1, 2.5, [0, 0, 0], [0, 0, 0], improvements=[(0.4, 1.2, 0.95), (1.1, 0.8, 0.55)])
+    >>> _first_found(plan)
+    ' (first plan: cost 1.200 m at 0.40 s; 1 better, the last at 1.10 s)'
+    """
+    if len(result.improvements) < 2:
+        return ""
+    (t, c, _), later = result.improvements[0], len(result.improvements) - 1
+    return f" (first plan: cost {c:.3f} m at {t:.2f} s; {later} better, the last at {result.improvements[-1][0]:.2f} s)"
 
 
 def _progress(k: int, n: int) -> None:

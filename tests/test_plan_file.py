@@ -6,6 +6,7 @@ import copy
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from planner import SceneError, load_plan, load_scene, plan
@@ -39,6 +40,11 @@ def test_round_trip(written):
     (lambda d: d["segments"][0].update(contact=[[0, 0]]), "plan.segments[0].contact"),
     (lambda d: d["segments"][0]["start"].__setitem__(2, "x"), "plan.segments[0].start[2]"),
     (lambda d: d.update(final=[9.0, 9.0, 0.0]), "plan.final"),
+    (lambda d: d.update(length=d["length"] + 0.01), "plan.length"),
+    (lambda d: d.update(cf=[d["cf"][0] + 0.01, d["cf"][1]]), "plan.length"),  # another point travels another path
+    (lambda d: d.update(cost=d["cost"] + 0.25), "plan.cost"),
+    (lambda d: d.pop("switch_cost"), "plan.cost"),
+    (lambda d: d.update(improvements=[[0.1, 1.0]]), "plan.improvements[0]"),
 ])
 def test_bad_fields_are_named(written, tmp_path, edit, field):
     _, data = written
@@ -49,6 +55,19 @@ def test_bad_fields_are_named(written, tmp_path, edit, field):
     with pytest.raises(SceneError) as err:
         load_plan(path)
     assert err.value.field == field
+
+
+def test_cost_and_length_side_by_side(written):
+    """The file says what the plan costs, as the planner counts it, beside its length: the CF's
+    path (summed here from the pushes' own speeds and durations) plus the switch cost per switch."""
+    _, data = written
+    cf = np.asarray(data["cf"])
+    length = sum(float(np.hypot(*(np.asarray(s["twist"][:2]) + s["twist"][2] * np.array([-cf[1], cf[0]]))))
+                 * s["duration"] for s in data["segments"] if s["kind"] == "push")
+    switches = sum(s["kind"] == "transit" for s in data["segments"])
+    assert data["length"] == pytest.approx(length, abs=1e-8)
+    assert data["cost"] == pytest.approx(length + data["switch_cost"] * switches, abs=1e-8)
+    assert data["improvements"][-1][1:] == pytest.approx([data["cost"], data["length"]], abs=1e-8)
 
 
 def test_unreadable_files(tmp_path):

@@ -100,6 +100,19 @@ class EdgeCar:
         cx, cy = self.cf
         return np.array([x + c * cx - s * cy, y + s * cx + c * cy, float(wrap_angle(th + self.heading_angle))])
 
+    def states(self, poses: ArrayLike) -> np.ndarray:
+        """:meth:`state` of each slider pose of ``poses`` ``(n, 3)``, as rows.
+
+        >>> car = EdgeCar(None, np.array([0.1, 0.0]), np.array([0.0, 1.0]), 0.5)
+        >>> car.states([[1.0, 0.0, 0.0], [0.0, 0.0, np.pi / 2]]).round(12).tolist()
+        [[1.1, 0.0, 1.570796326795], [0.0, 0.1, -3.14159265359]]
+        """
+        q = np.asarray(poses, dtype=float).reshape(-1, 3)
+        c, s = np.cos(q[:, 2]), np.sin(q[:, 2])
+        cx, cy = self.cf
+        return np.column_stack([q[:, 0] + c * cx - s * cy, q[:, 1] + s * cx + c * cy,
+                                wrap_angle(q[:, 2] + self.heading_angle)])
+
     def pose(self, state: ArrayLike) -> np.ndarray:
         """The slider pose for a car state (inverse of :meth:`state`)."""
         x, y, psi = (float(v) for v in state)

@@ -16,6 +16,7 @@ import math
 from dataclasses import replace
 
 import numpy as np
+from numpy.typing import ArrayLike
 from ompl import base as ob
 
 from mechanics import wrap_angle
@@ -143,6 +144,48 @@ class DubinsCurves:
     def length(self) -> float:
         """Length of the CF's path along the Dubins curve between the loaded states."""
         return self.space.distance(self._a, self._b)
+
+    def lengths(self, a: ArrayLike, b: ArrayLike) -> np.ndarray:
+        """Dubins lengths from car states ``a`` to car states ``b`` (rows ``(x, y, psi)``, one of
+        them may be a single row, broadcast against the other).
+
+        Straight ahead, and back where it started:
+
+        >>> from planner.actions.car import edge_car
+        >>> from planner.actions.controls import edge_controls
+        >>> from planner.model.scene import load_scene
+        >>> scene = load_scene("scenes/battery.yaml")
+        >>> curves = DubinsCurves(scene, edge_car(edge_controls(scene)[0], scene.slider.cf))
+        >>> lengths = curves.lengths([[0.0, 0.0, 0.0]], [[0.3, 0.0, 0.0], [0.0, 0.0, 0.0]])
+        >>> lengths.round(9).tolist()
+        [0.3, 0.0]
+        """
+        a, b = np.asarray(a, dtype=float).reshape(-1, 3), np.asarray(b, dtype=float).reshape(-1, 3)
+        # One end is usually fixed: it is set once (most of the cost here is setting states).
+        fixed, moving, other = (self._a, self._b, b) if len(a) == 1 else (self._b, self._a, a)
+        if len(a) == 1 or len(b) == 1:
+            x, y, psi = (a if len(a) == 1 else b)[0].tolist()
+            fixed.setXY(x, y), fixed.setYaw(psi)
+            out = np.empty(len(other))
+            for i, (x, y, psi) in enumerate(other.tolist()):
+                moving.setXY(x, y), moving.setYaw(psi)
+                out[i] = self.space.distance(self._a, self._b)
+            return out
+        out = np.empty(len(a))
+        for i, (p, q) in enumerate(zip(a.tolist(), b.tolist())):
+            self.states(p, q)
+            out[i] = self.space.distance(self._a, self._b)
+        return out
+
+    def blocked(self, samples: int) -> bool:
+        """Whether the curve between the loaded states certainly hits something: the part's CF
+        leaves the room its disk needs (:meth:`~planner.world.validity.CollisionModel.surely_blocked`)
+        at one of ``samples`` points inside it. A cheap screen before :meth:`is_free`."""
+        cf = np.empty((samples, 2))  # the car's reference point is the CF
+        for i, t in enumerate(((np.arange(samples) + 0.5) / samples).tolist()):
+            self.space.interpolate(self._a, self._b, t, self._probe)
+            cf[i] = self._probe.getX(), self._probe.getY()
+        return bool(self.model.cf_blocked(cf).any())
 
     def between(self, start: np.ndarray, goal: np.ndarray) -> float:
         """Load the car states of slider poses ``start`` and ``goal``; the :meth:`length` between them."""

@@ -238,7 +238,12 @@ class Plan:
     segments: list[Push | Transit] = field(default_factory=list)
     reason: str = ""  # why it is not solved
     note: str = ""  # what the user should know of a plan made with less than asked (not in the file)
-    first_length: float | None = None  # CF path length of the first plan found, before improvement (not in the file)
+    #: Metres a switch costs, as the planner counted: ``cost = length + switch_cost * switches``.
+    switch_cost: float | None = None
+    #: The part's centre of friction (slider frame), whose path :attr:`length` measures.
+    cf: np.ndarray | None = field(default=None, repr=False)
+    #: ``(planning time s, cost m, length m)`` of the first plan found and of each better one after it.
+    improvements: list[tuple[float, float, float]] = field(default_factory=list)
     tree: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)), repr=False)  # search tree, world xy
 
     @property
@@ -270,6 +275,26 @@ class Plan:
         """Length of the path of the centre of friction ``cf`` (slider frame)."""
         return sum(s.cf_path_length(cf) for s in self.segments)
 
+    @property
+    def length(self) -> float | None:
+        """Length of the centre of friction's path, where the plan knows its part's CF."""
+        return None if self.cf is None else self.path_length(self.cf)
+
+    @property
+    def cost(self) -> float | None:
+        """What the planner minimises: :attr:`length` plus :attr:`switch_cost` per switch, where
+        both are known.
+
+        >>> push = Push.along(0, np.zeros((2, 2)), [1.0, 0.0, 0.0], 0.5, np.zeros(3))
+        >>> transit = Transit(0, 2, "lift", np.zeros((4, 3)), 0.1, push.end)
+        >>> plan = Plan(None, True, "rrt", 1, 0.0, np.zeros(3), push.end, [push, transit], switch_cost=0.25,
+        ...             cf=np.zeros(2))
+        >>> plan.length, plan.cost
+        (0.5, 0.75)
+        """
+        length = self.length
+        return None if length is None or self.switch_cost is None else length + self.switch_cost * self.switches
+
     def to_dict(self) -> dict:
         return {
             "format": FORMAT,
@@ -282,7 +307,21 @@ class Plan:
             "goal": _floats(self.goal),
             "final": _floats(self.final),
             "segments": [s.to_dict() for s in self.segments],
-        } | ({"reason": self.reason} if self.reason and not self.solved else {})
+        } | ({"reason": self.reason} if self.reason and not self.solved else {}) | self._costs()
+
+    def _costs(self) -> dict:
+        """The file's cost fields, those the plan knows: length, switch cost, cost, improvements."""
+        out: dict[str, Any] = {}
+        if self.cf is not None:
+            out["cf"] = _floats(self.cf)
+            out["length"] = round(self.length, 9)
+        if self.switch_cost is not None:
+            out["switch_cost"] = float(self.switch_cost)
+        if self.cost is not None:
+            out["cost"] = round(self.cost, 9)
+        if self.improvements:
+            out["improvements"] = [[round(t, 4), round(c, 9), round(n, 9)] for t, c, n in self.improvements]
+        return out
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=1)
@@ -291,7 +330,8 @@ class Plan:
     def from_dict(cls, data: Any) -> "Plan":
         """A plan from its JSON form (``stablepush.plan/1``), every field checked."""
         spec = keys(data, "plan", ("format", "scene", "solved", "planner", "seed", "planning_time_s", "start",
-                                   "goal", "final", "segments"), ("reason",))
+                                   "goal", "final", "segments"),
+                    ("reason", "cf", "length", "switch_cost", "cost", "improvements"))
         if spec["format"] != FORMAT:
             raise SceneError("plan.format", f"must be {FORMAT!r}, got {spec['format']!r}")
         if not isinstance(spec["solved"], bool):
@@ -307,12 +347,31 @@ class Plan:
             start=vector(spec["start"], "plan.start", 3),
             goal=vector(spec["goal"], "plan.goal", 3),
             reason=str(spec.get("reason", "")),
+            switch_cost=number(spec["switch_cost"], "plan.switch_cost") if "switch_cost" in spec else None,
+            cf=vector(spec["cf"], "plan.cf", 2) if "cf" in spec else None,
+            improvements=[tuple(vector(row, f"plan.improvements[{i}]", 3).tolist())
+                          for i, row in enumerate(_list(spec.get("improvements", []), "plan.improvements"))],
         )
         plan.segments = _read_segments(spec["segments"], plan.start)
         final = vector(spec["final"], "plan.final", 3)
         if not np.allclose(final, plan.final, atol=1e-9):
             raise SceneError("plan.final", "is not the end of the last segment")
+        for name in ("length", "cost"):  # what the file says must be what its segments make
+            said, made = number(spec[name], f"plan.{name}") if name in spec else None, getattr(plan, name)
+            if said is not None and (made is None or abs(said - made) > 1e-6):
+                raise SceneError(f"plan.{name}", f"is {said:g}, but the segments make {_made(made, name)}")
         return plan
+
+
+def _made(value: float | None, name: str) -> str:
+    needs = "cf" if name == "length" else "cf and switch_cost"
+    return f"{value:g}" if value is not None else f"no {name} without {needs}"
+
+
+def _list(value: Any, name: str) -> list:
+    if not isinstance(value, list):
+        raise SceneError(name, "must be a list")
+    return value
 
 
 def _read_segments(items: list, start: np.ndarray) -> list[Push | Transit]:

@@ -14,6 +14,7 @@ import numpy as np
 from ..actions.controls import EdgeControls, RegionTimeout, clearance_margin, edge_controls, step_length
 from ..actions.dubins import DubinsShortcut
 from ..actions.shortcut import JoinShortcut
+from ..actions.switch_pose import SwitchShortcut
 from ..actions.transit import TransitPlanner
 from ..model.plan_file import Plan, Push, Transit
 from ..model.fields import SceneError
@@ -76,7 +77,8 @@ class PlanRequest:
                note: str = "", tree: np.ndarray | None = None) -> Plan:
         """The plan for ``goal`` (solved if no ``reason``), timed from ``clock`` (perf_counter)."""
         found = Plan(self.scene.path, not reason, self.planner, self.seed, 0.0, self.scene.start.copy(), goal.copy(),
-                     segments, f"{reason}; {note}" if reason and note else reason, note)
+                     segments, f"{reason}; {note}" if reason and note else reason, note,
+                     switch_cost=self.scene.planner.switch_cost, cf=self.scene.slider.cf)
         if tree is not None:
             found.tree = tree
         found.planning_time_s = time.perf_counter() - clock
@@ -151,6 +153,8 @@ class PlanningContext:
                                        self.margin) if switching else None
         self._joined = JoinShortcut(controls, self.model, self.margin, self.transits)
         self._dubins = DubinsShortcut(scene, controls, self.model, self.margin)
+        self._switches = SwitchShortcut(scene, self._dubins.curves, self.model, self.transits,
+                                        scene.planner.switch_cost) if switching else None
 
     def result(self, goal: np.ndarray, segments: list[Push | Transit], reason: str = "",
                tree: np.ndarray | None = None) -> Plan:
@@ -162,8 +166,10 @@ class PlanningContext:
         return GoalRegion(self.scene, goals, self.controls, self.model, self.margin, self.transits)
 
     def shortcut(self, segments: list[Push | Transit]) -> list[Push | Transit]:
-        """Fewer pushes where one joins several, then shorter Dubins curves where they are free."""
-        return self._dubins(self._joined(segments))
+        """Fewer pushes where one joins several, switches moved where the plan is shortest, then
+        shorter Dubins curves where they are free."""
+        joined = self._joined(segments)
+        return self._dubins(self._switches(joined) if self._switches is not None else joined)
 
     def direct(self, region: GoalRegion, goal: int = 0) -> list[Push | Transit] | None:
         """The cheapest plan of one or two pushes on a start edge, as in the paper's one-step

@@ -86,7 +86,8 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     first plan, each round searches again with a seed of its own (drawn from ``seed``) and twice
     the first search's iterations, and its plan, shortened like the first, replaces the plan if it
     costs less. Rounds are counted, not timed, so a seed still gives one plan; they stop early at
-    the time limit. ``Plan.first_length`` is the first plan's length. A plan of one or two pushes
+    the time limit. ``Plan.improvements`` holds the time, cost and length of the first plan and of
+    each better one. A plan of one or two pushes
     from the start (found before any search) is not searched again.
 
     ``prebuilt`` is the edges' pushes and the collision model (built with ``scene.pusher.edges``)
@@ -106,11 +107,11 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     except RegionTimeout as timeout:  # no edge's region in time
         return request.result(clock, scene.goal, [], str(timeout))
     if scene.within_tolerance(scene.start):
-        return context.result(scene.goal, [])
+        return _found_at_once(context.result(scene.goal, []))
     region = context.goal_region(scene.goal)
     direct = context.direct(region)
     if direct:
-        return context.result(scene.goal, direct)
+        return _found_at_once(context.result(scene.goal, direct))
     search = _Search(context)
     segments, tree, iterations = search.run(region)
     if segments is None:
@@ -121,14 +122,23 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
         plain, _, _ = search.run(region.without_switches(), budget)
         if plain is not None and cost(scene, plain := context.shortcut(plain)) <= cost(scene, segments):
             segments = plain
-    first = segments
+    improvements = [(time.perf_counter() - clock, cost(scene, segments), length(scene, segments))]
     budget = max(ROUND_ITERATIONS * iterations, ROUND_MIN_ITERATIONS)
     for r in range(1, request.optimize + 1):
+        if time.perf_counter() >= context.deadline:
+            break
         other, _, _ = search.run(region, budget, (request.seed + r * _ROUND_SEEDS) % MAX_SEED + 1)
         if other is not None and cost(scene, other := context.shortcut(other)) < cost(scene, segments):
             segments = other
+            improvements.append((time.perf_counter() - clock, cost(scene, segments), length(scene, segments)))
     result = context.result(scene.goal, segments, tree=tree)
-    result.first_length = length(scene, first)
+    result.improvements = improvements
+    return result
+
+
+def _found_at_once(result: Plan) -> Plan:
+    """``result``, found before any search: its one improvement is itself."""
+    result.improvements = [(result.planning_time_s, result.cost, result.length)]
     return result
 
 

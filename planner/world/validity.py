@@ -165,7 +165,13 @@ class CollisionModel:
         c, s = np.cos(q[..., 2]), np.sin(q[..., 2])
         x = q[..., 0] + c * self._cf[0] - s * self._cf[1]
         y = q[..., 1] + s * self._cf[0] + c * self._cf[1]
-        return ~shapely.contains_xy(self.cf_room, x, y)
+        return self.cf_blocked(np.stack([x, y], axis=-1))
+
+    def cf_blocked(self, points: ArrayLike) -> np.ndarray:
+        """:meth:`surely_blocked` of the poses whose CF is at each of ``points`` (shape
+        ``(..., 2)``, world), whatever their heading."""
+        p = np.asarray(points, dtype=float)
+        return ~shapely.contains_xy(self.cf_room, p[..., 0], p[..., 1])
 
     def is_clear(self, pose: ArrayLike, edge: int, distance: float) -> bool:
         """Whether :meth:`clearance` exceeds ``distance``; cheaper where the body is far from
