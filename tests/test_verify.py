@@ -307,6 +307,8 @@ def plan_files(tmp_path_factory):
     twist = np.r_[n + 3 * np.array([n[1], -n[0]]), 0.0] * 0.05
     segment["twist"], segment["end"] = twist.tolist(), advance(segment["start"], twist, segment["duration"]).tolist()
     data["final"] = segment["end"]
+    for stale in ("length", "cost", "improvements"):  # the edited push no longer makes them (load_plan says so)
+        data.pop(stale)
     bad = folder / "tampered.json"
     bad.write_text(json.dumps(data))
     return good, bad

@@ -56,9 +56,9 @@ _SCREEN = 8
 #: The pattern search's moves: every combination of a step back, none or forward in x, y and heading.
 _MOVES = np.array([m for m in itertools.product((-1, 0, 1), repeat=3) if any(m)], dtype=float)
 #: Neighbours checked per move of the pattern search, cheapest first.
-_TRIES = 3
+_TRIES = 4
 #: Where along each push of the current plan its poses are taken as candidates.
-_ALONG = (0.5, 1.0)
+_ALONG = (0.25, 0.5, 0.75, 1.0)
 #: Fewest headings of the stage-1 grid (every 15 degrees).
 _LEAST_TURNS = 24
 
@@ -84,8 +84,8 @@ class Grid:
 
     spacing: float = 0.5
     heading: float = 5.0
-    finest: float = 0.1
-    checks: int = 12
+    finest: float = 0.05
+    checks: int = 24
     candidates: int = 4000
 
 

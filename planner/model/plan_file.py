@@ -310,8 +310,11 @@ class Plan:
         } | ({"reason": self.reason} if self.reason and not self.solved else {}) | self._costs()
 
     def _costs(self) -> dict:
-        """The file's cost fields, those the plan knows: length, switch cost, cost, improvements."""
+        """The file's cost fields, those a solved plan knows: the CF, length, switch cost, cost and
+        improvements (an unsolved plan's segments are not a way to the goal: no cost is said)."""
         out: dict[str, Any] = {}
+        if not self.solved:
+            return out
         if self.cf is not None:
             out["cf"] = _floats(self.cf)
             out["length"] = round(self.length, 9)

@@ -43,12 +43,13 @@ from .spaces import pose_of, space_information
 __all__ = ["plan", "plan_batch", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS", "ROUND_ITERATIONS",
            "ROUND_MIN_ITERATIONS"]
 
-#: When the first plan found switches, a search without switches gets this many times the
-#: iterations the first search used (at least ``ONE_EDGE_MIN_ITERATIONS``): one edge alone
-#: usually needs more of them. On parking, junction, gap and narrow_junction (20 seeds), 2x / 500
-#: against 4x / 1000 raised the mean plan cost by at most 1.6 % and cut the median planning time
-#: by up to a third (gap: 0.44 -> 0.28 s); ``optimize`` is the way to shorter plans.
-ONE_EDGE_ITERATIONS, ONE_EDGE_MIN_ITERATIONS = 2, 500
+#: When the first plan still switches once shortened (the switch-pose shortcut drops a switch
+#: wherever one edge joins its ends through a via pose), a search without switches gets this many
+#: times the iterations the first search used (at least ``ONE_EDGE_MIN_ITERATIONS``). Seeds 1-10
+#: of gap, junction, narrow_junction and parking: 1x / 250 against the 2x / 500 used before that
+#: shortcut gave the same median costs and cut the median planning time by up to a third;
+#: ``optimize`` is the way to cheaper plans.
+ONE_EDGE_ITERATIONS, ONE_EDGE_MIN_ITERATIONS = 1, 250
 #: An improvement round (``optimize``) gets this many times the first search's iterations (and
 #: at least ``ROUND_MIN_ITERATIONS``).
 ROUND_ITERATIONS, ROUND_MIN_ITERATIONS = 2, 1000
