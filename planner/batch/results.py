@@ -86,7 +86,7 @@ class ResultsFile:
 
 
 def summary(records: Iterable[Mapping[str, Any]]) -> str:
-    """A table of ``records`` per scene (in order of the first task id of each): tasks, how many
+    """A table of ``records`` per scene file (named, in order of their first task ids): tasks, how many
     of each status, and the median cost, length and planning time of the solved ones.
 
     >>> print(summary([{"id": "a-s1", "scene": "a.yaml", "status": "solved", "cost": 1.0, "length": 1.0,
@@ -104,6 +104,6 @@ def summary(records: Iterable[Mapping[str, Any]]) -> str:
         solved = [r for r in rows if r.get("status") == "solved"]
         medians = [f"{statistics.median(r[k] for r in solved):.3f}" if solved else "-"
                    for k in ("cost", "length", "planning_time_s")]
-        lines.append(f"{scene[-26:]:<26}{len(rows):>7}{counts[0]:>8}{counts[1]:>9}{counts[2]:>9}{counts[3]:>8}"
+        lines.append(f"{Path(scene).name[:25]:<26}{len(rows):>7}{counts[0]:>8}{counts[1]:>9}{counts[2]:>9}{counts[3]:>8}"
                      f"{medians[0]:>10}{medians[1]:>9}{medians[2]:>10}")
     return "\n".join(lines)
