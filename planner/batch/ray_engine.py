@@ -16,6 +16,7 @@ the same on every engine) and, after ``retries``, answered failed with Ray's rea
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
@@ -27,7 +28,11 @@ __all__ = ["RayExecutor", "needs_ray"]
 
 
 def needs_ray():
-    """The ``ray`` module, or a :class:`SceneError` saying how to install it."""
+    """The ``ray`` module, or a :class:`SceneError` saying how to install it. Ray 2.60's clusters
+    (``ray start``) want token authentication, and Ray reads the mode once, when it is first
+    imported: a driver that has not chosen one asks for it (the token is read from
+    ``~/.ray/auth_token``, or as ``RAY_AUTH_TOKEN_PATH`` or ``RAY_AUTH_TOKEN`` say)."""
+    os.environ.setdefault("RAY_AUTH_MODE", "token")
     try:
         import ray
     except ImportError:
@@ -38,7 +43,6 @@ def needs_ray():
 def _call(fn: Callable[[Any, Any], Any], item: Any, shared: Any) -> tuple[Any, str | None, str, int]:
     """In a Ray worker: ``fn(item, shared)``, an exception it raises as its one-line description
     (so that Ray does not retry or wrap it), with the worker's host and pid."""
-    import os
     import socket
 
     try:
