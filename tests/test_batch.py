@@ -26,7 +26,7 @@ PLAN = Path(sys.executable).with_name("plan")
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = [str(ROOT / "scenes" / "battery.yaml"), str(ROOT / "scenes" / "cluttered.yaml")]
 #: What may differ between two runs of the same tasks: when they ran, where, and how often.
-VARYING = {"planning_time_s", "host", "attempts"}
+VARYING = {"planning_time_s", "task_s", "host", "attempts"}
 
 
 def comparable(out: Path) -> dict[str, tuple]:

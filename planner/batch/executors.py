@@ -46,14 +46,16 @@ __all__ = ["Executor", "LocalExecutor", "Outcome", "cores", "describe"]
 @dataclass(frozen=True)
 class Outcome:
     """How one call ended: its ``value``, or ``error`` (why it failed, one line); the ``host`` and
-    process id of the worker that answered, and the ``attempts`` it took (more than one when a
-    worker died under it)."""
+    process id of the worker that answered, the ``attempts`` it took (more than one when a worker
+    died under it) and the ``seconds`` the call itself took in its worker (what is not, of a run's
+    wall time, is the executor's overhead: planner.bench.batch)."""
 
     value: Any = None
     error: str | None = None
     host: str = ""
     pid: int = 0
     attempts: int = 1
+    seconds: float = 0.0
 
     @property
     def failed(self) -> bool:
@@ -90,7 +92,7 @@ def describe(err: BaseException) -> str:
 
 def _serve(conn: Connection, parent: int) -> None:
     """A worker's life: receive ``("shared", obj)`` and ``("call", index, fn, item)`` messages, answer
-    each call with ``(index, value, error, pid)``, until the pipe closes."""
+    each call with ``(index, value, error, pid, seconds)``, until the pipe closes."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole group: the run handles it
     die_with_parent(parent, signal.SIGKILL)  # it writes nothing: SIGKILL is the right end
     shared = None
@@ -103,12 +105,13 @@ def _serve(conn: Connection, parent: int) -> None:
             shared = message[1]
             continue
         _, index, fn, item = message
+        clock = time.perf_counter()
         try:
-            answer = (index, fn(item, shared), None, os.getpid())
+            value, error = fn(item, shared), None
         except Exception as err:  # the call's own failure: reported, the worker goes on
-            answer = (index, None, describe(err), os.getpid())
+            value, error = None, describe(err)
             traceback.print_exc()
-        conn.send(answer)
+        conn.send((index, value, error, os.getpid(), time.perf_counter() - clock))
 
 
 class _Worker:
@@ -205,10 +208,10 @@ class LocalExecutor:
         """The worker's answer if it gave one, ``'died'``, ``'late'`` (past ``timeout``), or None (still running)."""
         if worker.conn in ready:
             try:
-                index, value, error, pid = worker.conn.recv()
+                index, value, error, pid, seconds = worker.conn.recv()
             except (EOFError, OSError):
                 return "died"
-            return Outcome(value, error, self.host, pid)
+            return Outcome(value, error, self.host, pid, seconds=seconds)
         if worker.process.sentinel in ready or not worker.process.is_alive():
             return "died"
         if timeout and time.monotonic() - worker.began > timeout:

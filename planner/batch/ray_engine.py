@@ -40,15 +40,17 @@ def needs_ray():
     return ray
 
 
-def _call(fn: Callable[[Any, Any], Any], item: Any, shared: Any) -> tuple[Any, str | None, str, int]:
+def _call(fn: Callable[[Any, Any], Any], item: Any, shared: Any) -> tuple[Any, str | None, str, int, float]:
     """In a Ray worker: ``fn(item, shared)``, an exception it raises as its one-line description
-    (so that Ray does not retry or wrap it), with the worker's host and pid."""
+    (so that Ray does not retry or wrap it), with the worker's host and pid and the call's seconds."""
     import socket
 
+    clock = time.perf_counter()
     try:
-        return fn(item, shared), None, socket.gethostname(), os.getpid()
+        value, error = fn(item, shared), None
     except Exception as err:
-        return None, describe(err), socket.gethostname(), os.getpid()
+        value, error = None, describe(err)
+    return value, error, socket.gethostname(), os.getpid(), time.perf_counter() - clock
 
 
 class RayExecutor:
@@ -111,7 +113,7 @@ class RayExecutor:
                 for ref in done:
                     index, _ = running.pop(ref)
                     try:
-                        value, error, host, pid = ray.get(ref)
+                        value, error, host, pid, seconds = ray.get(ref)
                     except (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError,
                             ray.exceptions.OutOfMemoryError, ray.exceptions.LocalRayletDiedError) as err:
                         if attempts[index] <= retries:
@@ -120,7 +122,7 @@ class RayExecutor:
                             yield index, Outcome(error=f"its worker died ({describe(err)}), {attempts[index]} times",
                                                  attempts=attempts[index])
                         continue
-                    yield index, Outcome(value, error, host, pid, attempts[index])
+                    yield index, Outcome(value, error, host, pid, attempts[index], seconds)
                 if timeout:
                     for ref, (index, began) in list(running.items()):
                         if time.monotonic() - began > timeout:

@@ -16,7 +16,8 @@ import numpy as np
 
 from ..model.scene import Scene
 from ..queries.reachable_set import HEADINGS, ReachableSet, reachable_set
-from .engines import executor
+from .engines import map_ordered
+from .executors import cores
 
 __all__ = ["merge", "reachable_set_on"]
 
@@ -44,18 +45,17 @@ def reachable_set_on(scene: Scene, pushes: int = 1, engine: str = "local", worke
     """:func:`~planner.queries.reachable_set.reachable_set` of ``scene`` for any final heading,
     its ``headings`` computed on the ``engine`` executor (:func:`planner.batch.executor`).
 
+    The headings are cut into one run per worker (``workers``, default: this machine's cores):
+    each run builds the collision model and the goal regions once.
+
     Raises
     ------
     RuntimeError
-        If a heading's map failed (its worker died more often than retried, say).
+        If a part of the map failed (its worker died more often than retried, say).
     """
     clock = time.perf_counter()
-    with executor(engine, workers, address) as pool:
-        cuts = np.linspace(0, headings, min(pool.workers, headings) + 1).round().astype(int)
-        jobs = [(scene, pushes, resolution, headings, slice(a, b)) for a, b in zip(cuts[:-1], cuts[1:])]
-        maps: list = [None] * len(jobs)
-        for index, outcome in pool.run(_part, jobs):
-            if outcome.failed:
-                raise RuntimeError(f"the map's headings {jobs[index][-1]} failed: {outcome.error}")
-            maps[index] = outcome.value
+    parts = min(workers or cores(), headings)
+    cuts = np.linspace(0, headings, parts + 1).round().astype(int)
+    jobs = [(scene, pushes, resolution, headings, slice(a, b)) for a, b in zip(cuts[:-1], cuts[1:])]
+    maps = map_ordered(_part, jobs, workers, engine, address)
     return merge(maps, time.perf_counter() - clock)

@@ -11,8 +11,9 @@ The columns, in this order, are :data:`COLUMNS`: the task (``id``, ``scene``, ``
 ``overrides``), its ``status`` (``solved``, ``unreachable``: certified at once, ``unknown``: not
 solved within its time limit, ``failed``: ``error`` says why), the plan's ``cost`` (length plus the
 switch cost per switch), ``length`` (of the centre of friction's path), ``pushes`` and ``switches``,
-``planning_time_s``, ``regions_computed`` (exact regions the worker computed itself), the worker's
-``host``, the ``attempts`` it took and the ``plan`` file.
+``planning_time_s``, ``task_s`` (the whole task's seconds in its worker: reading, certificates,
+planning), ``regions_computed`` (exact regions the worker computed itself), the worker's ``host``,
+the ``attempts`` it took and the ``plan`` file.
 
 >>> import tempfile
 >>> results = ResultsFile(Path(tempfile.mkdtemp()) / "results.jsonl")
@@ -35,7 +36,7 @@ from typing import Any
 __all__ = ["COLUMNS", "STATUSES", "ResultsFile", "summary"]
 
 COLUMNS = ("id", "scene", "seed", "goal", "overrides", "status", "cost", "length", "pushes", "switches",
-           "planning_time_s", "regions_computed", "host", "attempts", "error", "plan")
+           "planning_time_s", "task_s", "regions_computed", "host", "attempts", "error", "plan")
 STATUSES = ("solved", "unreachable", "unknown", "failed")
 
 

@@ -92,7 +92,7 @@ def _record(task: Task, outcome: Outcome, out: Path) -> dict[str, Any]:
     """The results line of ``task``, whose call ended with ``outcome``; its plan file is written first."""
     record: dict[str, Any] = dict.fromkeys(COLUMNS)
     record |= task.record() | {"status": "failed", "host": outcome.host, "attempts": outcome.attempts,
-                               "error": outcome.error}
+                               "error": outcome.error, "task_s": outcome.seconds if not outcome.failed else None}
     if not outcome.failed:
         value = dict(outcome.value)
         plan_file = f"{task.id}.json"
