@@ -77,9 +77,11 @@ def test_a_worker_killed_mid_task_is_replaced_and_its_task_run_again(tmp_path):
     answered, killed = {}, None
     with LocalExecutor(2) as pool:
         runs = pool.run(_pid_then_sleep, items)
-        while Path(marker).exists() is False:
+        while len(answered) < 3:  # the three others, which return at once
             index, outcome = next(runs)
             answered[index] = outcome
+        while not Path(marker).exists():  # the first, begun and waiting
+            time.sleep(0.01)
         killed = int(Path(marker).read_text())
         Path(marker + ".killed").touch()
         os.kill(killed, signal.SIGKILL)

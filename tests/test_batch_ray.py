@@ -63,9 +63,11 @@ def test_a_ray_worker_killed_mid_task_is_replaced_and_its_task_run_again(cluster
     answered = {}
     with RayExecutor(address=cluster.address) as pool:
         runs = pool.run(test_batch._pid_then_sleep, items)
-        while not Path(marker).exists():
+        while len(answered) < 3:  # the three others, which return at once
             index, outcome = next(runs)
             answered[index] = outcome
+        while not Path(marker).exists():  # the first, begun and waiting
+            time.sleep(0.01)
         killed = int(Path(marker).read_text())
         Path(marker + ".killed").touch()
         os.kill(killed, signal.SIGKILL)
