@@ -12,7 +12,9 @@ change the simulated friction and centre of pressure, ``--mjcf FILE`` writes the
 and prints a line per run and a summary line; MuJoCo is imported only then.
 ``--reach N`` (1 or 2) then maps the goal positions reachable from the start in at most N stable
 pushes (:func:`planner.queries.reachable_set.reachable_set`, any heading): ``<name>-reach.png`` in the
-output folder and ``/world/reach`` in the recording.
+output folder and ``/world/reach`` in the recording; with ``--engine`` (and ``--jobs``) its headings
+are computed on the batch executors (:func:`planner.batch.reach.reachable_set_on`). Several scenes,
+or ``--seeds``, make a batch instead (:mod:`planner.batch.command`).
 
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
 solved or certified unreachable (:func:`planner.certify_unreachable`, checked before planning; one

@@ -69,26 +69,32 @@ def _pid_then_sleep(path: str, shared) -> int:
     return os.getpid()
 
 
-def test_a_worker_killed_mid_task_is_replaced_and_its_task_run_again(tmp_path):
-    marker = str(tmp_path / "pid")
-    items = [marker] + [str(tmp_path / f"other{k}") for k in range(3)]
+def kill_mid_task(pool, folder: Path) -> tuple[dict, int]:
+    """Run four calls on ``pool``, kill the worker of the first once it is under way, and return
+    every call's outcome by index and the pid killed."""
+    marker = str(folder / "pid")
+    items = [marker] + [str(folder / f"other{k}") for k in range(3)]
     for item in items[1:]:
         Path(item + ".killed").touch()  # these return at once
-    answered, killed = {}, None
-    with LocalExecutor(2) as pool:
-        runs = pool.run(_pid_then_sleep, items)
-        while len(answered) < 3:  # the three others, which return at once
-            index, outcome = next(runs)
-            answered[index] = outcome
-        while not Path(marker).exists():  # the first, begun and waiting
-            time.sleep(0.01)
-        killed = int(Path(marker).read_text())
-        Path(marker + ".killed").touch()
-        os.kill(killed, signal.SIGKILL)
-        answered |= dict(runs)
-    assert sorted(answered) == [0, 1, 2, 3]
-    assert not any(o.failed for o in answered.values())
+    answered = {}
+    runs = pool.run(_pid_then_sleep, items)
+    while len(answered) < 3:  # the three others
+        index, outcome = next(runs)
+        answered[index] = outcome
+    while not Path(marker).exists():  # the first, begun and waiting
+        time.sleep(0.01)
+    killed = int(Path(marker).read_text())
+    Path(marker + ".killed").touch()
+    os.kill(killed, signal.SIGKILL)
+    answered |= dict(runs)
+    assert sorted(answered) == [0, 1, 2, 3] and not any(o.failed for o in answered.values())
     assert answered[0].attempts == 2 and answered[0].value != killed
+    return answered, killed
+
+
+def test_a_worker_killed_mid_task_is_replaced_and_its_task_run_again(tmp_path):
+    with LocalExecutor(2) as pool:
+        answered, killed = kill_mid_task(pool, tmp_path)
     workers = {o.value for o in answered.values()} | {killed}
     assert [pid for pid in workers if Path(f"/proc/{pid}").exists()] == []  # every worker stopped and reaped
 
@@ -142,7 +148,7 @@ def _group_of(proc: Path) -> int | None:
     return int(text[text.rindex(")") + 2:].split()[2])
 
 
-def _alive(pid: str) -> bool:
+def _alive(pid: int | str) -> bool:
     try:
         text = Path(f"/proc/{pid}/stat").read_text()
     except OSError:

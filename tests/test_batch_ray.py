@@ -5,7 +5,6 @@ machine's workers, a Ray worker killed mid-task, reachable-set maps."""
 from __future__ import annotations
 
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -26,7 +25,7 @@ from planner.batch.reach import reachable_set_on  # noqa: E402
 from planner.queries.reachable_set import reachable_set  # noqa: E402
 
 import test_batch  # noqa: E402 (tests/ is on the path)
-from test_batch import PLAN, ROOT, batch, comparable  # noqa: E402
+from test_batch import PLAN, ROOT, _alive, batch, comparable, kill_mid_task  # noqa: E402
 
 
 def test_the_ray_engine_starts_its_own_cluster_and_leaves_no_process(tmp_path):
@@ -56,26 +55,10 @@ def test_forty_tasks_give_the_same_results_on_ray_as_on_local_workers(cluster, t
 
 def test_a_ray_worker_killed_mid_task_is_replaced_and_its_task_run_again(cluster, tmp_path):
     ray.cloudpickle.register_pickle_by_value(test_batch)  # Ray's workers cannot import the tests
-    marker = str(tmp_path / "pid")
-    items = [marker] + [str(tmp_path / f"other{k}") for k in range(3)]
-    for item in items[1:]:
-        Path(item + ".killed").touch()
-    answered = {}
     with RayExecutor(address=cluster.address) as pool:
-        runs = pool.run(test_batch._pid_then_sleep, items)
-        while len(answered) < 3:  # the three others, which return at once
-            index, outcome = next(runs)
-            answered[index] = outcome
-        while not Path(marker).exists():  # the first, begun and waiting
-            time.sleep(0.01)
-        killed = int(Path(marker).read_text())
-        Path(marker + ".killed").touch()
-        os.kill(killed, signal.SIGKILL)
-        answered |= dict(runs)
-    assert sorted(answered) == [0, 1, 2, 3] and not any(o.failed for o in answered.values())
-    assert answered[0].attempts == 2 and answered[0].value != killed
+        _, killed = kill_mid_task(pool, tmp_path)
     time.sleep(0.2)
-    assert not Path(f"/proc/{killed}/cmdline").read_bytes() if Path(f"/proc/{killed}").exists() else True
+    assert not _alive(killed)
 
 
 def test_a_reachable_set_map_on_ray_is_the_map_of_one_process(cluster, tmp_path):

@@ -83,6 +83,9 @@ class LocalRayCluster:
 
     def __enter__(self) -> LocalRayCluster:
         try:
+            # The head authenticates nodes and drivers with the token in ~/.ray/auth_token: made if missing.
+            subprocess.run([_RAY, "get-auth-token", "--generate"], env=self.environment, check=True,
+                           capture_output=True, timeout=60)
             for k, cpus in enumerate(self.cpus):
                 where = ["--head", "--port", self.address.rsplit(":", 1)[1], "--include-dashboard", "false"] if k == 0 \
                     else ["--address", self.address]

@@ -18,20 +18,21 @@ import sys
 import threading
 import time
 from collections import Counter, deque
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["main", "plan_with_frames_held"]
+__all__ = ["frames_held", "main", "plan_with_frames_held"]
 
 SCENE = Path(__file__).resolve().parents[2] / "scenes" / "parking.yaml"
 
 
-def plan_with_frames_held(seed: int, time_limit: float = 2.0) -> str:
-    """Plan the parking scene with ``seed`` while a thread holds the main thread's recent frames;
-    ``'solved'``, ``'unsolved'`` or the error's type and first line."""
-    from planner import load_scene, plan
-
+@contextmanager
+def frames_held() -> Iterator[None]:
+    """Within the block, a thread keeps the last ~10 ms of the calling thread's frames (a sample
+    every 0.5 ms, 20 kept), as a sampling profiler does; they are let go when it ends."""
     main, done = threading.get_ident(), threading.Event()
-    held: deque = deque(maxlen=20)  # about 10 ms of samples, as a profiler keeps them
+    held: deque = deque(maxlen=20)
 
     def sampler() -> None:
         while not done.is_set():
@@ -45,13 +46,23 @@ def plan_with_frames_held(seed: int, time_limit: float = 2.0) -> str:
     thread = threading.Thread(target=sampler, daemon=True)
     thread.start()
     try:
-        return "solved" if plan(load_scene(SCENE), seed=seed, time_limit=time_limit).solved else "unsolved"
-    except Exception as err:
-        return f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"
+        yield
     finally:
         done.set()
         thread.join()
         held.clear()
+
+
+def plan_with_frames_held(seed: int, time_limit: float = 2.0) -> str:
+    """Plan the parking scene with ``seed`` while a thread holds the main thread's recent frames
+    (:func:`frames_held`); ``'solved'``, ``'unsolved'`` or the error's type and first line."""
+    from planner import load_scene, plan
+
+    with frames_held():
+        try:
+            return "solved" if plan(load_scene(SCENE), seed=seed, time_limit=time_limit).solved else "unsolved"
+        except Exception as err:
+            return f"{type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''}"
 
 
 def _task(seed: int, shared: None) -> str:
