@@ -8,7 +8,8 @@ under many support distributions. The subpackages, lowest first (each imports on
 before it): :mod:`.model` (scene and plan files), :mod:`.world` (collisions, free space),
 :mod:`.actions` (stable pushes, transits, shortcuts), :mod:`.search` (OMPL), :mod:`.queries`
 (one step, reachability, controllability, bounds), :mod:`.execution` (re-simulation),
-:mod:`.outputs` (recording, pictures) and :mod:`.bench`; :mod:`.cli` is the ``plan`` command.
+:mod:`.outputs` (recording, pictures), :mod:`.batch` (many tasks on local workers or Ray) and
+:mod:`.bench`; :mod:`.cli` is the ``plan`` command.
 """
 
 from importlib import import_module

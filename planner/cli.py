@@ -12,7 +12,9 @@ change the simulated friction and centre of pressure, ``--mjcf FILE`` writes the
 and prints a line per run and a summary line; MuJoCo is imported only then.
 ``--reach N`` (1 or 2) then maps the goal positions reachable from the start in at most N stable
 pushes (:func:`planner.queries.reachable_set.reachable_set`, any heading): ``<name>-reach.png`` in the
-output folder and ``/world/reach`` in the recording.
+output folder and ``/world/reach`` in the recording; with ``--engine`` (and ``--jobs``) its headings
+are computed on the batch executors (:func:`planner.batch.reach.reachable_set_on`). Several scenes,
+or ``--seeds``, make a batch instead (:mod:`planner.batch.command`).
 
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
 solved or certified unreachable (:func:`planner.certify_unreachable`, checked before planning; one
@@ -93,7 +95,7 @@ def _parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="plan", description="Plan guaranteed-stable pushes for a YAML scene.",
                                 epilog=_EPILOG.format(cache=cache_folder()),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("scene", help="scene file (YAML; its format is in the README)")
+    p.add_argument("scene", nargs="+", help="scene file (YAML; its format is in the README); several make a batch")
     p.add_argument("--planner", choices=PLANNERS, help=f"OMPL control planner (default: the scene's, else {DEFAULT_PLANNER})")
     p.add_argument("--time-limit", type=float, metavar="S",
                    help=f"planning time limit in seconds, at most {MAX_TIME_LIMIT:g} (default: the scene's, "
@@ -133,6 +135,13 @@ def _parser() -> argparse.ArgumentParser:
                    help="with --simulate: move the supports' centre of pressure by this offset from the CF "
                         "(slider frame, m)")
     p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")
+    batch = p.add_argument_group("batch runs (several scenes, or --seeds; planner.batch)")
+    batch.add_argument("--seeds", metavar="A:B", help="plan each scene for seeds A to B (or N, or A,B,C)")
+    batch.add_argument("--jobs", type=int, metavar="N", help="tasks at once (default: the cores, or the Ray cluster's CPUs)")
+    batch.add_argument("--engine", choices=("local", "ray"),
+                       help="where tasks (and --reach's map) run: processes of this machine (default) or Ray")
+    batch.add_argument("--address", metavar="ADDR", help="with --engine ray: an existing cluster's (default: start one)")
+    batch.add_argument("--resume", action="store_true", help="run only the tasks of --out DIR without a result")
     return p
 
 
@@ -149,6 +158,7 @@ class Inputs:
     plan_path: str | None  # --plan FILE
     given: Plan | None  # that file's plan, to verify instead of planning
     reach: int | None = None  # --reach N: pushes of the reachable-set map
+    engine: tuple[str, int | None, str | None] | None = None  # --engine, --jobs, --address: where the map runs
     trajectory: bool = False  # --trajectory: write the pusher's trajectory
     simulate: int | None = None  # --simulate N: runs in MuJoCo
     sim_mu: float | None = None  # --sim-mu
@@ -177,7 +187,13 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     _check_simulation(args)
     if args.reach is not None and args.reach not in (1, 2):
         raise SceneError("--reach", f"must be 1 or 2 pushes, got {args.reach}")
-    scene = load_scene(args.scene)
+    for flag, value in (("--engine", args.engine), ("--jobs", args.jobs), ("--address", args.address)):
+        if value is not None and args.reach is None:
+            raise SceneError(flag, "is for a batch (several scenes or --seeds) or a --reach map")
+    if _is_batch(args) or args.resume:
+        raise SceneError("--resume" if args.resume else "scene", "several scenes, --seeds or --resume make a batch, "
+                                                               "which the plan command runs itself (planner.batch)")
+    scene = load_scene(args.scene[0])
     if args.sim_cf_offset is not None:
         from .execution.mujoco_sim import support_centre
 
@@ -197,7 +213,9 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--out", f"{shown(str(out))} exists and is not a folder")
     return Inputs(scene, args.planner or scene.planner.name, limit or scene.planner.time_limit,
                   seed or scene.planner.seed, out, args.verify, args.plan,
-                  None if args.plan is None else load_plan(args.plan), args.reach, args.trajectory, args.simulate,
+                  None if args.plan is None else load_plan(args.plan), args.reach,
+                  None if args.engine is None and args.jobs is None else (args.engine or "local", args.jobs, args.address),
+                  args.trajectory, args.simulate,
                   args.sim_mu, tuple(args.sim_cf_offset or (0.0, 0.0)), None if args.mjcf is None else Path(args.mjcf))
 
 
@@ -223,6 +241,10 @@ def main(argv: list[str] | None = None) -> int:
     atexit.register(_silence_nanobind_leak_report)
     try:
         with raise_on_sigterm():
+            if _is_batch(args := _parser().parse_args(argv)):
+                from .batch.command import run_command
+
+                return run_command(args)
             return _run(read_inputs(argv))
     except SceneError as err:
         print(f"plan: error: {err}", file=sys.stderr)
@@ -236,6 +258,11 @@ def main(argv: list[str] | None = None) -> int:
     except Terminated:
         print("plan: terminated", file=sys.stderr)
         return 143
+
+
+def _is_batch(args: argparse.Namespace) -> bool:
+    """Several scenes, or a seed range, make a batch (planner.batch.command)."""
+    return len(args.scene) > 1 or args.seeds is not None
 
 
 class _NotWritten(Exception):
@@ -285,9 +312,14 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         simulation = simulate(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset)
     reach = None
     if inputs.reach:  # after planning: the map is about the start, whatever the plan
-        from .queries.reachable_set import reachable_set
+        if inputs.engine is None:
+            from .queries.reachable_set import reachable_set
 
-        reach = reachable_set(scene, inputs.reach)
+            reach = reachable_set(scene, inputs.reach)
+        else:
+            from .batch.reach import reachable_set_on
+
+            reach = reachable_set_on(scene, inputs.reach, *inputs.engine)
     _write_outputs(out, scene, result, check, reach, motion, write_recording, simulation, inputs.mjcf)
     if unreachable:
         print(f"plan: unreachable: {unreachable} (outputs in {out})", file=sys.stderr)

@@ -48,7 +48,7 @@ from ..model.files import write_atomic
 from ..model.processes import die_with_parent, fork_context
 
 __all__ = ["MEMORY_SIZE", "RegionCache", "cache_folder", "cache_key", "compute_regions", "default_cache",
-           "edge_region", "is_cached"]
+           "edge_region", "is_cached", "regions_held"]
 
 #: Bump when the exact region's construction (or the recording's analysis) changes, so old cache
 #: files are not used. 3: the support LPs by a batched simplex (its duals can differ where the LP
@@ -190,6 +190,25 @@ def is_cached(slider: Slider, edge: int, mu: float, width: float | None = None, 
         return True
     cache = default_cache() if cache is None else cache
     return any(cache.holds("exact", key) for key in _keys_alike(slider, edge, mu, width, cf_radius))
+
+
+def regions_held(slider: Slider, edges: Sequence[int], mu: float, width: float | None = None, cf_radius: float = 0.0,
+                 cache: RegionCache | None = None) -> dict[str, ExactRegion]:
+    """The exact regions of ``edges`` (and of their twins, :func:`_twin`) that ``cache`` (default:
+    :func:`default_cache`) holds in memory, by key: what another process planning this part needs
+    to be spared computing them (it :meth:`~RegionCache.put` s them into its own cache; the keys
+    say what each region depends on, so one given for another part or friction is never used).
+
+    >>> block = Slider([[-0.05, 0.0], [0.05, 0.0], [0.05, 0.06], [-0.05, 0.06]])
+    >>> cache = RegionCache("/nonexistent")
+    >>> held = regions_held(block, [0], 0.5, 0.08, cache=cache)
+    >>> _ = edge_region(block, 0, 0.5, 0.08, cache=cache)
+    >>> len(held), len(regions_held(block, [0], 0.5, 0.08, cache=cache))
+    (0, 1)
+    """
+    cache = default_cache() if cache is None else cache
+    keys = dict.fromkeys(key for edge in edges for key in _keys_alike(slider, edge, mu, width, cf_radius))
+    return {key: region for key in keys if (region := cache.get(key)) is not None}
 
 
 def _twin(slider: Slider, edge: int) -> int:

@@ -4,7 +4,8 @@ Plans every scene with every planner for seeds ``1..runs`` and prints, per scene
 success rate, the median and 90th-percentile planning time, and the median path length (of the
 centre of friction), number of pushes and number of switches (edge changes) of the solved runs.
 ``--transit`` overrides every scene's ``pusher.transit`` (``none``: one edge per plan). Runs go to worker processes, one per
-core, each building its own OMPL objects (they cannot be pickled; docs/stack.md, "Worker processes"). ``--ompl-log FILE``
+core, each building its own OMPL objects (they cannot be pickled; docs/stack.md, "Worker processes"), on planner.batch's
+executors (``--engine local`` or ``ray``): a run whose worker is killed is run again. ``--ompl-log FILE``
 also writes the runs in OMPL's benchmark log format (planner.bench.ompl_log), one log per scene, for
 ``ompl_benchmark_statistics.py`` and Planner Arena.
 """
@@ -12,7 +13,6 @@ also writes the runs in OMPL's benchmark log format (planner.bench.ompl_log), on
 from __future__ import annotations
 
 import argparse
-import multiprocessing
 import os
 import statistics
 import sys
@@ -24,12 +24,14 @@ import numpy as np
 from .ompl_log import Run, log_paths, write_ompl_log
 from ..model.options import PLANNERS, TRANSITS
 from ..model.scene import load_scene
+from ..batch.engines import ENGINES, map_ordered
 from ..search import plan
 
 __all__ = ["main"]
 
 
-def _run(job: tuple[str, str, int, float, str | None]) -> tuple[str, str, bool, float, float, int, int]:
+def _run(job: tuple[str, str, int, float, str | None],
+         shared: None = None) -> tuple[str, str, bool, float, float, int, int]:
     path, name, seed, limit, transit = job
     scene = load_scene(path)
     result = plan(scene, seed=seed, time_limit=limit, planner=name, transit=transit)
@@ -54,6 +56,9 @@ def main(argv: list[str] | None = None) -> int:
                    help="override every scene's pusher.transit (none: one edge per plan; default: each scene's)")
     p.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="K",
                    help="runs in parallel, one process each (default: the number of cores, %(default)s)")
+    p.add_argument("--engine", choices=ENGINES, default="local",
+                   help="run on this machine's processes or on Ray (planner.batch; default: %(default)s)")
+    p.add_argument("--address", metavar="ADDR", help="with --engine ray: an existing cluster's")
     p.add_argument("--quality", action="store_true",
                    help="instead, path quality with the default planner: lengths against a lower bound and the "
                         "Dubins length, on obstacle-free tasks for each scene's part and on the scenes "
@@ -81,8 +86,7 @@ def main(argv: list[str] | None = None) -> int:
     jobs = [(s, name, seed, args.time_limit, args.transit) for s in args.scenes for name in args.planners
             for seed in range(1, args.runs + 1)]
     clock = time.perf_counter()
-    with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
-        results = pool.map(_run, jobs, chunksize=1)
+    results = map_ordered(_run, jobs, args.workers, args.engine, args.address)  # a killed worker's run is retried
     wall = time.perf_counter() - clock
     print(f"{'scene':<22}{'planner':<8}{'success':>8}{'t_med[s]':>10}{'t_p90[s]':>10}{'len_med[m]':>11}{'pushes':>8}"
           f"{'switches':>9}")

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import multiprocessing
 import os
 import statistics
 import sys
@@ -36,6 +35,7 @@ from ..actions.dubins import DubinsCurves
 from ..queries.geodesic import geodesic_bound
 from ..actions.controls import edge_controls
 from ..model.scene import Scene, load_scene
+from ..batch.engines import map_ordered
 from ..search import plan
 
 __all__ = ["TASKS", "dubins_length", "open_task", "main"]
@@ -67,7 +67,8 @@ def dubins_length(scene: Scene) -> float:
                default=math.inf)
 
 
-def _run(job: tuple[str, str, int, float]) -> tuple[str, str, bool, float, int, int, float, float, float]:
+def _run(job: tuple[str, str, int, float],
+         shared: None = None) -> tuple[str, str, bool, float, int, int, float, float, float]:
     path, task, seed, limit = job
     scene = load_scene(path)
     if task != "scene":
@@ -86,8 +87,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     tasks = [*TASKS, "scene"]
     jobs = [(s, t, seed, args.time_limit) for s in args.scenes for t in tasks for seed in range(1, args.runs + 1)]
-    with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
-        results = pool.map(_run, jobs, chunksize=1)
+    results = map_ordered(_run, jobs, args.workers)  # planner.batch: a killed worker's run is retried
     print(f"{'scene':<16}{'task':<12}{'solved':>7}{'len_med':>9}{'lower':>8}{'dubins':>8}{'len/low':>8}"
           f"{'len/dub':>8}{'pushes':>7}{'switch':>7}{'t_med':>7}")
     for s in args.scenes:

@@ -105,7 +105,7 @@ class ReachableSet:
 
 
 def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, resolution: float | None = None,
-                  *, headings: int = HEADINGS) -> ReachableSet:
+                  *, headings: int = HEADINGS, among: slice | None = None) -> ReachableSet:
     """The map of goal positions reachable from ``scene.start`` in at most ``pushes`` (1 or 2)
     constant stable collision-free pushes (module docstring).
 
@@ -121,6 +121,9 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
         non-square.
     headings : int
         Headings tried when ``heading`` is None.
+    among : slice, optional
+        With ``heading`` None, only these of the ``headings`` (a part of the map, which
+        :func:`planner.batch.reach.reachable_set_on` computes on another worker).
     """
     import time
 
@@ -137,7 +140,7 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
     x, y = np.meshgrid(xmin + (np.arange(nx) + 0.5) * dx, ymin + (np.arange(ny) + 0.5) * dy)
     xy = np.stack([x.ravel(), y.ravel()], axis=-1)
     thetas = (np.array([wrap_angle(heading)]) if heading is not None
-              else wrap_angle(np.arange(headings) * 2 * np.pi / headings))
+              else wrap_angle(np.arange(headings) * 2 * np.pi / headings)[among or slice(None)])
     count = np.zeros(nx * ny, dtype=np.int8)
     theta = np.full(nx * ny, np.nan)
     blocked = np.ones(nx * ny, dtype=bool)

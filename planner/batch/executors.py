@@ -1,0 +1,220 @@
+"""Executors: run one picklable function over many items in worker processes, and hear of each
+call as it ends, whatever happens to the workers.
+
+An executor's :meth:`~Executor.run` calls ``fn(item, shared)`` for every item and yields
+``(index, Outcome)`` in the order the calls finish. ``shared`` is sent to each worker once per run
+(the batch's stable regions), not with every item. A call whose worker dies (killed, out of memory,
+its node lost) is begun again on a new worker, up to ``retries`` times, then answered as failed
+with the reason; a call that raises is answered failed at once (it would raise again: the same
+item gives the same call); a call still running ``timeout`` seconds after it began has its worker
+killed and is answered failed. So a run always ends with every item answered.
+
+:class:`LocalExecutor` is a pool of this machine's processes. Its workers are spawned, not forked:
+a fork copies only the forking thread, so a lock held by another thread (a progress bar's, Ray's,
+a profiler's) would stay held in the child for ever (:mod:`planner.model.processes`); a spawned
+worker imports the planner once, then plans task after task. A worker dies with the run
+(:func:`~planner.model.processes.die_with_parent`), ignores Ctrl-C (the run kills it) and is killed
+by pid when the run ends or is interrupted, so none is left behind. A dead worker breaks nothing
+but its own call, unlike :class:`multiprocessing.pool.Pool` (which hangs) or
+:class:`concurrent.futures.ProcessPoolExecutor` (whose every pending call fails with
+``BrokenProcessPool``).
+
+>>> with LocalExecutor(2) as pool:
+...     sorted((i, o.value) for i, o in pool.run(divmod, [7, 9], shared=2))
+[(0, (3, 1)), (1, (4, 1))]
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+import signal
+import socket
+import time
+import traceback
+from collections import deque
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, replace
+from multiprocessing.connection import Connection, wait
+from typing import Any, Protocol
+
+from ..model.processes import die_with_parent
+
+__all__ = ["Executor", "LocalExecutor", "Outcome", "cores", "describe"]
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """How one call ended: its ``value``, or ``error`` (why it failed, one line); the ``host`` and
+    process id of the worker that answered, the ``attempts`` it took (more than one when a worker
+    died under it) and the ``seconds`` the call itself took in its worker (what is not, of a run's
+    wall time, is the executor's overhead: planner.bench.batch)."""
+
+    value: Any = None
+    error: str | None = None
+    host: str = ""
+    pid: int = 0
+    attempts: int = 1
+    seconds: float = 0.0
+
+    @property
+    def failed(self) -> bool:
+        return self.error is not None
+
+
+class Executor(Protocol):
+    """What runs a batch's calls (:class:`LocalExecutor`, :class:`planner.batch.ray_engine.RayExecutor`)."""
+
+    workers: int  # calls that run at once
+
+    def run(self, fn: Callable[[Any, Any], Any], items: Sequence, shared: Any = None, *, retries: int = 2,
+            timeout: float | None = None) -> Iterator[tuple[int, Outcome]]: ...
+
+    def close(self) -> None: ...
+
+    def __enter__(self) -> Executor: ...
+
+    def __exit__(self, *exc) -> None: ...
+
+
+def cores() -> int:
+    """The CPUs this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def describe(err: BaseException) -> str:
+    """One line for an exception: its type and message, as a results file records it."""
+    return f"{type(err).__name__}: {err}".splitlines()[0] if str(err) else type(err).__name__
+
+
+def _serve(conn: Connection, parent: int) -> None:
+    """A worker's life: receive ``("shared", obj)`` and ``("call", index, fn, item)`` messages, answer
+    each call with ``(index, value, error, pid, seconds)``, until the pipe closes."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole group: the run handles it
+    die_with_parent(parent, signal.SIGKILL)  # it writes nothing: SIGKILL is the right end
+    shared = None
+    while True:
+        try:
+            message = conn.recv()
+        except (EOFError, OSError):
+            return
+        if message[0] == "shared":
+            shared = message[1]
+            continue
+        _, index, fn, item = message
+        clock = time.perf_counter()
+        try:
+            value, error = fn(item, shared), None
+        except Exception as err:  # the call's own failure: reported, the worker goes on
+            value, error = None, describe(err)
+            traceback.print_exc()
+        conn.send((index, value, error, os.getpid(), time.perf_counter() - clock))
+
+
+class _Worker:
+    """One spawned worker process and the pipe to it."""
+
+    def __init__(self, context: multiprocessing.context.BaseContext, shared: Any):
+        self.conn, child = context.Pipe()
+        self.process = context.Process(target=_serve, args=(child, os.getpid()), daemon=True,
+                                       name="stablepush-batch-worker")
+        self.process.start()
+        child.close()
+        self.conn.send(("shared", shared))
+        self.index: int | None = None  # the call it runs
+        self.began = 0.0
+
+    def begin(self, index: int, fn: Callable, item: Any) -> None:
+        self.conn.send(("call", index, fn, item))
+        self.index, self.began = index, time.monotonic()
+
+    def kill(self) -> None:
+        """Kill it by pid and reap it."""
+        if self.process.is_alive():
+            self.process.kill()
+        self.process.join()
+        self.conn.close()
+
+
+class LocalExecutor:
+    """Up to ``workers`` calls at once (default: one per core) in processes of this machine (module
+    docstring). Workers are started by :meth:`run` and killed when it ends."""
+
+    def __init__(self, workers: int | None = None):
+        self.workers = max(1, cores() if workers is None else int(workers))
+        self._context = multiprocessing.get_context("spawn")
+        self.host = socket.gethostname()
+
+    def __enter__(self) -> LocalExecutor:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Nothing to release: each run stops its own workers."""
+
+    def run(self, fn: Callable[[Any, Any], Any], items: Sequence, shared: Any = None, *, retries: int = 2,
+            timeout: float | None = None) -> Iterator[tuple[int, Outcome]]:
+        """Call ``fn(item, shared)`` for each item; yield ``(index, Outcome)`` as calls end (module docstring)."""
+        waiting = deque(range(len(items)))
+        attempts = [0] * len(items)
+        pool: list[_Worker] = []
+        try:
+            while waiting or any(w.index is not None for w in pool):
+                while waiting and len(pool) < self.workers:
+                    pool.append(_Worker(self._context, shared))
+                for worker in pool:
+                    if worker.index is None and waiting:
+                        index = waiting.popleft()
+                        attempts[index] += 1
+                        worker.begin(index, fn, items[index])
+                busy = [w for w in pool if w.index is not None]
+                soonest = min((w.began + timeout for w in busy), default=None) if timeout else None
+                ready = wait([w.conn for w in busy] + [w.process.sentinel for w in busy],
+                             None if soonest is None else max(0.0, soonest - time.monotonic()))
+                for worker in busy:
+                    index = worker.index
+                    outcome = self._answer(worker, ready, timeout)
+                    if outcome is None:
+                        continue
+                    if outcome == "died":
+                        pool.remove(worker)
+                        worker.kill()
+                        code = worker.process.exitcode
+                        why = (f"its worker died (signal {-code})" if code is not None and code < 0
+                               else f"its worker died (exit code {code})")
+                        if attempts[index] <= retries:
+                            waiting.appendleft(index)  # again, first, on a new worker
+                            continue
+                        yield index, Outcome(error=f"{why}, {attempts[index]} times", host=self.host,
+                                             attempts=attempts[index])
+                    elif outcome == "late":
+                        pool.remove(worker)
+                        worker.kill()
+                        yield index, Outcome(error=f"stopped after {timeout:g} s, past its time limit",
+                                             host=self.host, attempts=attempts[index])
+                    else:
+                        worker.index = None
+                        yield index, replace(outcome, attempts=attempts[index])
+        finally:
+            for worker in pool:
+                worker.kill()
+
+    def _answer(self, worker: _Worker, ready: list, timeout: float | None) -> Outcome | str | None:
+        """The worker's answer if it gave one, ``'died'``, ``'late'`` (past ``timeout``), or None (still running)."""
+        if worker.conn in ready:
+            try:
+                index, value, error, pid, seconds = worker.conn.recv()
+            except (EOFError, OSError):
+                return "died"
+            return Outcome(value, error, self.host, pid, seconds=seconds)
+        if worker.process.sentinel in ready or not worker.process.is_alive():
+            return "died"
+        if timeout and time.monotonic() - worker.began > timeout:
+            return "late"
+        return None
+
