@@ -161,7 +161,8 @@ class DubinsCurves:
         [0.3, 0.0]
         """
         a, b = np.asarray(a, dtype=float).reshape(-1, 3), np.asarray(b, dtype=float).reshape(-1, 3)
-        # One end is usually fixed: it is set once (most of the cost here is setting states).
+        # One end is usually fixed: it is set once (setting states costs more than the distance;
+        # docs/stack.md, "Dubins curves").
         fixed, moving, other = (self._a, self._b, b) if len(a) == 1 else (self._b, self._a, a)
         if len(a) == 1 or len(b) == 1:
             x, y, psi = (a if len(a) == 1 else b)[0].tolist()
