@@ -1,8 +1,9 @@
 """Benchmark: ``python -m planner.bench.planners scenes/*.yaml --runs 20``.
 
 Plans every scene with every planner for seeds ``1..runs`` and prints, per scene and planner, the
-success rate, the median and 90th-percentile planning time, and the median path length (of the
-centre of friction), number of pushes and number of switches (edge changes) of the solved runs.
+success rate, the median and 90th-percentile planning time, and the median cost (length plus the
+switch cost per switch), path length (of the centre of friction), number of pushes and number of
+switches (edge changes) of the solved runs.
 ``--transit`` overrides every scene's ``pusher.transit`` (``none``: one edge per plan). Runs go to worker processes, one per
 core, each building its own OMPL objects (they cannot be pickled; docs/stack.md, "Worker processes"), on planner.batch's
 executors (``--engine local`` or ``ray``): a run whose worker is killed is run again. ``--ompl-log FILE``
@@ -31,12 +32,12 @@ __all__ = ["main"]
 
 
 def _run(job: tuple[str, str, int, float, str | None],
-         shared: None = None) -> tuple[str, str, bool, float, float, int, int]:
+         shared: None = None) -> tuple[str, str, bool, float, float, int, int, float]:
     path, name, seed, limit, transit = job
     scene = load_scene(path)
     result = plan(scene, seed=seed, time_limit=limit, planner=name, transit=transit)
     return (path, name, result.solved, result.planning_time_s, result.path_length(scene.slider.cf), result.pushes,
-            result.switches)
+            result.switches, result.cost if result.solved else float("inf"))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -88,17 +89,17 @@ def main(argv: list[str] | None = None) -> int:
     clock = time.perf_counter()
     results = map_ordered(_run, jobs, args.workers, args.engine, args.address)  # a killed worker's run is retried
     wall = time.perf_counter() - clock
-    print(f"{'scene':<22}{'planner':<8}{'success':>8}{'t_med[s]':>10}{'t_p90[s]':>10}{'len_med[m]':>11}{'pushes':>8}"
-          f"{'switches':>9}")
+    print(f"{'scene':<22}{'planner':<8}{'success':>8}{'t_med[s]':>10}{'t_p90[s]':>10}{'cost_med[m]':>12}"
+          f"{'len_med[m]':>11}{'pushes':>8}{'switches':>9}")
     for s in args.scenes:
         for name in args.planners:
             rows = [r for r in results if r[0] == s and r[1] == name]
             solved = [r for r in rows if r[2]]
             times = [r[3] for r in rows]  # unsolved runs count with the time they used
-            length = f"{statistics.median(r[4] for r in solved):.3f}" if solved else "-"
+            cost, length = (f"{statistics.median(r[i] for r in solved):.3f}" if solved else "-" for i in (7, 4))
             pushes, switches = (f"{statistics.median(r[i] for r in solved):g}" if solved else "-" for i in (5, 6))
             print(f"{os.path.basename(s):<22}{name:<8}{len(solved) / len(rows):>8.0%}"
-                  f"{statistics.median(times):>10.3f}{float(np.percentile(times, 90)):>10.3f}{length:>11}{pushes:>8}"
+                  f"{statistics.median(times):>10.3f}{float(np.percentile(times, 90)):>10.3f}{cost:>12}{length:>11}{pushes:>8}"
                   f"{switches:>9}")
     if args.ompl_log:
         _write_ompl_logs(args, names, logs, jobs, results, wall, argv)
@@ -110,7 +111,7 @@ def _write_ompl_logs(args: argparse.Namespace, names: list[str], logs: list[Path
     """One OMPL benchmark log per scene (planner.bench.ompl_log); the runs of each planner in seed order."""
     command = " ".join(["python -m planner.bench.planners", *(sys.argv[1:] if argv is None else argv)])
     for s, name, log in zip(args.scenes, names, logs):
-        by_planner = {planner: [Run(job[2], *r[2:]) for job, r in zip(jobs, results) if r[0] == s and r[1] == planner]
+        by_planner = {planner: [Run(job[2], *r[2:7]) for job, r in zip(jobs, results) if r[0] == s and r[1] == planner]
                       for planner in args.planners}
         setup = (f"stablepush benchmark: {command}\nscene: {s}\ntransit: {args.transit or 'as the scene'}\n"
                  f"wall time of the whole benchmark: {wall:.3f} s\n" + Path(s).read_text())
