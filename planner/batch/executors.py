@@ -39,9 +39,9 @@ from dataclasses import dataclass, replace
 from multiprocessing.connection import Connection, wait
 from typing import Any, Protocol
 
-from ..model.processes import die_with_parent
+from ..model.processes import cores, die_with_parent
 
-__all__ = ["Executor", "LocalExecutor", "Outcome", "cores", "describe"]
+__all__ = ["Executor", "LocalExecutor", "Outcome", "describe"]
 
 
 @dataclass(frozen=True)
@@ -76,14 +76,6 @@ class Executor(Protocol):
     def __enter__(self) -> Executor: ...
 
     def __exit__(self, *exc) -> None: ...
-
-
-def cores() -> int:
-    """The CPUs this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
 
 
 def describe(err: BaseException) -> str:
