@@ -5,6 +5,7 @@ machine's workers, a Ray worker killed mid-task, reachable-set maps."""
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -25,18 +26,29 @@ from planner.batch.reach import reachable_set_on  # noqa: E402
 from planner.queries.reachable_set import reachable_set  # noqa: E402
 
 import test_batch  # noqa: E402 (tests/ is on the path)
-from test_batch import PLAN, ROOT, _alive, batch, comparable, kill_mid_task  # noqa: E402
+from test_batch import PLAN, ROOT, SCENES, _alive, batch, comparable, kill_mid_task  # noqa: E402
 
 
-def test_the_ray_engine_starts_its_own_cluster_and_leaves_no_process(tmp_path):
+def test_sigterm_stops_a_batch_on_a_ray_cluster_of_its_own_leaving_no_process_and_local_resume_ends_it(tmp_path):
     # First in the module, before the shared cluster starts: one Ray cluster at a time.
-    before = _ray_processes()
-    run = subprocess.run([str(PLAN), str(ROOT / "scenes" / "battery.yaml"), "--seeds", "1:4", "--engine", "ray",
-                          "--jobs", "1", "--out", str(tmp_path / "out")], capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stderr
-    assert len((tmp_path / "out" / "results.jsonl").read_text().splitlines()) == 4
+    before, out = _ray_processes(), tmp_path / "out"
+    run = subprocess.Popen([str(PLAN), *SCENES, "--seeds", "1:20", "--time-limit", "2", "--engine", "ray",
+                            "--jobs", "2", "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                           text=True)
+    results = out / "results.jsonl"
+    while run.poll() is None and (not results.exists() or len(results.read_text().splitlines()) < 3):
+        time.sleep(0.01)
+    assert _ray_processes() - before  # its cluster is running
+    run.send_signal(signal.SIGTERM)
+    _, stderr = run.communicate(timeout=120)
+    assert run.returncode == 143, stderr
     time.sleep(0.5)
     assert _ray_processes() - before == set()
+    done = len(results.read_text().splitlines())
+    again = batch(out, "--resume")  # on local workers: the same tasks, the same results
+    assert again.returncode == 0, again.stderr
+    assert len([line for line in again.stderr.splitlines() if line.startswith("[")]) == 40 - done
+    assert len(comparable(out)) == 40
 
 
 @pytest.fixture(scope="module")

@@ -227,7 +227,7 @@ def test_bench_help_describes_every_argument(capsys):
     # the next lines, what it means.
     entries = [entry.strip().partition("  ") for entry in re.split(r"\n  (?=\S)", arguments)[1:]]
     names = [name.split()[0].rstrip(",") for name, _, _ in entries]
-    assert names == ["SCENE", "-h", "--runs", "--planners", "--time-limit", "--transit", "--workers", "--quality",
-                     "--ompl-log"]
+    assert names == ["SCENE", "-h", "--runs", "--planners", "--time-limit", "--transit", "--workers", "--engine",
+                     "--address", "--quality", "--ompl-log"]
     for name, _, meaning in entries:
         assert len(meaning.split()) >= 4, f"{name} is not described"

@@ -45,7 +45,7 @@ from mechanics import DeadlineExceeded, ExactRegion, Slider, StableRegion, exact
 
 from ..model.fields import SceneError
 from ..model.files import write_atomic
-from ..model.processes import die_with_parent, fork_context
+from ..model.processes import cores, die_with_parent, fork_context
 
 __all__ = ["MEMORY_SIZE", "RegionCache", "cache_folder", "cache_key", "compute_regions", "default_cache",
            "edge_region", "is_cached", "regions_held"]
@@ -305,7 +305,7 @@ def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: floa
     """
     cache = default_cache() if cache is None else cache
     first = list(dict.fromkeys(_twin(slider, edge) for edge in edges))
-    workers = min(len(first), _cores() if workers is None else workers)
+    workers = min(len(first), cores() if workers is None else workers)
     out: dict[int, ExactRegion] = {}
     with _workers(workers) as pool:
         waiting, running = list(first), 0
@@ -331,14 +331,6 @@ def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: floa
             out[edge] = replace(out[twin], stable=stable_region(slider, edge, mu, width))
             cache.put(_key(slider, edge, mu, width, cf_radius), out[edge])
     return {edge: out[edge] for edge in edges if edge in out}
-
-
-def _cores() -> int:
-    """The CPUs this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
 
 
 class _Workers:

@@ -34,13 +34,14 @@ import time
 import traceback
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from multiprocessing.connection import Connection, wait
 from typing import Any, Protocol
 
-from ..model.processes import die_with_parent
+from ..model.processes import cores, die_with_parent
 
-__all__ = ["Executor", "LocalExecutor", "Outcome", "cores", "describe"]
+__all__ = ["Executor", "LocalExecutor", "Outcome", "describe"]
 
 
 @dataclass(frozen=True)
@@ -77,14 +78,6 @@ class Executor(Protocol):
     def __exit__(self, *exc) -> None: ...
 
 
-def cores() -> int:
-    """The CPUs this process may run on."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
-
-
 def describe(err: BaseException) -> str:
     """One line for an exception: its type and message, as a results file records it."""
     return f"{type(err).__name__}: {err}".splitlines()[0] if str(err) else type(err).__name__
@@ -114,6 +107,25 @@ def _serve(conn: Connection, parent: int) -> None:
         conn.send((index, value, error, os.getpid(), time.perf_counter() - clock))
 
 
+#: Thread counts of the BLAS libraries numpy may load, read when the library loads.
+_BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+@contextmanager
+def _one_blas_thread() -> Iterator[None]:
+    """Within the block, the environment a spawned process starts with asks for one BLAS thread
+    (unless the user chose a number), as the ``plan`` command does for itself (planner.cli): a
+    worker plans one task on one core, its matrices are tiny, and BLAS threads would only compete
+    with the other workers for the cores."""
+    added = [name for name in _BLAS_THREADS if name not in os.environ]
+    os.environ.update(dict.fromkeys(added, "1"))
+    try:
+        yield
+    finally:
+        for name in added:
+            os.environ.pop(name, None)
+
+
 class _Worker:
     """One spawned worker process and the pipe to it."""
 
@@ -121,7 +133,8 @@ class _Worker:
         self.conn, child = context.Pipe()
         self.process = context.Process(target=_serve, args=(child, os.getpid()), daemon=True,
                                        name="stablepush-batch-worker")
-        self.process.start()
+        with _one_blas_thread():
+            self.process.start()
         child.close()
         self.conn.send(("shared", shared))
         self.index: int | None = None  # the call it runs

@@ -17,7 +17,7 @@ import numpy as np
 from ..model.scene import Scene
 from ..queries.reachable_set import HEADINGS, ReachableSet, reachable_set
 from .engines import map_ordered
-from .executors import cores
+from ..model.processes import cores
 
 __all__ = ["merge", "reachable_set_on"]
 

@@ -26,9 +26,18 @@ from .stop import Terminated, terminate
 if TYPE_CHECKING:
     from multiprocessing.context import BaseContext
 
-__all__ = ["die_with_parent", "fork_context", "threads"]
+__all__ = ["cores", "die_with_parent", "fork_context", "threads"]
 
 _PR_SET_PDEATHSIG = 1  # linux/prctl.h
+
+
+def cores() -> int:
+    """The CPUs this process may run on (its affinity, where the platform tells), the number of
+    worker processes that can run at once."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
 
 
 def threads() -> int:
