@@ -196,8 +196,8 @@ def test_concurrent_cold_runs_share_one_cache(tmp_path):
     alone.communicate(timeout=120)
     plans = [json.loads((tmp_path / out / "parking.json").read_text()) for out in ("alone", "out-0", "out-1", "out-2",
                                                                                "out-3")]
-    for p in plans:
-        del p["planning_time_s"]
+    for p in plans:  # when each plan was found varies, not the plan
+        del p["planning_time_s"], p["improvements"]
     assert all(p == plans[0] for p in plans[1:])
     files = list((tmp_path / "cache").iterdir())
     assert files and all(not f.name.endswith(".tmp") and json.loads(f.read_text()) for f in files)
