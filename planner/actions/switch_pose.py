@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -59,6 +60,8 @@ _MOVES = np.array([m for m in itertools.product((-1, 0, 1), repeat=3) if any(m)]
 _TRIES = 4
 #: Where along each push of the current plan its poses are taken as candidates.
 _ALONG = (0.25, 0.5, 0.75, 1.0)
+#: Switch poses whose Dubins sums are computed between two looks at the deadline.
+_CHUNK = 4096
 #: Fewest headings of the stage-1 grid (every 15 degrees).
 _LEAST_TURNS = 24
 
@@ -87,6 +90,19 @@ class Grid:
     finest: float = 0.05
     checks: int = 24
     candidates: int = 4000
+
+    def refined(self, level: int) -> "Grid":
+        """This grid ``level`` times finer: steps smaller by a factor of the square root of 2 a
+        level, twice the checks and four times the candidates (the number of poses grows as the
+        cube of the steps' ratio: a little faster than the candidates, so the finest grids keep to
+        their bound by coarsening).
+
+        >>> Grid().refined(2)
+        Grid(spacing=0.25, heading=2.5, finest=0.025, checks=96, candidates=64000)
+        """
+        shrink = 2.0 ** (-level / 2)
+        return Grid(round(self.spacing * shrink, 12), round(self.heading * shrink, 12),
+                    round(self.finest * shrink, 12), self.checks * 2 ** level, self.candidates * 4 ** level)
 
 
 def runs(segments: list[Push | Transit]) -> tuple[list[list[Push]], list[Transit]]:
@@ -167,21 +183,29 @@ class SwitchShortcut:
         What a switch costs (metres), weighed when switches are merged.
     grid : Grid
         How finely switch poses are searched.
+    via : bool
+        Also search a via pose for a plan without switches: the whole plan replaced by two Dubins
+        curves of its edge's car through it (a grid over the whole table finds ways round the
+        obstacles that the plan did not take).
+    deadline : float
+        A ``time.perf_counter()`` time: the search stops there, keeping what it found.
     """
 
     def __init__(self, scene: Scene, curves: dict[int, DubinsCurves], model: CollisionModel,
-                 transits: TransitPlanner, switch_cost: float, grid: Grid = Grid()):
+                 transits: TransitPlanner | None, switch_cost: float, grid: Grid = Grid(), *, via: bool = False,
+                 deadline: float = math.inf):
         self.curves, self.model, self.transits, self.switch_cost = curves, model, transits, switch_cost
         self.cf = scene.slider.cf
         self.radius = scene.slider.radius
-        self.grid = grid
+        self.grid, self.via, self.deadline = grid, via, deadline
+        self._ends: dict[tuple[int, bytes], np.ndarray] = {}
         xmin, ymin, xmax, ymax = scene.workspace
         self._workspace = (xmin, ymin, xmax, ymax)
 
     def __call__(self, segments: list[Push | Transit]) -> list[Push | Transit]:
         legs, transits = runs(segments)
         if not transits:
-            return segments
+            return self._via(segments) if self.via and segments else segments
         plan = _Legs(legs, [t.from_edge for t in transits] + [transits[-1].to_edge], transits)
         self._tried: set[tuple] = set()
         for _ in range(_SWEEPS):
@@ -200,6 +224,20 @@ class SwitchShortcut:
 
     def _cf_length(self, run: list[Push]) -> float:
         return sum(p.cf_path_length(self.cf) for p in run)
+
+    def _late(self) -> bool:
+        return time.perf_counter() >= self.deadline
+
+    def _via(self, segments: list[Push]) -> list[Push]:
+        """A plan without switches replaced by two Dubins curves of its edge's car through a via
+        pose, where that is cheaper."""
+        begin, end, edge = segments[0].start, segments[-1].end, segments[0].edge
+        along = np.array([_part_of(p, f).end for p in segments for f in _ALONG])
+        if edge not in self.curves:
+            return segments
+        found = self.best(begin, edge, end, edge, self._cf_length(segments) * (1.0 - _GAIN), along[len(along) // 2],
+                          along)
+        return segments if found is None else rechain(found[0] + found[2], begin)
 
     def _search(self, plan: "_Legs", i: int, j: int, a: int, b: int, extra: float) -> Stretch | None:
         """The best stretch from where leg ``i`` begins to where leg ``j`` ends, on edge ``a``
@@ -250,10 +288,17 @@ class SwitchShortcut:
         return False
 
     def sums(self, begin: np.ndarray, a: int, end: np.ndarray, b: int, poses: np.ndarray) -> np.ndarray:
-        """``D_a(begin, P) + D_b(P, end)`` for each switch pose ``P`` of ``poses`` ``(n, 3)``."""
+        """``D_a(begin, P) + D_b(P, end)`` for each switch pose ``P`` of ``poses`` ``(n, 3)``
+        (``inf`` for those left when the deadline passes)."""
         ca, cb = self.curves[a], self.curves[b]
-        return (ca.lengths(ca.car.state(begin)[None], ca.car.states(poses))
-                + cb.lengths(cb.car.states(poses), cb.car.state(end)[None]))
+        out = np.full(len(poses), np.inf)
+        for k in range(0, len(poses), _CHUNK):
+            if self._late():
+                break
+            chunk = poses[k:k + _CHUNK]
+            out[k:k + _CHUNK] = (ca.lengths(ca.car.state(begin)[None], ca.car.states(chunk))
+                                 + cb.lengths(cb.car.states(chunk), cb.car.state(end)[None]))
+        return out
 
     def best(self, begin: np.ndarray, a: int, end: np.ndarray, b: int, below: float,
              near: np.ndarray, along: np.ndarray | None = None) -> Stretch | None:
@@ -266,8 +311,11 @@ class SwitchShortcut:
         grid's cheapest feasible pose, the grid going through ``near``, and from the cheapest
         feasible of the poses ``along`` ``(n, 3)`` (the current plan's: they thread its
         passages)."""
+        self._ends = {}
         starts = [near]
         for candidates in (self._grid(begin, end, below, near), along):
+            if self._late():
+                return None
             if candidates is not None and len(candidates):
                 found = self._cheapest_feasible(begin, a, end, b, below, candidates)
                 if found is not None:
@@ -286,7 +334,7 @@ class SwitchShortcut:
         costs = self.sums(begin, a, end, b, candidates)
         checks = 0
         for i in np.argsort(costs, kind="stable"):
-            if costs[i] >= below or checks >= self.grid.checks:
+            if costs[i] >= below or checks >= self.grid.checks or self._late():
                 break
             feasible = self._feasible(begin, a, end, b, candidates[i])
             checks += feasible is not None
@@ -300,7 +348,7 @@ class SwitchShortcut:
         the best pose found and its sum."""
         g = self.grid
         step = np.array([g.spacing * self.radius, g.spacing * self.radius, math.radians(g.heading)]) / 2
-        while step[0] >= g.finest * self.radius:
+        while step[0] >= g.finest * self.radius and not self._late():
             near = pose + _MOVES * step
             near_costs = self.sums(begin, a, end, b, near)
             moved = False
@@ -341,19 +389,29 @@ class SwitchShortcut:
         are free and a transit exists there; None where the cheap screens rule it out (that is
         not counted as a check)."""
         ca, cb = self.curves[a], self.curves[b]
-        ca.states(ca.car.state(begin), ca.car.state(pose))
+        first = (self._end_state(a, begin), ca.car.state(pose))
+        second = (first[1] if a == b else cb.car.state(pose), self._end_state(b, end))
+        ca.states(*first)
         if ca.blocked(_SCREEN):
             return None
-        cb.states(cb.car.state(pose), cb.car.state(end))
+        cb.states(*second)
         if cb.blocked(_SCREEN):
             return None
         if a != b and self.transits.find(pose, a, b) is None:
             return False
-        ca.states(ca.car.state(begin), ca.car.state(pose))
+        ca.states(*first)
         if not ca.is_free():
             return False
-        cb.states(cb.car.state(pose), cb.car.state(end))
+        cb.states(*second)
         return cb.is_free()
+
+    def _end_state(self, edge: int, pose: np.ndarray) -> np.ndarray:
+        """The car state of ``edge`` at an end of the stretch searched (the same for every
+        candidate: kept, as the screens of fine grids ask for it tens of thousands of times)."""
+        key = (edge, pose.tobytes())
+        if key not in self._ends:
+            self._ends[key] = self.curves[edge].car.state(pose)
+        return self._ends[key]
 
     def _stretch(self, begin: np.ndarray, a: int, end: np.ndarray, b: int, pose: np.ndarray) -> Stretch | None:
         """The pushes and transit through feasible switch ``pose``; None if a push fails its

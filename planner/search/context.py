@@ -14,7 +14,7 @@ import numpy as np
 from ..actions.controls import EdgeControls, RegionTimeout, clearance_margin, edge_controls, step_length
 from ..actions.dubins import DubinsShortcut
 from ..actions.shortcut import JoinShortcut
-from ..actions.switch_pose import SwitchShortcut
+from ..actions.switch_pose import Grid, SwitchShortcut
 from ..actions.transit import TransitPlanner
 from ..model.plan_file import Plan, Push, Transit
 from ..model.fields import SceneError
@@ -153,8 +153,9 @@ class PlanningContext:
                                        self.margin) if switching else None
         self._joined = JoinShortcut(controls, self.model, self.margin, self.transits)
         self._dubins = DubinsShortcut(scene, controls, self.model, self.margin)
+        self._grid = Grid()
         self._switches = SwitchShortcut(scene, self._dubins.curves, self.model, self.transits,
-                                        scene.planner.switch_cost) if switching else None
+                                        scene.planner.switch_cost, self._grid) if switching else None
 
     def result(self, goal: np.ndarray, segments: list[Push | Transit], reason: str = "",
                tree: np.ndarray | None = None) -> Plan:
@@ -170,6 +171,15 @@ class PlanningContext:
         shorter Dubins curves where they are free."""
         joined = self._joined(segments)
         return self._dubins(self._switches(joined) if self._switches is not None else joined)
+
+    def refine(self, segments: list[Push | Transit], level: int) -> list[Push | Transit]:
+        """``segments`` shortened across their switches (or, without switches, through a via
+        pose) on a grid ``level`` times finer than :meth:`shortcut`'s, until the deadline: the
+        refining grid of the improvement rounds."""
+        grid = self._grid.refined(level)
+        refined = SwitchShortcut(self.scene, self._dubins.curves, self.model, self.transits,
+                                 self.scene.planner.switch_cost, grid, via=True, deadline=self.deadline)(segments)
+        return self._dubins(refined)
 
     def direct(self, region: GoalRegion, goal: int = 0) -> list[Push | Transit] | None:
         """The cheapest plan of one or two pushes on a start edge, as in the paper's one-step

@@ -40,8 +40,8 @@ from .goal import PushGoal
 from .goal_region import GoalRegion
 from .spaces import pose_of, space_information
 
-__all__ = ["plan", "plan_batch", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS", "ROUND_ITERATIONS",
-           "ROUND_MIN_ITERATIONS"]
+__all__ = ["plan", "plan_batch", "MAX_REFINEMENT", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
+           "ROUND_ITERATIONS", "ROUND_MIN_ITERATIONS"]
 
 #: When the first plan still switches once shortened (the switch-pose shortcut drops a switch
 #: wherever one edge joins its ends through a via pose), a search without switches gets this many
@@ -54,6 +54,11 @@ ONE_EDGE_ITERATIONS, ONE_EDGE_MIN_ITERATIONS = 1, 250
 #: at least ``ROUND_MIN_ITERATIONS``).
 ROUND_ITERATIONS, ROUND_MIN_ITERATIONS = 2, 1000
 
+#: Improvement rounds alternate: a new search, then the plan so far shortened on a grid of
+#: switch (or via) poses finer by one level (:meth:`~planner.actions.switch_pose.Grid.refined`)
+#: than the round before's, up to this level (a grid of 64 times the default's poses; each level
+#: also ends at the time limit).
+MAX_REFINEMENT = 3
 _ROUND_SEEDS = 1_000_003
 _RECHECK = "a switch of the path found no transit when its poses were re-composed"
 _PLANNERS: dict[str, Callable] = {"rrt": oc.RRT, "kpiece": oc.KPIECE1, "est": oc.EST}
@@ -84,9 +89,10 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
     regions that must be computed.
 
     ``optimize`` (default: ``planner.optimize``) is a number of improvement rounds: after the
-    first plan, each round searches again with a seed of its own (drawn from ``seed``) and twice
-    the first search's iterations, and its plan, shortened like the first, replaces the plan if it
-    costs less. Rounds are counted, not timed, so a seed still gives one plan; they stop early at
+    first plan, odd rounds search again with a seed of their own (drawn from ``seed``) and twice
+    the first search's iterations, and even rounds shorten the plan so far on a grid of switch
+    (or via) poses finer each time (:data:`MAX_REFINEMENT`); a round's plan replaces the plan if
+    it costs less. Rounds are counted, not timed, so a seed still gives one plan; they stop early at
     the time limit. ``Plan.improvements`` holds the time, cost and length of the first plan and of
     each better one. A plan of one or two pushes
     from the start (found before any search) is not searched again.
@@ -125,11 +131,20 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
             segments = plain
     improvements = [(time.perf_counter() - clock, cost(scene, segments), length(scene, segments))]
     budget = max(ROUND_ITERATIONS * iterations, ROUND_MIN_ITERATIONS)
+    refined: tuple[int, int] | None = None  # the grid level and plan last refined
     for r in range(1, request.optimize + 1):
         if time.perf_counter() >= context.deadline:
             break
-        other, _, _ = search.run(region, budget, (request.seed + r * _ROUND_SEEDS) % MAX_SEED + 1)
-        if other is not None and cost(scene, other := context.shortcut(other)) < cost(scene, segments):
+        if r % 2 == 0:  # the plan so far on a grid finer every other round
+            level = min(r // 2, MAX_REFINEMENT)
+            if refined == (level, id(segments)):
+                continue  # the same grid gives the same plan
+            refined = (level, id(segments))
+            other = context.refine(segments, level)
+        else:
+            other, _, _ = search.run(region, budget, (request.seed + r * _ROUND_SEEDS) % MAX_SEED + 1)
+            other = context.shortcut(other) if other is not None else None
+        if other is not None and cost(scene, other) < cost(scene, segments):
             segments = other
             improvements.append((time.perf_counter() - clock, cost(scene, segments), length(scene, segments)))
     result = context.result(scene.goal, segments, tree=tree)
