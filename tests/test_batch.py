@@ -100,6 +100,20 @@ def test_a_worker_killed_mid_task_is_replaced_and_its_task_run_again(tmp_path):
     assert [pid for pid in workers if Path(f"/proc/{pid}").exists()] == []  # every worker stopped and reaped
 
 
+def test_a_worker_killed_while_idle_is_replaced_before_its_next_call():
+    with LocalExecutor(1) as pool:
+        runs = pool.run(_pid, [0, 1])
+        _, first = next(runs)
+        os.kill(first.value, signal.SIGKILL)  # between its calls
+        time.sleep(0.2)
+        _, second = next(runs)
+    assert not second.failed and second.value != first.value and second.attempts == 1
+
+
+def _pid(item, shared) -> int:
+    return os.getpid()
+
+
 def _dies(item, shared):
     os.kill(os.getpid(), signal.SIGKILL)
 

@@ -180,12 +180,20 @@ class LocalExecutor:
             while waiting or any(w.index is not None for w in pool):
                 while waiting and len(pool) < self.workers:
                     pool.append(_Worker(self._context, shared))
-                for worker in pool:
+                for worker in list(pool):
                     if worker.index is None and waiting:
                         index = waiting.popleft()
+                        try:
+                            worker.begin(index, fn, items[index])
+                        except OSError:  # it died while idle: replaced, the call not begun
+                            waiting.appendleft(index)
+                            pool.remove(worker)
+                            worker.kill()
+                            continue
                         attempts[index] += 1
-                        worker.begin(index, fn, items[index])
                 busy = [w for w in pool if w.index is not None]
+                if not busy:  # every worker free died: start others
+                    continue
                 soonest = min((w.began + timeout for w in busy), default=None) if timeout else None
                 ready = wait([w.conn for w in busy] + [w.process.sentinel for w in busy],
                              None if soonest is None else max(0.0, soonest - time.monotonic()))
@@ -196,6 +204,7 @@ class LocalExecutor:
                         continue
                     if outcome == "died":
                         pool.remove(worker)
+                        worker.process.join(1.0)  # its own exit code, if it is exiting of itself
                         worker.kill()
                         code = worker.process.exitcode
                         why = (f"its worker died (signal {-code})" if code is not None and code < 0
