@@ -36,10 +36,11 @@ def test_open_table_plans_are_near_dubins_and_stable(part, task):
 
 
 def test_improvement_rounds_only_shorten_and_repeat():
-    """Cluttered, seed 1: two more searches find a cheaper plan. The improved plan costs no more
-    than the first, whose cost and length (and each better plan's) its improvements report, in
-    the order found; it is the same plan on a second run with the seed, and replays independently."""
-    path = ROOT / "scenes" / "cluttered.yaml"
+    """Corridor, seed 1: two improvement rounds (a search, then the plan on a finer grid) find a
+    cheaper plan. The improved plan costs no more than the first, whose cost and length (and each
+    better plan's) its improvements report, in the order found; it is the same plan on a second
+    run with the seed, and replays independently."""
+    path = ROOT / "scenes" / "corridor.yaml"
     scene = load_scene(path)
     first = plan(scene, seed=1, time_limit=30)
     better = plan(scene, seed=1, time_limit=30, optimize=2)
