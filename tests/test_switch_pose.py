@@ -25,8 +25,9 @@ from planner.actions.car import edge_car
 from planner.actions.controls import clearance_margin, edge_controls
 from planner.actions.dubins import DubinsCurves
 from planner.actions.push import connect
-from planner.actions.switch_pose import Grid, SwitchShortcut, cf_poses, runs
+from planner.actions.switch_pose import Grid, SwitchShortcut, runs
 from planner.actions.transit import TransitPlanner
+from planner.model.bodies import cf_poses
 from planner.model.plan_file import Plan, rechain
 from planner.model.scene import load_scene
 from planner.queries.geodesic import geodesic_bound

@@ -146,8 +146,8 @@ class DubinsCurves:
         return self.space.distance(self._a, self._b)
 
     def lengths(self, a: ArrayLike, b: ArrayLike) -> np.ndarray:
-        """Dubins lengths from car states ``a`` to car states ``b`` (rows ``(x, y, psi)``, one of
-        them may be a single row, broadcast against the other).
+        """Dubins lengths from car states ``a`` to car states ``b`` (rows ``(x, y, psi)``): from
+        one state to each of many, or from each of many to one.
 
         Straight ahead, and back where it started:
 
@@ -161,20 +161,16 @@ class DubinsCurves:
         [0.3, 0.0]
         """
         a, b = np.asarray(a, dtype=float).reshape(-1, 3), np.asarray(b, dtype=float).reshape(-1, 3)
-        # One end is usually fixed: it is set once (setting states costs more than the distance;
-        # docs/stack.md, "Dubins curves").
-        fixed, moving, other = (self._a, self._b, b) if len(a) == 1 else (self._b, self._a, a)
-        if len(a) == 1 or len(b) == 1:
-            x, y, psi = (a if len(a) == 1 else b)[0].tolist()
-            fixed.setXY(x, y), fixed.setYaw(psi)
-            out = np.empty(len(other))
-            for i, (x, y, psi) in enumerate(other.tolist()):
-                moving.setXY(x, y), moving.setYaw(psi)
-                out[i] = self.space.distance(self._a, self._b)
-            return out
-        out = np.empty(len(a))
-        for i, (p, q) in enumerate(zip(a.tolist(), b.tolist())):
-            self.states(p, q)
+        if len(a) != 1 and len(b) != 1:
+            raise ValueError(f"one end must be a single state, got {len(a)} and {len(b)}")
+        # The single end is set once: setting states costs more than the distance
+        # (docs/stack.md, "Dubins curves").
+        fixed, moving, many = (self._a, self._b, b) if len(a) == 1 else (self._b, self._a, a)
+        x, y, psi = (a if len(a) == 1 else b)[0].tolist()
+        fixed.setXY(x, y), fixed.setYaw(psi)
+        out = np.empty(len(many))
+        for i, (x, y, psi) in enumerate(many.tolist()):
+            moving.setXY(x, y), moving.setYaw(psi)
             out[i] = self.space.distance(self._a, self._b)
         return out
 

@@ -38,15 +38,15 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
-from numpy.typing import ArrayLike
 
+from ..model.bodies import cf_poses, place
 from ..model.plan_file import Push, Transit, rechain
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 from .dubins import DubinsCurves
 from .transit import TransitPlanner
 
-__all__ = ["Grid", "SwitchShortcut", "cf_points", "cf_poses", "runs"]
+__all__ = ["Grid", "SwitchShortcut", "runs"]
 
 #: Least relative gain for which a stretch of plan is replaced (its Dubins pieces are pushes too).
 _GAIN = 1e-3
@@ -126,19 +126,6 @@ def runs(segments: list[Push | Transit]) -> tuple[list[list[Push]], list[Transit
     return out, transits
 
 
-def cf_poses(cf: ArrayLike, xy: ArrayLike, theta: ArrayLike) -> np.ndarray:
-    """Slider poses ``(n, 3)`` that put the slider-frame point ``cf`` at world points ``xy``
-    ``(n, 2)`` with headings ``theta`` ``(n,)``.
-
-    >>> cf_poses([0.1, 0.0], [[1.0, 1.0]], [np.pi / 2]).round(12).tolist()
-    [[1.0, 0.9, 1.570796326795]]
-    """
-    xy, theta = np.asarray(xy, dtype=float).reshape(-1, 2), np.asarray(theta, dtype=float).reshape(-1)
-    c, s = np.cos(theta), np.sin(theta)
-    cx, cy = np.asarray(cf, dtype=float)
-    return np.column_stack([xy[:, 0] - (c * cx - s * cy), xy[:, 1] - (s * cx + c * cy), theta])
-
-
 #: A stretch of plan through one switch pose: the pushes to it, the transit there (None for a
 #: via pose on one edge) and the pushes from it.
 Stretch = tuple[list[Push], "Transit | None", list[Push]]
@@ -199,8 +186,7 @@ class SwitchShortcut:
         self.radius = scene.slider.radius
         self.grid, self.via, self.deadline = grid, via, deadline
         self._ends: dict[tuple[int, bytes], np.ndarray] = {}
-        xmin, ymin, xmax, ymax = scene.workspace
-        self._workspace = (xmin, ymin, xmax, ymax)
+        self._workspace = scene.workspace
 
     def __call__(self, segments: list[Push | Transit]) -> list[Push | Transit]:
         legs, transits = runs(segments)
@@ -232,9 +218,9 @@ class SwitchShortcut:
         """A plan without switches replaced by two Dubins curves of its edge's car through a via
         pose, where that is cheaper."""
         begin, end, edge = segments[0].start, segments[-1].end, segments[0].edge
-        along = np.array([_part_of(p, f).end for p in segments for f in _ALONG])
         if edge not in self.curves:
             return segments
+        along = np.array([_part_of(p, f).end for p in segments for f in _ALONG])
         found = self.best(begin, edge, end, edge, self._cf_length(segments) * (1.0 - _GAIN), along[len(along) // 2],
                           along)
         return segments if found is None else rechain(found[0] + found[2], begin)
@@ -296,8 +282,8 @@ class SwitchShortcut:
             if self._late():
                 break
             chunk = poses[k:k + _CHUNK]
-            out[k:k + _CHUNK] = (ca.lengths(ca.car.state(begin)[None], ca.car.states(chunk))
-                                 + cb.lengths(cb.car.states(chunk), cb.car.state(end)[None]))
+            out[k:k + _CHUNK] = (ca.lengths(self._end_state(a, begin)[None], ca.car.states(chunk))
+                                 + cb.lengths(cb.car.states(chunk), self._end_state(b, end)[None]))
         return out
 
     def best(self, begin: np.ndarray, a: int, end: np.ndarray, b: int, below: float,
@@ -367,7 +353,7 @@ class SwitchShortcut:
         where its disk fits: headings every :attr:`Grid.heading` degrees, or coarser (down to
         every 15 degrees, then with the CF spacing doubled) to keep to :attr:`Grid.candidates`."""
         g = self.grid
-        (fa, fb, fn) = cf_points(self.cf, np.array([begin, end, near]))
+        fa, fb, fn = place(self.cf[None], np.array([begin, end, near]))[:, 0]
         xmin, ymin, xmax, ymax = self._workspace
         h = g.spacing * self.radius
         while True:
@@ -426,15 +412,3 @@ class SwitchShortcut:
 def _part_of(push: Push, fraction: float) -> Push:
     """The first ``fraction`` of ``push``."""
     return Push.along(push.edge, push.contact, push.twist, push.duration * fraction, push.start)
-
-
-def cf_points(cf: ArrayLike, poses: ArrayLike) -> np.ndarray:
-    """World positions ``(n, 2)`` of the slider-frame point ``cf`` at slider ``poses`` ``(n, 3)``.
-
-    >>> cf_points([0.1, 0.0], cf_poses([0.1, 0.0], [[1.0, 1.0]], [0.3])).round(12).tolist()
-    [[1.0, 1.0]]
-    """
-    q = np.asarray(poses, dtype=float).reshape(-1, 3)
-    c, s = np.cos(q[:, 2]), np.sin(q[:, 2])
-    cx, cy = np.asarray(cf, dtype=float)
-    return np.column_stack([q[:, 0] + c * cx - s * cy, q[:, 1] + s * cx + c * cy])

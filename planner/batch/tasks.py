@@ -31,7 +31,6 @@ from ..model.plan_file import Plan
 from ..model.scene import Scene, load_scene
 from ..queries.reachability import certify_unreachable
 from ..search import plan
-from ..search.context import cost
 
 __all__ = ["OVERRIDES", "Task", "make_tasks", "parse_seeds", "run_task", "shared_regions"]
 
@@ -198,8 +197,8 @@ def run_task(task: Task, shared: Mapping[str, Any] | None) -> dict[str, Any]:
     else:
         result = plan(scene, seed=task.seed)
     status = "solved" if result.solved else "unreachable" if unreachable else "unknown"
-    return {"status": status, "cost": cost(scene, result.segments) if result.solved else None,
-            "length": result.path_length(scene.slider.cf) if result.solved else None,
+    return {"status": status, "cost": result.cost if result.solved else None,
+            "length": result.length if result.solved else None,
             "pushes": result.pushes, "switches": result.switches, "planning_time_s": result.planning_time_s,
             "reason": result.reason, "regions_computed": missing, "host": socket.gethostname(),
             "plan": result.to_json()}

@@ -32,12 +32,12 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
 
 from ..actions.car import edge_car
 from ..actions.dubins import DubinsCurves
 from ..queries.geodesic import geodesic_bound
 from ..actions.controls import edge_controls
+from ..model.bodies import cf_poses
 from ..model.scene import Scene, load_scene
 from ..batch.engines import map_ordered
 from ..search import plan
@@ -50,18 +50,12 @@ TASKS = {"ahead+90": ((1.0, 0.0), 90.0), "side": ((0.0, 0.5), 0.0), "behind+180"
          "behind": ((-0.3, 0.0), 0.0)}
 
 
-def _pose_with_cf_at(scene: Scene, xy, theta: float) -> np.ndarray:
-    c, s = math.cos(theta), math.sin(theta)
-    cx, cy = scene.slider.cf
-    return np.array([xy[0] - (c * cx - s * cy), xy[1] - (s * cx + c * cy), theta])
-
-
 def open_task(scene: Scene, task: str) -> Scene:
     """``scene``'s part and pusher on an empty 4 x 4 m table, its CF at the origin, heading 0."""
     target, turn = TASKS[task]
     return replace(scene, name=f"{scene.name}:{task}", obstacles=(), workspace=(-2.0, -2.0, 2.0, 2.0),
-                   start=_pose_with_cf_at(scene, (0.0, 0.0), 0.0),
-                   goal=_pose_with_cf_at(scene, target, math.radians(turn)), path=None)
+                   start=cf_poses(scene.slider.cf, [0.0, 0.0], [0.0])[0],
+                   goal=cf_poses(scene.slider.cf, target, [math.radians(turn)])[0], path=None)
 
 
 def dubins_length(scene: Scene) -> float:

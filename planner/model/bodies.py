@@ -13,7 +13,8 @@ from numpy.typing import ArrayLike
 
 from mechanics import Slider
 
-__all__ = ["body_outline", "place", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at", "transform_points"]
+__all__ = ["body_outline", "cf_poses", "place", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at",
+           "transform_points"]
 
 
 def transform_points(points: ArrayLike, pose: ArrayLike) -> np.ndarray:
@@ -37,6 +38,20 @@ def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
     c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
     x, y = points[:, 0], points[:, 1]
     return np.stack([c * x - s * y + poses[:, :1], s * x + c * y + poses[:, 1:2]], axis=-1)
+
+
+def cf_poses(cf: ArrayLike, xy: ArrayLike, theta: ArrayLike) -> np.ndarray:
+    """Slider poses ``(n, 3)`` that put the slider-frame point ``cf`` at world points ``xy``
+    ``(n, 2)`` with headings ``theta`` ``(n,)``: the inverse of :func:`place` for one point.
+
+    >>> poses = cf_poses([0.1, 0.0], [[1.0, 1.0]], [np.pi / 2])
+    >>> poses.round(12).tolist(), place(np.array([[0.1, 0.0]]), poses)[:, 0].round(12).tolist()
+    ([[1.0, 0.9, 1.570796326795]], [[1.0, 1.0]])
+    """
+    xy, theta = np.asarray(xy, dtype=float).reshape(-1, 2), np.asarray(theta, dtype=float).reshape(-1)
+    c, s = np.cos(theta), np.sin(theta)
+    cx, cy = np.asarray(cf, dtype=float)
+    return np.column_stack([xy[:, 0] - (c * cx - s * cy), xy[:, 1] - (s * cx + c * cy), theta])
 
 
 def slider_at(polygon: shapely.Polygon, pose: ArrayLike) -> shapely.Polygon:
