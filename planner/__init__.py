@@ -18,15 +18,15 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from .execution.verify import Verification, verify
     from .model.fields import SceneError
-    from .model.options import DEFAULT_PLANNER
+    from .model.options import DEFAULT_PLANNER, PlannerOptions
     from .model.plan_file import Plan, Push, Transit, load_plan
     from .model.scene import Scene, load_scene, parse_scene
     from .queries.controllability import SceneControllability, controllability
     from .queries.one_step import OneStep, one_step
-    from .queries.reachability import Reach, certify_unreachable, reachability
-    from .search import plan
+    from .queries.reachability import Reach, certify_unreachable
+    from .queries.session import Planner, plan, reachability
 
-__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Reach", "Scene", "SceneError", "Push", "Transit",
+__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Planner", "PlannerOptions", "Reach", "Scene", "SceneError", "Push", "Transit",
            "certify_unreachable", "load_plan", "load_scene", "one_step", "parse_scene", "plan", "reachability",
            "Verification", "verify", "SceneControllability", "controllability"]
 
@@ -35,12 +35,13 @@ __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Reach", "Scene", "SceneError",
 #: controllability report (scipy) and the re-simulator are loaded only where used
 #: (tests/test_startup.py).
 _ON_FIRST_USE = {
-    "SceneError": ".model.fields", "DEFAULT_PLANNER": ".model.options",
+    "SceneError": ".model.fields", "DEFAULT_PLANNER": ".model.options", "PlannerOptions": ".model.options",
+    "Planner": ".queries.session",
     "Plan": ".model.plan_file", "Push": ".model.plan_file", "Transit": ".model.plan_file",
     "load_plan": ".model.plan_file", "Scene": ".model.scene", "load_scene": ".model.scene",
     "parse_scene": ".model.scene", "OneStep": ".queries.one_step", "one_step": ".queries.one_step",
     "Reach": ".queries.reachability", "certify_unreachable": ".queries.reachability",
-    "reachability": ".queries.reachability", "plan": ".search",
+    "reachability": ".queries.session", "plan": ".queries.session",
     "SceneControllability": ".queries.controllability", "controllability": ".queries.controllability",
     "Verification": ".execution.verify", "verify": ".execution.verify",
 }

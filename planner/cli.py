@@ -52,7 +52,7 @@ from .actions.region_cache import cache_folder
 from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_OPTIMIZE, MAX_SEED, MAX_TIME_LIMIT,
                             PLANNERS, REGIONS, TRANSITS, PlannerOptions, check_optimize, check_seed, check_time_limit)
 from .model.scene import Scene, load_scene
-from .search import plan
+from .queries.session import plan
 
 if TYPE_CHECKING:
     from .execution.trajectory import Trajectory

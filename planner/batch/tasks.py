@@ -30,7 +30,7 @@ from ..model.options import (check_optimize, check_planner, check_regions, check
 from ..model.plan_file import Plan
 from ..model.scene import Scene, load_scene
 from ..queries.reachability import certify_unreachable
-from ..search import plan
+from ..queries.session import plan
 
 __all__ = ["OVERRIDES", "Task", "make_tasks", "parse_seeds", "run_task", "shared_regions"]
 

@@ -18,7 +18,7 @@ from collections import Counter
 import numpy as np
 
 from ..actions.controls import edge_controls
-from ..queries.reachability import reachability
+from ..queries.session import reachability
 from ..model.scene import load_scene
 
 __all__ = ["main", "sample_goals"]

@@ -21,9 +21,7 @@ from mechanics import Slider, wrap_angle
 
 from .bodies import slider_at
 from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vector
-from .options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEFAULT_TRANSIT, PlannerOptions,
-                      check_optimize, check_planner, check_regions, check_seed, check_switch_cost, check_time_limit,
-                      check_transit)
+from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
 from .yaml_file import read_yaml
 
 __all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene"]
@@ -283,14 +281,7 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
                                             f"of a plan's headings is about 1e-11 rad), got {math.degrees(tol_ang):g}")
     opts = keys(spec.get("planner", {}), "planner", (),
                 ("name", "time_limit", "seed", "regions", "switch_cost", "optimize"))
-    planner = PlannerOptions(
-        name=check_planner(opts.get("name", DEFAULT_PLANNER), "planner.name"),
-        time_limit=check_time_limit(opts.get("time_limit", PlannerOptions.time_limit), "planner.time_limit"),
-        seed=check_seed(opts.get("seed", PlannerOptions.seed), "planner.seed"),
-        regions=check_regions(opts.get("regions", DEFAULT_REGIONS), "planner.regions"),
-        switch_cost=check_switch_cost(opts.get("switch_cost", DEFAULT_SWITCH_COST), "planner.switch_cost"),
-        optimize=check_optimize(opts.get("optimize", PlannerOptions.optimize), "planner.optimize"),
-    )
+    planner = PlannerOptions().merged(opts, prefix="planner.")
     return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path,
                  cf_uncertainty)
 

@@ -1,8 +1,8 @@
 """Planning pushes among obstacles with OMPL's control planners (Lynch & Mason 1996, §4).
 
-:func:`plan` answers one goal, :func:`plan_batch` many with one search tree. Each run checks its
-request (:class:`~planner.search.context.PlanRequest`), builds its context once
-(:class:`~planner.search.context.PlanningContext`), tries the direct connection from the start,
+:func:`solve` answers one goal, :func:`solve_many` many with one search tree, each on a
+:class:`~planner.search.context.PlanningContext` (a run of a request on a world built once:
+:class:`~planner.search.context.SearchWorld`). A run tries the direct connection from the start,
 and otherwise grows OMPL trees over the spaces of :mod:`planner.search.spaces` towards the goal
 region of :mod:`planner.search.goal_region`; the path found is decoded with the goal test's own
 connection (:mod:`planner.search.decode`) and shortened (:mod:`planner.actions.shortcut`).
@@ -22,25 +22,22 @@ import time
 from collections.abc import Callable, Iterator
 
 import numpy as np
-from numpy.typing import ArrayLike
 from ompl import base as ob
 from ompl import control as oc
 from ompl import util as ou
 
 from mechanics import wrap_angle
 
-from ..actions.controls import RegionTimeout
 from ..model.plan_file import Plan, Push, Transit
 from ..model.options import MAX_SEED
-from ..model.scene import Scene
 from ..model.stop import signals_deferred
 from . import decode
-from .context import PlanningContext, PlanRequest, Prebuilt, cost, length
+from .context import PlanningContext, cost, length
 from .goal import PushGoal
 from .goal_region import GoalRegion
 from .spaces import pose_of, space_information
 
-__all__ = ["plan", "plan_batch", "MAX_REFINEMENT", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
+__all__ = ["solve", "solve_many", "MAX_REFINEMENT", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
            "ROUND_ITERATIONS", "ROUND_MIN_ITERATIONS"]
 
 #: When the first plan still switches once shortened (the switch-pose shortcut drops a switch
@@ -72,64 +69,33 @@ def _seed_ompl(seed: int) -> None:
     ou.setLogLevel(ou.LOG_ERROR)
 
 
-def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
-         regions: str | None = None, transit: str | None = None, switch_cost: float | None = None,
-         progress: Callable[[int, int], None] | None = None, *, optimize: int | None = None,
-         prebuilt: Prebuilt | None = None) -> Plan:
-    """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``.
-
-    Arguments left as ``None`` take the scene's options: ``regions`` is ``'stable'`` (procedure
-    STABLE) or ``'exact'`` (the exact region, the default); ``transit`` is ``'plane'``, ``'lift'``
-    or ``'none'`` (``pusher.transit``); ``switch_cost`` is in metres (``planner.switch_cost``). With a
-    given seed, a run that solves within the time limit returns the same plan every time.
-
-    The time limit bounds the edges' stable regions (computed once per part and cached; they may
-    take half of it: a part with many edges plans with those done in time, and says so in
-    ``Plan.note``, or ends unsolved if none is) and the search together; ``progress(k, n)`` hears of the ``k``-th of the ``n``
-    regions that must be computed.
-
-    ``optimize`` (default: ``planner.optimize``) is a number of improvement rounds: after the
-    first plan, odd rounds search again with a seed of their own (drawn from ``seed``) and twice
-    the first search's iterations, and even rounds shorten the plan so far on a grid of switch
-    (or via) poses finer each time (:data:`MAX_REFINEMENT`); a round's plan replaces the plan if
-    it costs less. Rounds are counted, not timed, so a seed still gives one plan; they stop early at
-    the time limit. ``Plan.improvements`` holds the time, cost and length of the first plan and of
-    each better one. A plan of one or two pushes
-    from the start (found before any search) is not searched again.
-
-    ``prebuilt`` is the edges' pushes and the collision model (built with ``scene.pusher.edges``)
-    for this scene's part, pusher and options, as :func:`planner.reachability` shares them between
-    goals; they are then not rebuilt, and the time limit is the search's alone.
-
-    Raises
-    ------
-    SceneError
-        If an option is invalid or no allowed edge can start pushing.
+def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
+    """Plan guaranteed-stable pushes from ``context.start`` to ``goal`` (radians) on the context's
+    world, within its deadline: the search, the shortcuts and the improvement rounds
+    (``request.optimize``: odd rounds search again with a seed of their own drawn from the
+    request's and twice the first search's iterations, even rounds shorten the plan so far on a
+    grid of switch or via poses finer each time, :data:`MAX_REFINEMENT`; a round's plan replaces
+    the plan if it costs less, and rounds stop early at the deadline). A plan of one or two
+    pushes from the start (found before any search) is not searched again.
     """
-    request = PlanRequest.of(scene, seed=seed, time_limit=time_limit, planner=planner, regions=regions,
-                             transit=transit, switch_cost=switch_cost, optimize=optimize)
-    scene, clock = request.scene, time.perf_counter()
-    try:
-        context = PlanningContext(request, clock, progress, prebuilt)
-    except RegionTimeout as timeout:  # no edge's region in time
-        return request.result(clock, scene.goal, [], str(timeout))
-    if scene.within_tolerance(scene.start):
-        return _found_at_once(context.result(scene.goal, []))
-    region = context.goal_region(scene.goal)
+    request, scene = context.request, context.scene
+    if scene.within_tolerance(context.start, goal):
+        return context.result(goal, [])
+    region = context.goal_region(goal)
     direct = context.direct(region)
     if direct:
-        return _found_at_once(context.result(scene.goal, direct))
+        return context.result(goal, direct)
     search = _Search(context)
     segments, tree, iterations = search.run(region)
     if segments is None:
-        return context.result(scene.goal, [], _RECHECK if tree is None else request.out_of_time, tree)
+        return context.result(goal, [], _RECHECK if tree is None else request.out_of_time, tree)
     segments = context.shortcut(segments)
     if any(s.kind == "transit" for s in segments):
         budget = max(ONE_EDGE_ITERATIONS * iterations, ONE_EDGE_MIN_ITERATIONS)
         plain, _, _ = search.run(region.without_switches(), budget)
         if plain is not None and cost(scene, plain := context.shortcut(plain)) <= cost(scene, segments):
             segments = plain
-    improvements = [(time.perf_counter() - clock, cost(scene, segments), length(scene, segments))]
+    improvements = [(time.perf_counter() - context.clock, cost(scene, segments), length(scene, segments))]
     budget = max(ROUND_ITERATIONS * iterations, ROUND_MIN_ITERATIONS)
     refined: tuple[int, int] | None = None  # the grid level and plan last refined
     for r in range(1, request.optimize + 1):
@@ -146,57 +112,36 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
             other = context.shortcut(other) if other is not None else None
         if other is not None and cost(scene, other) < cost(scene, segments):
             segments = other
-            improvements.append((time.perf_counter() - clock, cost(scene, segments), length(scene, segments)))
-    result = context.result(scene.goal, segments, tree=tree)
-    result.improvements = improvements
-    return result
+            improvements.append((time.perf_counter() - context.clock, cost(scene, segments), length(scene, segments)))
+    return context.result(goal, segments, tree=tree, improvements=improvements)
 
 
-def _found_at_once(result: Plan) -> Plan:
-    """``result``, found before any search: its one improvement is itself."""
-    result.improvements = [(result.planning_time_s, result.cost, result.length)]
-    return result
-
-
-def plan_batch(scene: Scene, goals: ArrayLike, seed: int | None = None, time_limit: float | None = None, *,
-               prebuilt: Prebuilt | None = None) -> list[Plan]:
-    """One :class:`Plan` per goal (rows ``(x, y, theta)``, radians) from ``scene.start``, grown
+def solve_many(context: PlanningContext, goals: np.ndarray, shorten: bool = True) -> list[Plan]:
+    """One :class:`Plan` per goal (rows ``(x, y, theta)``, radians) from ``context.start``, grown
     as one search tree.
 
-    Each goal first gets the direct connection (one or two pushes, as in :func:`plan`); the goals
+    Each goal first gets the direct connection (one or two pushes, as in :func:`solve`); the goals
     left share one OMPL search: every new tree state is tested against all goals not yet reached,
-    and when one is, its path is taken and the same tree grows on towards the rest. The time limit
-    (default: the scene's) bounds that shared search as a whole, so each goal gets the full time
-    limit of tree growth for the price of one. Plans are shortcut as :func:`plan`'s are, but
-    a plan with switches gets no second, one-edge search: a batch answers where the part can go,
-    :func:`plan` also what it costs. ``seed`` and ``prebuilt`` are as for :func:`plan`.
-
-    >>> from planner import load_scene
-    >>> scene = load_scene("scenes/battery.yaml")
-    >>> [p.solved for p in plan_batch(scene, [scene.goal, scene.start])]
-    [True, True]
+    and when one is, its path is taken and the same tree grows on towards the rest, until the
+    context's deadline, so each goal gets the full time of tree growth for the price of one.
+    Plans are shortcut as :func:`solve`'s are (unless not ``shorten``: a plan as found still
+    reaches its goal and verifies), but a plan with switches gets no second, one-edge search: a
+    batch answers where the part can go, :func:`solve` also what it costs.
     """
-    request = PlanRequest.of(scene, seed=seed, time_limit=time_limit)
-    scene, clock = request.scene, time.perf_counter()
-    goals = np.array(goals, dtype=float).reshape(-1, 3)
-    goals[:, 2] = wrap_angle(goals[:, 2])
-    try:
-        context = PlanningContext(request, clock, None, prebuilt)
-    except RegionTimeout as timeout:
-        return [request.result(clock, g, [], str(timeout)) for g in goals]
-    region = context.goal_region(goals)
     found: dict[int, Plan] = {}  # each timed when found
+    region = context.goal_region(goals)
     for i, goal in enumerate(goals):
-        if scene.within_tolerance(scene.start, goal):
+        if context.scene.within_tolerance(context.start, goal):
             found[i] = context.result(goal, [])
-        elif (direct := context.direct(region, i)) is not None:
+        elif (direct := context.direct(region, i, shorten)) is not None:
             found[i] = context.result(goal, direct)
     rest = [i for i in range(len(goals)) if i not in found]
     if rest:
         for i, segments in _Search(context).grow(region, rest):
             found[i] = (context.result(goals[i], [], _RECHECK) if segments is None
-                        else context.result(goals[i], context.shortcut(segments)))
-    return [found[i] if i in found else context.result(g, [], request.out_of_time) for i, g in enumerate(goals)]
+                        else context.result(goals[i], context.shortcut(segments) if shorten else segments))
+    return [found[i] if i in found else context.result(g, [], context.request.out_of_time)
+            for i, g in enumerate(goals)]
 
 
 class _Search:
@@ -208,13 +153,13 @@ class _Search:
     def _setup(self, region: GoalRegion, seed: int | None = None):
         context = self.context
         _seed_ompl(context.request.seed if seed is None else seed)
-        scene = context.scene
-        space, si = space_information(scene, context.controls, context.model, context.step, region.transits)
+        space, si = space_information(context.scene, context.controls, context.model, context.step, region.transits)
         ss = oc.SimpleSetup(si)
+        start = context.start
         for k in context.starts:
             s = space.allocState()
-            s[0].setXY(float(scene.start[0]), float(scene.start[1]))
-            s[0].setYaw(float(wrap_angle(scene.start[2])))
+            s[0].setXY(float(start[0]), float(start[1]))
+            s[0].setYaw(float(wrap_angle(start[2])))
             s[1].value = k
             ss.addStartState(s)
         goal = PushGoal(si, region)
