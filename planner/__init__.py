@@ -1,5 +1,21 @@
 """Planning guaranteed-stable pushes among obstacles (Lynch & Mason 1996, §4).
 
+A :class:`Planner` session sets a scene up once (its edges' stable regions, the collision model,
+the transits between edges) and then answers many plans, re-plans and reachability queries;
+poses are ``(x, y, theta)`` in metres and **radians** (a scene file's are in degrees):
+
+>>> from planner import Planner, load_scene
+>>> session = Planner(load_scene("scenes/parking.yaml"), {"seed": 1})
+>>> first = session.plan()                        # from the scene's start to its goal
+>>> first.solved, first.cost < 1.0                # metres of the part's path, plus each switch's cost
+(True, True)
+>>> moved = session.plan(start=session.scene.start + [0.005, 0.0, 0.02])  # re-plan: joins the first
+>>> moved.solved
+True
+>>> [a.status for a in session.reachability([[0.3, 0.3, 0.0], [0.0, -0.04, 0.0]])]  # the 2nd is in a wall
+['reachable', 'unreachable']
+
+:func:`plan` and :func:`reachability` are the same asked once of a fresh session.
 :func:`load_scene` reads a YAML scene, :func:`plan` searches with OMPL, :func:`one_step` answers
 the paper's one-step question, :func:`reachability` answers reachable / unreachable (certified) /
 unknown for many goals, :func:`controllability` says what the stable pushes can reach (1996 §2-3),

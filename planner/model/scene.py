@@ -9,7 +9,7 @@ documented in the README.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -69,6 +69,12 @@ class Scene:
     planner: PlannerOptions = field(default_factory=PlannerOptions)
     path: str | None = None  # the file it was read from
     cf_uncertainty: float = 0.0  # radius of the disk about slider.cf holding the true CF (metres)
+
+    def with_options(self, options: PlannerOptions) -> "Scene":
+        """This scene as planned with ``options``: its ``planner`` block replaced, and its
+        ``pusher.transit`` where the options name one."""
+        pusher = self.pusher if options.transit is None else replace(self.pusher, transit=options.transit)
+        return replace(self, planner=options, pusher=pusher)
 
     def within_tolerance(self, pose: ArrayLike, goal: ArrayLike | None = None) -> bool:
         """Whether ``pose`` ends the task: its origin within ``tolerance_position`` of ``goal``'s

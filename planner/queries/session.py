@@ -103,10 +103,9 @@ class Planner:
             self.options = scene.planner.merged(options)
         else:
             raise SceneError("options", f"must be PlannerOptions or a mapping, got {type(options).__name__}")
-        pusher = scene.pusher if self.options.transit is None else replace(scene.pusher, transit=self.options.transit)
         #: The scene as planned: its ``planner`` block is these options.
-        self.scene = replace(scene, planner=self.options, pusher=pusher)
-        self.model = CollisionModel(self.scene, pusher.edges)
+        self.scene = scene.with_options(self.options)
+        self.model = CollisionModel(self.scene, self.scene.pusher.edges)
         self.certificates = Certificates(self.scene, self.model)
         self.world: SearchWorld | None = None
         self._no_push: NoStablePush | None = None
