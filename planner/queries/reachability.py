@@ -165,7 +165,7 @@ def _no_stable_push_reason(why: str | None) -> str | None:
 
 
 def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | None], goals: np.ndarray,
-            pushes: int | None = None) -> list[Reach]:
+            pushes: int | None = None, timings: dict[str, float] | None = None) -> list[Reach]:
     """One :class:`Reach` per goal (rows ``(x, y, theta)``, radians) from ``scene.start`` (the
     context's), given each goal's certificate (``reasons``, None where none fired).
 
@@ -175,7 +175,8 @@ def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | N
     are as found, not shortened: they reach their goals and verify, and
     :meth:`planner.Planner.plan` gives a short one. ``pushes`` is a budget: a plan with more
     pushes is answered ``'unknown'``. Without a ``context`` (no edge has a stable push) every
-    open goal is the start, reached by no push at all.
+    open goal is the start, reached by no push at all. ``timings`` as
+    :func:`~planner.search.planning.solve_many`'s.
     """
     open_goals = [i for i, reason in enumerate(reasons) if reason is None]
     plans: dict[int, Plan] = {}
@@ -183,7 +184,7 @@ def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | N
         plans = {i: Plan(scene=scene.path, solved=True, planner=scene.planner.name, seed=scene.planner.seed,
                          planning_time_s=0.0, start=scene.start.copy(), goal=goals[i].copy()) for i in open_goals}
     elif open_goals:
-        plans = dict(zip(open_goals, solve_many(context, goals[open_goals], shorten=False)))
+        plans = dict(zip(open_goals, solve_many(context, goals[open_goals], shorten=False, timings=timings)))
     out = []
     for i, goal in enumerate(goals):
         found = plans.get(i)

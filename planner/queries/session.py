@@ -118,6 +118,11 @@ class Planner:
         except RegionTimeout as timeout:
             self._timeout = str(timeout)
         self._plans: OrderedDict[tuple[float, ...], list[Plan]] = OrderedDict()
+        #: Seconds the last :meth:`reachability` spent on the certificates, the direct connections
+        #: and the tree's growth.
+        self.timings: dict[str, float] = {}
+        #: Seconds setting the session up took (the regions, read or computed, and the rest).
+        self.setup_s = time.perf_counter() - self.clock
 
     @property
     def note(self) -> str:
@@ -242,7 +247,9 @@ class Planner:
             raise SceneError("pushes", f"must be >= 0, got {pushes}")
         if time_limit is not None:
             self._request(seed, time_limit)  # checked before any work
+        clock = time.perf_counter()
         reasons = [self.certify_unreachable(g, start=start) for g in rows]
+        self.timings = {"certificates": time.perf_counter() - clock, "connections": 0.0, "growth": 0.0}
         if time_limit is None:
             time_limit = min(self.options.time_limit, REACH_BASE_S + REACH_PER_GOAL_S * reasons.count(None))
         request = self._request(seed, time_limit)
@@ -253,7 +260,7 @@ class Planner:
                                                                                    scene, g)
                     for g, r in zip(rows, reasons)]
         context = None if self.world is None else PlanningContext(self.world, request, start, clock)
-        return answers(scene, context, reasons, rows, pushes)
+        return answers(scene, context, reasons, rows, pushes, self.timings)
 
     def certify_unreachable(self, goal: ArrayLike | None = None, *, start: ArrayLike | None = None) -> str | None:
         """Why ``goal`` (default: the scene's) is certainly unreachable from ``start`` (default:

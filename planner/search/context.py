@@ -215,9 +215,15 @@ class PlanningContext:
     def direct(self, region: GoalRegion, goal: int = 0, shorten: bool = True) -> list[Push | Transit] | None:
         """The cheapest plan of one or two pushes on a start edge, as in the paper's one-step
         planning (each shortened first, unless not ``shorten``), or None."""
-        found = [d for k in self.starts if (d := region.pushes_to(self.start, k, [goal]).get(goal))]
-        return min((self.world.shortcut(d) if shorten else d for d in found),
-                   key=lambda d: cost(self.scene, d)) if found else None
+        return self.direct_many(region, [goal], shorten).get(goal)
+
+    def direct_many(self, region: GoalRegion, goals: list[int], shorten: bool = True) -> dict[int, list[Push | Transit]]:
+        """:meth:`direct` for each of ``goals`` (indices) that has one, screened for all at once."""
+        found: dict[int, list[list[Push | Transit]]] = {}
+        for k in self.starts:
+            for g, pushes in region.pushes_to(self.start, k, goals).items():
+                found.setdefault(g, []).append(self.world.shortcut(pushes) if shorten else pushes)
+        return {g: min(options, key=lambda d: cost(self.scene, d)) for g, options in found.items()}
 
 
 def plan_result(scene: Scene, request: PlanRequest, clock: float, start: np.ndarray, goal: np.ndarray,

@@ -19,7 +19,7 @@ time, so a seed still gives one plan), and its plan wins if it costs no more.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Container, Iterator
 
 import numpy as np
 from ompl import base as ob
@@ -28,16 +28,16 @@ from ompl import util as ou
 
 from mechanics import wrap_angle
 
-from ..model.plan_file import Plan, Push, Transit
+from ..model.plan_file import Plan, Push, Transit, rechain
 from ..model.options import MAX_SEED
 from ..model.stop import signals_deferred
 from . import decode
 from .context import PlanningContext, cost, length
-from .goal import PushGoal
 from .goal_region import GoalRegion
+from .goal import PushGoal
 from .spaces import pose_of, space_information
 
-__all__ = ["solve", "solve_many", "MAX_REFINEMENT", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
+__all__ = ["solve", "solve_many", "HOP_GOALS", "HOP_REACH", "MAX_REFINEMENT", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
            "ROUND_ITERATIONS", "ROUND_MIN_ITERATIONS"]
 
 #: When the first plan still switches once shortened (the switch-pose shortcut drops a switch
@@ -57,6 +57,9 @@ ROUND_ITERATIONS, ROUND_MIN_ITERATIONS = 2, 1000
 #: also ends at the time limit).
 MAX_REFINEMENT = 3
 _ROUND_SEEDS = 1_000_003
+#: A goal reached is the start of pushes to the goals nearest it not reached yet: this many, within
+#: this many part radii (:class:`_Hops`).
+HOP_GOALS, HOP_REACH = 6, 4.0
 _RECHECK = "a switch of the path found no transit when its poses were re-composed"
 _PLANNERS: dict[str, Callable] = {"rrt": oc.RRT, "kpiece": oc.KPIECE1, "est": oc.EST}
 
@@ -116,7 +119,8 @@ def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
     return context.result(goal, segments, tree=tree, improvements=improvements)
 
 
-def solve_many(context: PlanningContext, goals: np.ndarray, shorten: bool = True) -> list[Plan]:
+def solve_many(context: PlanningContext, goals: np.ndarray, shorten: bool = True,
+               timings: dict[str, float] | None = None) -> list[Plan]:
     """One :class:`Plan` per goal (rows ``(x, y, theta)``, radians) from ``context.start``, grown
     as one search tree.
 
@@ -126,22 +130,74 @@ def solve_many(context: PlanningContext, goals: np.ndarray, shorten: bool = True
     context's deadline, so each goal gets the full time of tree growth for the price of one.
     Plans are shortcut as :func:`solve`'s are (unless not ``shorten``: a plan as found still
     reaches its goal and verifies), but a plan with switches gets no second, one-edge search: a
-    batch answers where the part can go, :func:`solve` also what it costs.
+    batch answers where the part can go, :func:`solve` also what it costs. ``timings``, if
+    given, gets the seconds spent on the direct connections (``'connections'``) and on the tree
+    (``'growth'``).
     """
-    found: dict[int, Plan] = {}  # each timed when found
+    clock = time.perf_counter()
+    found: dict[int, list[Push | Transit]] = {}  # segments, as found
+    timed: dict[int, Plan] = {}  # each plan timed when found
     region = context.goal_region(goals)
+    hops = _Hops(context, region, found)
+
+    def take(i: int, segments: list[Push | Transit] | None) -> None:
+        if segments is None:
+            timed[i] = context.result(goals[i], [], _RECHECK)
+            return
+        found[i] = segments
+        timed[i] = context.result(goals[i], context.shortcut(segments) if shorten and segments else segments)
+
     for i, goal in enumerate(goals):
         if context.scene.within_tolerance(context.start, goal):
-            found[i] = context.result(goal, [])
-        elif (direct := context.direct(region, i, shorten)) is not None:
-            found[i] = context.result(goal, direct)
-    rest = [i for i in range(len(goals)) if i not in found]
+            take(i, [])
+    for i, direct in context.direct_many(region, [i for i in range(len(goals)) if i not in timed], False).items():
+        take(i, direct)
+    for i, segments in hops.spread(list(found)):
+        take(i, segments)
+    grown = time.perf_counter()
+    rest = [i for i in range(len(goals)) if i not in timed]
     if rest:
-        for i, segments in _Search(context).grow(region, rest):
-            found[i] = (context.result(goals[i], [], _RECHECK) if segments is None
-                        else context.result(goals[i], context.shortcut(segments) if shorten else segments))
-    return [found[i] if i in found else context.result(g, [], context.request.out_of_time)
+        search = _Search(context).grow(region, rest, timed)
+        for i, segments in search:
+            take(i, segments)
+            for j, hopped in hops.spread([i] if segments is not None else []):
+                take(j, hopped)
+    if timings is not None:
+        timings.update(connections=grown - clock, growth=time.perf_counter() - grown)
+    return [timed[i] if i in timed else context.result(g, [], context.request.out_of_time)
             for i, g in enumerate(goals)]
+
+
+class _Hops:
+    """Goals reached from goals: from where the plan of a goal reached ends, one or two pushes on
+    the edge the pusher is on (the goal region's) to the nearest goals not reached yet
+    (:data:`HOP_GOALS` of them, within :data:`HOP_REACH` part radii). A grid of goals a part's
+    length or two apart is mostly reached so, a goal from its neighbour, once the first of them is
+    reached at all; the tree reaches the rest."""
+
+    def __init__(self, context: PlanningContext, region: GoalRegion, found: dict[int, list[Push | Transit]]):
+        self.context, self.region, self.found = context, region, found
+        self._index = {c.edge: k for k, c in enumerate(context.controls)}
+        self._reach = HOP_REACH * context.scene.slider.radius
+
+    def spread(self, sources: list[int]) -> Iterator[tuple[int, list[Push | Transit]]]:
+        """Each goal reached, breadth first, from the goals ``sources`` (reached already) and from
+        those reached so, with its segments; until none is left or the deadline."""
+        queue, xy = list(sources), self.region.goals[:, :2]
+        while queue and time.perf_counter() < self.context.deadline:
+            segments = self.found[queue.pop(0)]
+            pose = segments[-1].end if segments else self.context.start
+            rest = np.array([g for g in range(len(xy)) if g not in self.found], dtype=int)
+            if rest.size == 0:
+                return
+            distance = np.hypot(*(xy[rest] - pose[:2]).T)
+            near = rest[np.argsort(distance, kind="stable")[:HOP_GOALS]]
+            near = near[np.hypot(*(xy[near] - pose[:2]).T) <= self._reach].tolist()
+            for k in [self._index[segments[-1].edge]] if segments else self.context.starts:
+                for g, more in self.region.pushes_to(pose, k, [g for g in near if g not in self.found]).items():
+                    self.found[g] = rechain(segments + more)
+                    queue.append(g)
+                    yield g, self.found[g]
 
 
 class _Search:
@@ -193,9 +249,11 @@ class _Search:
         segments = self._decoded(ss.getSolutionPath(), goal, 0)
         return segments, tree if segments is not None else None, count[0]
 
-    def grow(self, region: GoalRegion, goals: list[int]) -> Iterator[tuple[int, list[Push | Transit] | None]]:
+    def grow(self, region: GoalRegion, goals: list[int],
+             done: Container[int] = ()) -> Iterator[tuple[int, list[Push | Transit] | None]]:
         """One tree towards all of ``goals``: yields each goal index reached with its segments
-        (None if the plan failed to decode), until every goal is reached or the deadline.
+        (None if the plan failed to decode), until every goal is reached (here, or by the caller
+        between yields: ``done``) or the deadline.
 
         OMPL's planners keep their tree between calls of ``solve`` (only ``clear`` empties it), so
         each call goes on growing it towards the goals left; every state joins the tree tested
@@ -218,6 +276,7 @@ class _Search:
             del path
             goal.active = [g for g in goal.active if g not in hits]
             yield from found
+            goal.active = [g for g in goal.active if g not in done]
 
 
 def _solve(ss, stop: Callable[[], bool]) -> None:
