@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike
 from ..actions.controls import EdgeControls, RegionTimeout, clearance_margin, edge_controls, step_length
 from ..actions.dubins import DubinsShortcut
 from ..actions.region_cache import RegionCache
-from ..actions.shortcut import JoinShortcut
+from ..actions.shortcut import JoinShortcut, Shortcut
 from ..actions.switch_pose import Grid, SwitchShortcut
 from ..actions.transit import TransitPlanner
 from ..model.fields import SceneError
@@ -97,10 +97,10 @@ class SearchWorld:
         self.step, self.margin = step_length(scene), clearance_margin(scene)
         switching = scene.pusher.transit != "none" and len(controls) > 1
         self.transits = TransitPlanner(scene, [c.edge for c in controls], model, self.margin) if switching else None
-        self._joined = JoinShortcut(controls, model, self.margin, self.transits)
+        self._joined: Shortcut = JoinShortcut(controls, model, self.margin, self.transits)
         self._dubins = DubinsShortcut(scene, controls, model, self.margin)
         self._grid = Grid()
-        self._switches = SwitchShortcut(scene, self._dubins.curves, model, self.transits,
+        self._switches: Shortcut | None = SwitchShortcut(scene, self._dubins.curves, model, self.transits,
                                         scene.planner.switch_cost, self._grid) if switching else None
 
     @classmethod
