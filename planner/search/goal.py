@@ -29,7 +29,10 @@ class PushGoal(ob.GoalSampleableRegion):
     """In the goal region of some goal still sought (``active``, indices of the region's goals).
 
     ``found[key]`` holds, for a satisfied state (``key`` = :func:`~planner.search.spaces.pose_of`),
-    its segments per goal reached.
+    its segments per goal reached. With ``nearest = (n, reach)`` a state is tested only against
+    the ``n`` active goals nearest it within ``reach`` metres: a tree grown towards many goals
+    then pays for a few per state, not for all (each goal is tested from the states that come
+    near it).
     """
 
     def __init__(self, si, region: GoalRegion):
@@ -39,6 +42,7 @@ class PushGoal(ob.GoalSampleableRegion):
         self.found: dict[Key, dict[int, list[Push | Transit]]] = {}
         self._samples = 0
         self._radius = region.scene.slider.radius
+        self.nearest: tuple[int, float] | None = None
         self.setThreshold(1e-9)  # OMPL accepts distances strictly below the threshold
 
     def distanceGoal(self, state) -> float:
@@ -47,13 +51,17 @@ class PushGoal(ob.GoalSampleableRegion):
         x, y, theta, k = key
         if k >= len(self.region.controls):  # the marker of a blocked switch
             return math.inf
-        hits = self.region.connections((x, y, theta), k, self.active)
+        goals = self.region.goals[self.active]
+        distance = np.hypot(goals[:, 0] - x, goals[:, 1] - y)
+        tested = self.active
+        if self.nearest is not None and len(tested) > self.nearest[0]:
+            near = np.argsort(distance, kind="stable")[:self.nearest[0]]
+            tested = [self.active[i] for i in near if distance[i] <= self.nearest[1]]
+        hits = self.region.connections((x, y, theta), k, tested) if tested else None
         if hits:
             self.found[key] = hits
             return 0.0
-        goals = self.region.goals[self.active]
-        return float(np.min(np.hypot(goals[:, 0] - x, goals[:, 1] - y)
-                            + self._radius * np.abs(wrap_angle(goals[:, 2] - theta))))
+        return float(np.min(distance + self._radius * np.abs(wrap_angle(goals[:, 2] - theta))))
 
     def sampleGoal(self, state) -> None:
         # Goal samples take turns among the edges (and the goals), so goal bias pulls every

@@ -58,15 +58,16 @@ from ..model.scene import Scene
 from ..world.free_space import Components
 from ..world.validity import CollisionModel
 
-__all__ = ["AIM_CLEARANCE", "AIM_REACH", "GoalRegion", "REMEMBERED", "TRIES"]
+__all__ = ["AIMS", "GoalRegion", "REMEMBERED", "TRIES"]
 
 _U1 = np.linspace(0.0, 1.0, 12, endpoint=False)  # around the boundary of the stable cone
 _U2 = (0.5, 1.0)  # half way out, and on the boundary (the sharpest turns)
 _LEGS = (1.0, 2.0, 4.0, 8.0)  # waypoint push lengths, in part radii
-#: A goal is aimed at where the part, with the pusher on the edge, has this many push margins of
-#: clearance; where it has not (a goal drawn against a wall), at the nearest pose that has, within
-#: this share of the position tolerance (a little less than all of it, so rounding keeps it inside).
-AIM_CLEARANCE, AIM_REACH = 2.0, 0.9
+#: A goal is aimed at where the part, with the pusher on the edge, has the first of these numbers
+#: of push margins of clearance; where it has not (a goal drawn against a wall), at the nearest
+#: pose that has, within that share of the position tolerance; failing that, the next pair: less
+#: room to spare, nearer the tolerance's edge (never on it, so that rounding keeps it inside).
+AIMS = ((2.0, 0.9), (1.1, 0.99))
 #: Waypoints collision-checked per state and edge: this test runs on every new tree state.
 TRIES = 4
 #: Poses whose answers :meth:`GoalRegion.pushes_to` keeps (per edge and set of goals).
@@ -126,18 +127,21 @@ class GoalRegion:
 
     def _aims_of(self, edge: int) -> np.ndarray:
         """Per goal, where pushes on ``edge`` aim: the goal itself where the part with the pusher
-        there has :data:`AIM_CLEARANCE` margins of room, else the nearest pose at its heading within
-        :data:`AIM_REACH` of the tolerance that has (a goal drawn against a wall, say); NaN where
-        none has, so that no push on that edge aims at it."""
-        clearance = AIM_CLEARANCE * self.margin
+        there has room (the first of :data:`AIMS`' clearances), else the nearest pose at its
+        heading that has, within that share of the position tolerance (a goal drawn against a
+        wall, say), trying each of :data:`AIMS` in turn; NaN where none has, so that no push on
+        that edge aims at it."""
         aims = np.full_like(self.goals, np.nan)
         for g, goal in enumerate(self.goals):
-            if self.model.is_clear(goal, edge, clearance):
+            if self.model.is_clear(goal, edge, AIMS[0][0] * self.margin):
                 aims[g] = goal
-            elif (aim := self.model.room.aim(self.model.body_pieces[edge], goal,
-                                             AIM_REACH * self.scene.tolerance_position, clearance)) is not None:
-                if self.model.is_clear(aim, edge, self.margin):
+                continue
+            for clearance, reach in AIMS:
+                aim = self.model.room.aim(self.model.body_pieces[edge], goal, reach * self.scene.tolerance_position,
+                                          clearance * self.margin)
+                if aim is not None and self.model.is_clear(aim, edge, self.margin):
                     aims[g] = aim
+                    break
         return aims
 
     @property

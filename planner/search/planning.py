@@ -37,7 +37,7 @@ from .goal_region import GoalRegion
 from .goal import PushGoal
 from .spaces import pose_of, space_information
 
-__all__ = ["solve", "solve_many", "HOP_GOALS", "HOP_REACH", "MAX_REFINEMENT", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
+__all__ = ["solve", "solve_many", "GROW_GOALS", "GROW_REACH", "HOP_GOALS", "HOP_REACH", "MAX_REFINEMENT", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
            "ROUND_ITERATIONS", "ROUND_MIN_ITERATIONS"]
 
 #: When the first plan still switches once shortened (the switch-pose shortcut drops a switch
@@ -60,6 +60,9 @@ _ROUND_SEEDS = 1_000_003
 #: A goal reached is the start of pushes to the goals nearest it not reached yet: this many, within
 #: this many part radii (:class:`_Hops`).
 HOP_GOALS, HOP_REACH = 6, 4.0
+#: A tree grown towards many goals tests each new state against this many goals nearest it, within
+#: this many part radii (:attr:`~planner.search.goal.PushGoal.nearest`).
+GROW_GOALS, GROW_REACH = 8, 16.0
 _RECHECK = "a switch of the path found no transit when its poses were re-composed"
 _PLANNERS: dict[str, Callable] = {"rrt": oc.RRT, "kpiece": oc.KPIECE1, "est": oc.EST}
 
@@ -261,6 +264,7 @@ class _Search:
         """
         ss, si, goal = self._setup(region)
         goal.active = list(goals)
+        goal.nearest = (GROW_GOALS, GROW_REACH * self.context.scene.slider.radius)
         deadline = self.context.deadline
         while goal.active and time.perf_counter() < deadline:
             ss.getProblemDefinition().clearSolutionPaths()
