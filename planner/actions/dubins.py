@@ -13,6 +13,7 @@ shorten plans.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Mapping
 from dataclasses import replace
 
 import numpy as np
@@ -231,6 +232,34 @@ def _xy_yaw(state) -> tuple[float, float, float]:
     return state.getX(), state.getY(), state.getYaw()
 
 
+class _Cars(Mapping):
+    """Edge to :class:`DubinsCurves` of its car, for the edges that have one (an edge whose stable
+    pushes turn neither way has none); each car is made when first asked for, since a part of many
+    edges may use few of them."""
+
+    def __init__(self, scene: Scene, controls: list[EdgeControls], model: CollisionModel, margin: float):
+        self._scene, self._model, self._margin = scene, model, margin
+        self._controls = {c.edge: c for c in controls}
+        self._made: dict[int, DubinsCurves | None] = {}
+
+    def _curves(self, edge: int) -> DubinsCurves | None:
+        if edge not in self._made:
+            car = edge_car(self._controls[edge], self._scene.slider.cf)
+            self._made[edge] = None if car is None else DubinsCurves(self._scene, car, self._model, self._margin)
+        return self._made[edge]
+
+    def __getitem__(self, edge: int) -> DubinsCurves:
+        if edge not in self._controls or (curves := self._curves(edge)) is None:
+            raise KeyError(edge)
+        return curves
+
+    def __iter__(self) -> Iterator[int]:
+        return (e for e in self._controls if self._curves(e) is not None)
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+
 class DubinsShortcut:
     """Shorten a plan by Dubins curves of the edges' cars wherever one is free and shorter.
 
@@ -252,8 +281,7 @@ class DubinsShortcut:
 
     def __init__(self, scene: Scene, controls: list[EdgeControls], model: CollisionModel, margin: float):
         self.cf = scene.slider.cf
-        cars = (edge_car(c, self.cf) for c in controls)
-        self.curves = {car.push.edge: DubinsCurves(scene, car, model, margin) for car in cars if car is not None}
+        self.curves = _Cars(scene, controls, model, margin)
 
     def __call__(self, segments: list) -> list:
         out, run = [], []

@@ -129,7 +129,7 @@ class Certificates:
             room = f"with the push margin of {self.margin * 1000:.3g} mm"
             if self._blocked(model.part_pieces, goal):
                 return f"collision: the part at the goal overlaps an obstacle or leaves the workspace ({room})"
-            if all(self._blocked(model.body_pieces[e], goal) for e in edges):
+            if all(self._blocked(model.body_pieces(e), goal) for e in edges):
                 return (f"no pusher room: no allowed edge has room for the pusher at the goal, where the last push "
                         f"ends ({room})")
         start_c, goal_c = (shapely.Point(transform_points([self.centre], pose)[0]) for pose in (start, goal))

@@ -113,7 +113,7 @@ class SearchWorld:
         ------
         SceneError
             If the pusher has no room at the scene's start on any edge (found before any region is
-            computed), or only on edges with no stable push; :class:`NoStablePush` if no edge has one.
+            computed); :class:`NoStablePush` if no edge has a stable push.
         RegionTimeout
             If no edge's region was computed by ``deadline``.
         """
@@ -128,9 +128,7 @@ class SearchWorld:
             if not timeout.controls:
                 raise
             controls, note = timeout.controls, str(timeout)
-        world = cls(scene, controls, model, note)
-        world.start_edges(scene.start)
-        return world
+        return cls(scene, controls, model, note)
 
     def start_edges(self, start: np.ndarray) -> list[int]:
         """The indices of the controls whose edge has room for the pusher at ``start``.

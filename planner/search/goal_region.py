@@ -137,7 +137,7 @@ class GoalRegion:
                 aims[g] = goal
                 continue
             for clearance, reach in AIMS:
-                aim = self.model.room.aim(self.model.body_pieces[edge], goal, reach * self.scene.tolerance_position,
+                aim = self.model.room.aim(self.model.body_pieces(edge), goal, reach * self.scene.tolerance_position,
                                           clearance * self.margin)
                 if aim is not None and self.model.is_clear(aim, edge, self.margin):
                     aims[g] = aim

@@ -122,19 +122,15 @@ class CollisionModel:
         self._obstacles = [fcl.CollisionObject(_prism(p)) for p in pieces]
         self._boxes = [(*p.min(axis=0).tolist(), *p.max(axis=0).tolist()) for p in pieces]
         # Per body: its convex pieces, outline vertices (as floats) and farthest point from its origin.
+        # An edge's body is made when first asked for: a part of many edges may use few of them.
         self._bodies: dict[int | str, tuple[list[fcl.CollisionObject], list, float]] = {}
         p = scene.pusher
+        self._slider, self._width, self._depth, self.edges = scene.slider, p.width, p.depth, tuple(edges)
         # The part's pieces are made once and shared by every edge's body (each check places the
         # pieces it uses first): a part of many edges would otherwise cost as many copies.
         self.part_pieces = convex_pieces(scene.slider.polygon)
-        part = [fcl.CollisionObject(_prism(s)) for s in self.part_pieces]
-        #: Per edge, the convex pieces of the part and of the pusher on it (slider frame).
-        self.body_pieces: dict[int, list[np.ndarray]] = {}
-        for e in edges:
-            pusher = convex_pieces(pusher_polygon(scene.slider, e, p.width, p.depth))
-            self.body_pieces[e] = self.part_pieces + pusher
-            self._add(e, part + [fcl.CollisionObject(_prism(s)) for s in pusher],
-                      body_outline(scene.slider, e, p.width, p.depth))
+        self._part = [fcl.CollisionObject(_prism(s)) for s in self.part_pieces]
+        self._pieces: dict[int, list[np.ndarray]] = {}
         alone = pusher_frame_body(p.width, p.depth)
         self._add(_PUSHER, [fcl.CollisionObject(_prism(alone))], alone)
         self._request = fcl.DistanceRequest()
@@ -147,6 +143,17 @@ class CollisionModel:
 
     def _add(self, key: int | str, pieces: list[fcl.CollisionObject], outline: np.ndarray) -> None:
         self._bodies[key] = (pieces, outline.tolist(), float(np.linalg.norm(outline, axis=1).max()))
+
+    def body_pieces(self, edge: int) -> list[np.ndarray]:
+        """The convex pieces of the part and of the pusher on ``edge`` (slider frame)."""
+        if edge not in self._pieces:
+            if edge not in self.edges:
+                raise KeyError(edge)
+            pusher = convex_pieces(pusher_polygon(self._slider, edge, self._width, self._depth))
+            self._pieces[edge] = self.part_pieces + pusher
+            self._add(edge, self._part + [fcl.CollisionObject(_prism(s)) for s in pusher],
+                      body_outline(self._slider, edge, self._width, self._depth))
+        return self._pieces[edge]
 
     def clearance(self, pose: ArrayLike, edge: int) -> float:
         """Distance from the body (slider and pusher on ``edge``) to the nearest obstacle or
@@ -187,6 +194,8 @@ class CollisionModel:
     def _clearance(self, pose: ArrayLike, key: int | str, enough: float = math.inf) -> float:
         """The clearance where it is below ``enough``; where it is not, possibly only a lower bound
         that is itself at least ``enough``."""
+        if key not in self._bodies:
+            self.body_pieces(key)
         pieces, hull, reach = self._bodies[key]
         x, y, theta = (float(v) for v in pose)
         xmin, ymin, xmax, ymax = self.workspace
