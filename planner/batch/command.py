@@ -60,6 +60,7 @@ def _note_workers(jobs: int, tasks: int) -> None:
     workers = min(jobs, tasks)
     notes = [f"{workers} worker{'s' if workers > 1 else ''}, one per task"] if jobs > tasks else []
     if workers > cores():
-        notes.append(f"more than the {cores()} cores: the tasks share them, each running slower")
+        n = cores()
+        notes.append(f"more than the {n} core{'s' if n > 1 else ''}: the tasks share them, each running slower")
     if notes:
         print(f"plan: note: --jobs {jobs}: {'; '.join(notes)}", file=sys.stderr)

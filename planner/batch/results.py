@@ -59,7 +59,9 @@ def _is_number(value: Any, optional: bool = False, whole: bool = False) -> bool:
     if value is None:
         return optional
     kinds = (int,) if whole else (int, float)
-    return isinstance(value, kinds) and not isinstance(value, bool) and math.isfinite(value) and value >= 0
+    if not isinstance(value, kinds) or isinstance(value, bool):
+        return False
+    return (math.isfinite(value) if isinstance(value, float) else True) and value >= 0  # an int may exceed a float
 
 
 def _is_text(value: Any, optional: bool = False) -> bool:

@@ -19,7 +19,10 @@ checked against the scene, each check naming the field that differs:
 
 Clear means never nearer than :data:`CLEARANCE` part radii. The planner's searches keep more
 (their margin, or half a propagation step at every state), so any plan of theirs passes; a plan
-that touches a wall does not.
+that touches a wall does not. The file is untrusted, so the work is bounded by the checking, not by
+its numbers: a push that would carry a point of the body beyond :data:`MAX_TRAVEL` is refused
+before it is followed, and a plan whose checks would take more than :data:`MAX_CHECKS` clearance
+computations (a path hugging a wall for kilometres) is refused rather than checked for ever.
 """
 
 from __future__ import annotations
@@ -34,7 +37,7 @@ from mechanics import point_velocity, wrap_angle
 from ..actions.transit import in_plane_moves
 from ..model.bodies import body_outline
 from ..model.fields import SceneError
-from ..model.plan_file import Plan, rechain
+from ..model.plan_file import Plan, Push, rechain
 from ..model.scene import Scene
 from ..world.validity import CollisionModel, advances, pose_along
 from .verify import check_chain
@@ -43,6 +46,14 @@ __all__ = ["CLEARANCE", "fit_plan"]
 
 #: Least clearance (in part radii) a loaded plan's pushes and transits must keep: a millionth.
 CLEARANCE = 1e-6
+#: Longest way (m) a push may carry a point of the body: a hundred times the largest table.
+MAX_TRAVEL = 1e5
+#: Most clearance computations a plan's check may take (about a second and a half of them).
+MAX_CHECKS = 100_000
+
+
+class _TooMany(Exception):
+    """The check of a plan has taken :data:`MAX_CHECKS` clearance computations."""
 
 
 def _pose(pose: np.ndarray) -> str:
@@ -80,6 +91,11 @@ def fit_plan(scene: Scene, plan: Plan) -> Plan:
     ...
     planner.model.fields.SceneError: plan.start: is [0.0000 m, 0.0000 m, 0.00 deg], not the scene's start ...
     """
+    with np.errstate(all="ignore"):  # a file's huge numbers overflow to inf, refused below, not warned of
+        return _fit(scene, plan)
+
+
+def _fit(scene: Scene, plan: Plan) -> Plan:
     if not plan.solved:
         raise SceneError("plan.solved", "is false: the file holds no way to the goal to check or run"
                                         + (f" ({plan.reason})" if plan.reason else ""))
@@ -90,6 +106,11 @@ def fit_plan(scene: Scene, plan: Plan) -> Plan:
     if not scene.within_tolerance(plan.start, scene.start):
         raise SceneError("plan.start", f"is {_pose(plan.start)}, not the scene's start {_pose(scene.start)}: "
                                        f"{_miss(scene, plan.start, scene.start)}")
+    for k, segment in enumerate(plan.segments):
+        if segment.kind == "push":
+            travel = _speed(scene, segment) * segment.duration
+            if not travel <= MAX_TRAVEL:
+                raise SceneError(f"plan.segments[{k}]", f"carries the body {travel:.3g} m, more than {MAX_TRAVEL:g} m")
     moved = replace(plan, start=scene.start.copy(), goal=scene.goal.copy(), segments=rechain(plan.segments, scene.start))
     if not scene.within_tolerance(moved.final):
         raise SceneError("plan.final", f"run from the scene's start, it ends at {_pose(moved.final)}, not at the "
@@ -98,23 +119,45 @@ def fit_plan(scene: Scene, plan: Plan) -> Plan:
     return moved
 
 
+def _speed(scene: Scene, push: Push) -> float:
+    """The largest speed of any point of the body (part and pusher) under ``push``'s twist."""
+    outline = body_outline(scene.slider, push.edge, scene.pusher.width, scene.pusher.depth)
+    return float(np.linalg.norm(point_velocity(push.twist, outline), axis=1).max())
+
+
 def _check_clear(scene: Scene, plan: Plan) -> None:
     """Refuse the first segment of ``plan`` whose motion comes within :data:`CLEARANCE` of an
-    obstacle or a wall of ``scene``."""
-    p = scene.pusher
+    obstacle or a wall of ``scene``, or the plan if checking it takes over :data:`MAX_CHECKS`
+    clearance computations."""
     edges = sorted({s.edge for s in plan.segments if s.kind == "push"})
     model = CollisionModel(scene, edges)
     margin = CLEARANCE * scene.slider.radius
+    checks = 0
+
+    def counted(clearance):
+        def count(*args) -> float:
+            nonlocal checks
+            checks += 1
+            if checks > MAX_CHECKS:
+                raise _TooMany
+            return clearance(*args)
+        return count
+
+    # The transits' moves are checked by the model's own method, which asks its pusher_clearance.
+    model.pusher_clearance = counted(model.pusher_clearance)
+    clearance = counted(model.clearance)
     for k, segment in enumerate(plan.segments):
-        if segment.kind == "push":
-            outline = body_outline(scene.slider, segment.edge, p.width, p.depth)
-            speed = float(np.linalg.norm(point_velocity(segment.twist, outline), axis=1).max())
-            at = pose_along(segment.start, segment.twist)
-            free = advances(lambda t: model.clearance(at(t), segment.edge), segment.duration, speed, margin)
-        else:
-            free = all(model.pusher_move_is_free(a, b, margin) for a, b in in_plane_moves(segment))
+        try:
+            if segment.kind == "push":
+                at = pose_along(segment.start, segment.twist)
+                free = advances(lambda t: clearance(at(t), segment.edge), segment.duration, _speed(scene, segment),
+                                margin)
+            else:
+                free = all(model.pusher_move_is_free(a, b, margin) for a, b in in_plane_moves(segment))
+        except _TooMany:
+            raise SceneError(f"plan.segments[{k}]", f"takes more than {MAX_CHECKS} clearance computations to "
+                                                    "check: a path too long, or too close to obstacles") from None
         if not free:
             what = "the push" if segment.kind == "push" else "the pusher's transit"
             raise SceneError(f"plan.segments[{k}]", f"{what} meets an obstacle or a workspace wall of the scene "
                                                     f"(from the part at {_pose(segment.start)})")
-
