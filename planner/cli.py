@@ -2,8 +2,9 @@
 
 ``--verify N`` then re-simulates the plan under N support distributions (:func:`planner.verify`)
 and prints a line per push and an overall line with the worst deviation; ``--verify N --plan
-FILE`` verifies a plan file instead of planning, and writes the same outputs (the plan as read,
-and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
+FILE`` verifies a plan file instead of planning, once it is found to be a plan for the scene
+(:func:`planner.execution.fit.fit_plan`), and writes the same outputs (the plan as run from the
+scene's start, and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
 ``--trajectory`` also writes the pusher's time-parameterised trajectory of a solved (or loaded)
 plan, ``<name>.trajectory.csv`` (:func:`planner.execution.trajectory.trajectory`, default limits).
 ``--simulate N`` runs the whole plan (solved or loaded) open-loop in MuJoCo once per support
@@ -81,15 +82,17 @@ __all__ = ["Inputs", "main", "read_inputs"]
 _EPILOG = f"""\
 exit codes:
   0    solved (and verified, with --verify)
-  1    bad input, in the scene (a goal in an obstacle, say) or in an option's value (--reach 3):
-       one line "plan: error: <field>: <problem>", nothing written
+  1    bad input, in the scene (a goal in an obstacle, say), in an option's value (--reach 3) or
+       a --plan file that is not a plan for the scene (another start, goal, part, or through a
+       wall): one line "plan: error: <field>: <problem>", nothing written
   2    not solved within the time limit, or the goal is certified unreachable (one line
        "plan: unreachable: <reason> (outputs in <dir>)", at once); the files are still written,
        "solved": false with the reason; or a usage error (an unknown option, a missing value)
   3    --verify: a push slips in the simulator; --simulate: a run in MuJoCo misses the goal,
        slips or collides
   4    an output could not be written: one line "plan: error: cannot write <file>: <OS error>";
-       no file is left in its place (a file already there is kept as it was)
+       no file is left in its place (a file already there is kept as it was); the output
+       folder and --mjcf's are tried before planning
   130  interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing is written, no process is left
 
 Defaults: a scene's planner: mapping (and pusher.transit) sets its own, which these options

@@ -42,7 +42,7 @@ from ..model.scene import Scene
 from ..world.validity import CollisionModel, advances, pose_along
 from .verify import check_chain
 
-__all__ = ["CLEARANCE", "fit_plan"]
+__all__ = ["CLEARANCE", "MAX_CHECKS", "MAX_TRAVEL", "fit_plan"]
 
 #: Least clearance (in part radii) a loaded plan's pushes and transits must keep: a millionth.
 CLEARANCE = 1e-6
