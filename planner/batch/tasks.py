@@ -102,6 +102,8 @@ class Task:
         >>> task = make_tasks(["scenes/battery.yaml"], [3])[0]
         >>> task.is_answered_by(task.record()), task.is_answered_by(task.record() | {"scene_digest": "0" * 64})
         (True, False)
+        >>> task.is_answered_by(task.record() | {"version": "0.1.0"}), task.is_answered_by(task.record() | {"seed": 4})
+        (False, False)
         """
         mine = json.loads(json.dumps(self.record()))
         return self.digest is not None and all(record.get(k) == v for k, v in mine.items())
@@ -135,11 +137,22 @@ def parse_seeds(text: str) -> Sequence[int]:
 
 @cache
 def planner_version() -> str:
-    """The installed planner's version, as each results line records it."""
+    """The planner's version as each results line records it: the package's version and a digest
+    of its source (the planner's and the mechanics' modules), since a plan depends on the code
+    that made it and the package's version does not change with every edit.
+
+    >>> planner_version().startswith(metadata.version("stablepush") + "+")
+    True
+    """
     try:
-        return metadata.version("stablepush")
+        version = metadata.version("stablepush")
     except metadata.PackageNotFoundError:
-        return "unknown"
+        version = "unknown"
+    root = Path(__file__).resolve().parents[2]
+    digest = hashlib.sha256()
+    for path in sorted([*(root / "planner").rglob("*.py"), *(root / "mechanics").rglob("*.py")]):
+        digest.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return f"{version}+{digest.hexdigest()[:12]}"
 
 
 #: A task id: the scene's name, the seed, and the goal's and the variant's numbers where there are several.
