@@ -295,3 +295,11 @@ def test_a_bad_scene_among_several_is_named(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith(f"plan: error: {bad}: pusher.mu: ") and err.count("\n") == 1
     assert not (tmp_path / "out").exists()
+
+
+def test_a_results_file_that_is_a_pipe_is_one_line_before_any_task(tmp_path, capsys):
+    (tmp_path / "out").mkdir()
+    os.mkfifo(tmp_path / "out" / "results.jsonl")
+    assert main([BATTERY, "--seeds", "1", "--out", str(tmp_path / "out"), "--resume"]) == 1
+    assert capsys.readouterr().err == (f"plan: error: --out: cannot use {str(tmp_path / 'out' / 'results.jsonl')!r}: "
+                                       "not a regular file\n")

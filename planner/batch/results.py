@@ -33,6 +33,7 @@ not a whole record is not reused, and its task runs again.
 
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
@@ -94,10 +95,17 @@ def is_record(record: Any) -> bool:
 
 class ResultsFile:
     """``path``, a results file: :meth:`read` the lines there, :meth:`append` one more. Opening
-    it cuts off a last line left incomplete by a killed run."""
+    it cuts off a last line left incomplete by a killed run.
+
+    Raises
+    ------
+    OSError
+        If ``path`` is there but is not a regular file, or cannot be opened."""
 
     def __init__(self, path: str | Path):
         self.path = Path(path)
+        if self.path.exists() and not self.path.is_file():  # a folder or a pipe: never opened
+            raise OSError(errno.EINVAL, "not a regular file", str(self.path))
         self._drop_torn_line()
 
     def _drop_torn_line(self) -> None:

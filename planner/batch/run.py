@@ -10,6 +10,7 @@ which would make its plan depend on how busy the machine was.
 from __future__ import annotations
 
 import sys
+import tempfile
 from collections import Counter
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
@@ -76,8 +77,13 @@ def run_batch(tasks: Sequence[Task], out: str | Path, executor: Executor | None 
         out.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise SceneError("--out", f"cannot make {shown(str(out))}: {err.strerror or err}") from None
-    results = ResultsFile(out / "results.jsonl")
-    done, bad = results.read()
+    try:
+        with tempfile.TemporaryFile(dir=out):  # where the results go is tried before any work
+            pass
+        results = ResultsFile(out / "results.jsonl")
+        done, bad = results.read()
+    except OSError as err:
+        raise SceneError("--out", f"cannot use {shown(str(err.filename or out))}: {err.strerror or err}") from None
     if (done or bad) and not resume:
         raise SceneError("--out", f"{shown(str(out))} holds results of a batch already: --resume it, or name "
                                   "another folder")
