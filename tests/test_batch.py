@@ -303,3 +303,19 @@ def test_a_results_file_that_is_a_pipe_is_one_line_before_any_task(tmp_path, cap
     assert main([BATTERY, "--seeds", "1", "--out", str(tmp_path / "out"), "--resume"]) == 1
     assert capsys.readouterr().err == (f"plan: error: --out: cannot use {str(tmp_path / 'out' / 'results.jsonl')!r}: "
                                        "not a regular file\n")
+
+
+def test_ctrl_c_while_the_workers_start_is_one_line(tmp_path):
+    """Ctrl-C reaches the whole process group, the batch's spawned workers too, which import the
+    planner for a second or so: they start with it ignored, so only the command speaks."""
+    runs = [subprocess.Popen([str(PLAN), *SCENES, "--seeds", "1:20", "--jobs", "2", "--out", str(tmp_path / f"o{k}")],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                             env={**os.environ, "STABLEPUSH_CACHE": str(tmp_path / f"cache{k}")}) for k in range(2)]
+    began = time.monotonic()
+    for after, run in zip((0.8, 1.4), runs):
+        time.sleep(max(0.0, began + after - time.monotonic()))
+        os.killpg(run.pid, signal.SIGINT)
+    for run in runs:
+        _, stderr = run.communicate(timeout=60)
+        assert run.returncode == 130 and "Traceback" not in stderr, stderr
+        assert [line for line in stderr.splitlines() if not line.startswith("[")] == ["plan: interrupted"], stderr

@@ -80,18 +80,27 @@ _STOPS = {signal.SIGINT, signal.SIGTERM}
 
 @contextmanager
 def signals_blocked() -> Iterator[None]:
-    """Within the block, SIGINT and SIGTERM wait (blocked) and are delivered on leaving it. A
-    process started within it starts with them blocked too (a fork or an exec keeps the mask), so
-    a signal to the whole group cannot reach it before it has set its own handlers
-    (:func:`quiet_child`): otherwise Ctrl-C in a child's first moments prints its traceback."""
+    """Within the block, SIGINT and SIGTERM wait (blocked) and are delivered on leaving it, and
+    SIGINT is ignored, so that a child started within it cannot get either before it has set its
+    own handlers (:func:`quiet_child`): otherwise Ctrl-C in a child's first moments prints its
+    traceback. A forked child keeps the mask; a spawned one (an exec, whose mask multiprocessing
+    clears) keeps SIGINT ignored, and Python then installs no KeyboardInterrupt handler; SIGTERM
+    ends it silently, Python having none for it. (A Ctrl-C between the blocking and the ignoring,
+    microseconds, is lost.)"""
     if not hasattr(signal, "pthread_sigmask"):
         yield
         return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS)
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS)
+    handler = signal.getsignal(signal.SIGINT)
+    ignoring = threading.current_thread() is threading.main_thread() and handler is not None
+    if ignoring:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        if ignoring:
+            signal.signal(signal.SIGINT, handler)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
 def quiet_child(on_sigterm=signal.SIG_DFL) -> None:
