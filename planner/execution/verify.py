@@ -36,7 +36,9 @@ where the one before it left the part, every push is on the edge the pusher is o
 transit starts at the contact pose on that edge, ends at the contact pose on the next push's edge,
 and uses a mode the scene allows (a lift only with ``pusher.transit: lift``). The drift treats a
 transit as the identity. Whether a transit's path is collision-free is the planner's rule
-(:mod:`planner.actions.transit`), not checked here.
+(:mod:`planner.actions.transit`), not checked here; a plan read from a file is checked against its
+scene, obstacles included, before it is verified (:mod:`planner.execution.fit`, which uses
+:func:`check_chain`).
 """
 
 from __future__ import annotations
