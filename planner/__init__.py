@@ -19,8 +19,8 @@ True
 :func:`load_scene` reads a YAML scene, :func:`plan` searches with OMPL, :func:`one_step` answers
 the paper's one-step question, :func:`reachability` answers reachable / unreachable (certified) /
 unknown for many goals, :func:`controllability` says what the stable pushes can reach (1996 §2-3),
-:func:`verify` re-simulates a plan (or one read by :func:`load_plan`)
-under many support distributions. The subpackages, lowest first (each imports only from those
+:func:`verify` re-simulates a plan (or one read by :func:`load_plan`, checked against its scene
+by :func:`fit_plan`) under many support distributions. The subpackages, lowest first (each imports only from those
 before it): :mod:`.model` (scene and plan files), :mod:`.world` (collisions, free space),
 :mod:`.actions` (stable pushes, transits, shortcuts), :mod:`.search` (OMPL), :mod:`.queries`
 (one step, reachability, controllability, bounds), :mod:`.execution` (re-simulation),
@@ -32,6 +32,7 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from .execution.fit import fit_plan
     from .execution.verify import Verification, verify
     from .model.fields import SceneError
     from .model.options import DEFAULT_PLANNER, PlannerOptions
@@ -44,7 +45,7 @@ if TYPE_CHECKING:
 
 __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Planner", "PlannerOptions", "Reach", "Scene", "SceneError", "Push", "Transit",
            "certify_unreachable", "load_plan", "load_scene", "one_step", "parse_scene", "plan", "reachability",
-           "Verification", "verify", "SceneControllability", "controllability"]
+           "Verification", "verify", "fit_plan", "SceneControllability", "controllability"]
 
 #: Every public name is imported on first use, from its module: ``import planner`` itself loads
 #: nothing (the ``plan`` command sets up the process before numpy is loaded, planner.cli), and the
@@ -59,7 +60,7 @@ _ON_FIRST_USE = {
     "Reach": ".queries.reachability", "certify_unreachable": ".queries.reachability",
     "reachability": ".queries.session", "plan": ".queries.session",
     "SceneControllability": ".queries.controllability", "controllability": ".queries.controllability",
-    "Verification": ".execution.verify", "verify": ".execution.verify",
+    "Verification": ".execution.verify", "verify": ".execution.verify", "fit_plan": ".execution.fit",
 }
 
 

@@ -2,8 +2,9 @@
 
 ``--verify N`` then re-simulates the plan under N support distributions (:func:`planner.verify`)
 and prints a line per push and an overall line with the worst deviation; ``--verify N --plan
-FILE`` verifies a plan file instead of planning, and writes the same outputs (the plan as read,
-and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
+FILE`` verifies a plan file instead of planning, once it is found to be a plan for the scene
+(:func:`planner.execution.fit.fit_plan`), and writes the same outputs (the plan as run from the
+scene's start, and a recording with the simulated ghost). ``--plan`` without ``--verify`` is bad input.
 ``--trajectory`` also writes the pusher's time-parameterised trajectory of a solved (or loaded)
 plan, ``<name>.trajectory.csv`` (:func:`planner.execution.trajectory.trajectory`, default limits).
 ``--simulate N`` runs the whole plan (solved or loaded) open-loop in MuJoCo once per support
@@ -30,7 +31,10 @@ from __future__ import annotations
 import argparse
 import atexit
 import os
+import signal
 import sys
+import tempfile
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -41,6 +45,20 @@ from typing import TYPE_CHECKING
 # command forks its recorder and region workers, which is safe only in a process with one thread
 # (planner.model.processes), and its matrices are far too small for BLAS threads to pay.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+
+def _stop_while_loading(signum: int, frame) -> None:
+    # Ctrl-C or SIGTERM while the modules below load: nothing runs or is written yet, so the
+    # command ends at once with the one line main() would print, not an import's traceback.
+    os.write(2, b"plan: interrupted\n" if signum == signal.SIGINT else b"plan: terminated\n")
+    os._exit(128 + signum)
+
+
+# Only where the signals are Python's defaults: a batch worker spawned with Ctrl-C ignored imports
+# this module too (as its parent's __main__ did), and must go on ignoring it.
+_LOADING = ({s: signal.signal(s, _stop_while_loading) for s in (signal.SIGINT, signal.SIGTERM)
+             if signal.getsignal(s) in (signal.default_int_handler, signal.SIG_DFL)}
+            if threading.current_thread() is threading.main_thread() else {})
 
 from .model.fields import SceneError, shown  # noqa: E402 (after the environment is set)
 from .model.files import atomic_path, staged_folder, write_atomic
@@ -54,6 +72,9 @@ from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COS
 from .model.scene import Scene, load_scene
 from .queries.session import plan
 
+for _signal, _handler in _LOADING.items():  # loaded: main() handles them from here on
+    signal.signal(_signal, _handler)
+
 if TYPE_CHECKING:
     from .execution.trajectory import Trajectory
     from .execution.mujoco_sim import Simulation
@@ -64,15 +85,17 @@ __all__ = ["Inputs", "main", "read_inputs"]
 _EPILOG = f"""\
 exit codes:
   0    solved (and verified, with --verify)
-  1    bad input, in the scene (a goal in an obstacle, say) or in an option's value (--reach 3):
-       one line "plan: error: <field>: <problem>", nothing written
+  1    bad input, in the scene (a goal in an obstacle, say), in an option's value (--reach 3) or
+       a --plan file that is not a plan for the scene (another start, goal, part, or through a
+       wall): one line "plan: error: <field>: <problem>", nothing written
   2    not solved within the time limit, or the goal is certified unreachable (one line
        "plan: unreachable: <reason> (outputs in <dir>)", at once); the files are still written,
        "solved": false with the reason; or a usage error (an unknown option, a missing value)
   3    --verify: a push slips in the simulator; --simulate: a run in MuJoCo misses the goal,
        slips or collides
   4    an output could not be written: one line "plan: error: cannot write <file>: <OS error>";
-       no file is left in its place (a file already there is kept as it was)
+       no file is left in its place (a file already there is kept as it was); the output
+       folder and --mjcf's are tried before planning
   130  interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing is written, no process is left
 
 Defaults: a scene's planner: mapping (and pusher.transit) sets its own, which these options
@@ -159,7 +182,7 @@ class Inputs:
     out: Path  # the output folder (not created yet)
     verify: int | None  # --verify N
     plan_path: str | None  # --plan FILE
-    given: Plan | None  # that file's plan, to verify instead of planning
+    given: Plan | None  # that file's plan, checked against the scene and run from its start, instead of planning
     reach: int | None = None  # --reach N: pushes of the reachable-set map
     engine: tuple[str, int | None, str | None] | None = None  # --engine, --jobs, --address: where the map runs
     trajectory: bool = False  # --trajectory: write the pusher's trajectory
@@ -209,8 +232,17 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--out", f"cannot use {shown(str(out))}: {getattr(err, 'strerror', None) or err}") from None
     if taken:  # found now, not after the search
         raise SceneError("--out", f"{shown(str(out))} exists and is not a folder")
+    # Where the outputs go is tried now, before the work whose results would have nowhere to go.
+    _check_writable(out, out)
+    if args.mjcf is not None and _within(Path(args.mjcf), out, out) == Path(args.mjcf):
+        _check_writable(Path(args.mjcf).parent, Path(args.mjcf))
+    given = None
+    if args.plan is not None:
+        from .execution.fit import fit_plan  # with the re-simulator: only for a plan file
+
+        given = fit_plan(scene, load_plan(args.plan))
     return Inputs(scene, scene.planner.name, scene.planner.time_limit, scene.planner.seed, out, args.verify, args.plan,
-                  None if args.plan is None else load_plan(args.plan), args.reach,
+                  given, args.reach,
                   None if args.engine is None and args.jobs is None else (args.engine or "local", args.jobs, args.address),
                   args.trajectory, args.simulate,
                   args.sim_mu, tuple(args.sim_cf_offset or (0.0, 0.0)), None if args.mjcf is None else Path(args.mjcf))
@@ -325,17 +357,17 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
             print(f"plan: note: {result.note}", file=sys.stderr)
     # The planning seed also draws the random distributions, so a run is repeatable as a whole.
     check = None
-    if inputs.verify and (result.solved or inputs.given is not None):
+    if inputs.verify and result.solved:
         from .execution.verify import verify  # the re-simulator, loaded only for --verify
 
         check = verify(scene, result, inputs.verify, seed)
     motion = None
-    if inputs.trajectory and (result.solved or inputs.given is not None):
+    if inputs.trajectory and result.solved:
         from .execution.trajectory import trajectory  # loads ruckig, only for --trajectory
 
         motion = trajectory(scene, result)
     simulation = None
-    if inputs.simulate and (result.solved or inputs.given is not None):
+    if inputs.simulate and result.solved:
         from .execution.mujoco_sim import simulate  # MuJoCo is loaded only for --simulate
 
         simulation = simulate(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset)
@@ -353,10 +385,10 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
     if unreachable:
         print(f"plan: unreachable: {unreachable} (outputs in {out})", file=sys.stderr)
         return 2
-    if not result.solved and inputs.given is None:
+    if not result.solved:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
         return 2
-    head = (f"loaded {inputs.plan_path}: {result.contents()}{'' if result.solved else ' (not solved)'}"
+    head = (f"loaded {inputs.plan_path}: {result.contents()}"
             if inputs.given is not None
             else f"solved: {result.contents()}, cost {result.cost:.3f} m, length {result.length:.3f} m, "
                  f"planning time {result.planning_time_s:.2f} s{_first_found(result)}")
@@ -431,6 +463,20 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
     except RecordingFailed as err:
         raise _NotWritten(f"cannot write {shown(str(out / f'{scene.name}.rrd'))}: the recording failed: {err}") from None
 
+
+
+def _check_writable(folder: Path, named: Path) -> None:
+    """Raise :class:`_NotWritten` naming ``named`` unless a file can be made in ``folder`` or, if
+    that does not exist yet, in the nearest folder above it that does (where it would be made).
+    The test file is anonymous (``O_TMPFILE`` where there is one) and gone at once."""
+    place = folder
+    try:
+        while not place.exists() and place != place.parent:
+            place = place.parent
+        with tempfile.TemporaryFile(dir=place):
+            pass
+    except (OSError, ValueError) as err:  # ValueError: a NUL in the name
+        raise _NotWritten(f"cannot write {shown(str(named))}: {getattr(err, 'strerror', None) or err}") from None
 
 
 def _within(path: Path, out: Path, stage: Path) -> Path:

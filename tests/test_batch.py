@@ -206,3 +206,116 @@ def test_a_reachable_set_map_split_between_workers_is_the_map_of_one_process():
     assert np.array_equal(alone.count, split.count) and np.array_equal(alone.blocked, split.blocked)
     assert np.array_equal(alone.theta, split.theta, equal_nan=True) and np.array_equal(alone.headings, split.headings)
     assert set(np.unique(alone.count)) == {0, 1, 2}  # a map with something to merge
+
+
+# -- streaming, resuming only the same task, bad input named (issue 31) ---------------------------------
+
+BATTERY = SCENES[0]
+
+
+def test_four_billion_seeds_stream_their_first_result_at_once_and_sigterm_ends_them_cleanly(tmp_path):
+    """The tasks are made as workers free up: no list of seeds, no option planned per task."""
+    out = tmp_path / "out"
+    run = subprocess.Popen([str(PLAN), BATTERY, "--seeds", "1:4294967295", "--jobs", "2", "--out", str(out)],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    results, began = out / "results.jsonl", time.monotonic()
+    while run.poll() is None and not (results.exists() and results.read_text().count("\n")) \
+            and time.monotonic() - began < 30:
+        time.sleep(0.05)
+    first = time.monotonic() - began
+    run.send_signal(signal.SIGTERM)
+    stdout, stderr = run.communicate(timeout=60)
+    assert first < 30 and results.read_text().count("\n") >= 1, stderr
+    assert run.returncode == 143 and "Traceback" not in stderr and stderr.splitlines()[-1] == "plan: terminated"
+    assert json.loads(results.read_text().splitlines()[0])["id"].startswith("battery-s")
+
+
+def test_more_jobs_than_tasks_start_a_worker_a_task_and_say_so(tmp_path, capsys, monkeypatch):
+    from planner.batch import command, executors
+
+    started = []
+    monkeypatch.setattr(executors._Worker, "__init__", _counted(executors._Worker.__init__, started))
+    monkeypatch.setattr(command, "cores", lambda: 1)  # as on a machine of one core
+    assert main([BATTERY, "--seeds", "1:2", "--jobs", "64", "--out", str(tmp_path / "out")]) == 0
+    assert len(started) <= 2
+    assert ("plan: note: --jobs 64: 2 workers, one per task; more than the 1 core: the tasks share them, each "
+            "running slower\n") in capsys.readouterr().err
+
+
+def _counted(init, started: list):
+    def counting(self, *args, **kwargs):
+        started.append(1)
+        init(self, *args, **kwargs)
+    return counting
+
+
+def _lines(out: Path) -> list[dict]:
+    return [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
+
+
+def test_resume_runs_again_the_tasks_whose_lines_are_not_whole_records(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main([BATTERY, "--seeds", "1:3", "--jobs", "1", "--out", str(out)]) == 0
+    whole = _lines(out)
+    cut = dict(whole[2])
+    del cut["cost"]
+    (out / "results.jsonl").write_text("\n".join([json.dumps(whole[0]), json.dumps({"id": "battery-s2"}),
+                                                   json.dumps(cut), "[" * 5000]) + "\n")
+    capsys.readouterr()
+    assert main([BATTERY, "--seeds", "1:3", "--jobs", "1", "--out", str(out), "--resume"]) == 0
+    err = capsys.readouterr().err
+    assert "plan: warning: 3 lines of " in err and "Traceback" not in err
+    assert [line.split(":")[0] for line in err.splitlines() if line.startswith("[")] == ["[2/3] battery-s2", "[3/3] battery-s3"]
+    again = {r["id"]: r for r in map(json.loads, (out / "results.jsonl").read_text().splitlines()[4:])}
+    assert sorted(again) == ["battery-s2", "battery-s3"] and again["battery-s3"]["cost"] == whole[2]["cost"]
+
+
+def test_resume_with_a_changed_scene_file_runs_its_tasks_again(tmp_path, capsys):
+    """The same file name with another goal: its results are another task's, not reused."""
+    scene, out = tmp_path / "battery.yaml", tmp_path / "out"
+    scene.write_text(Path(BATTERY).read_text())
+    assert main([str(scene), "--seeds", "1:2", "--jobs", "1", "--out", str(out)]) == 0
+    scene.write_text(Path(BATTERY).read_text().replace("goal: [0.05798, 0.02116, 40.107]", "goal: [0.05, 0.0, 0.0]"))
+    capsys.readouterr()
+    assert main([str(scene), "--seeds", "1:2", "--jobs", "1", "--out", str(out), "--resume"]) == 0
+    assert "plan: warning: 2 lines of " in capsys.readouterr().err
+    first, second = _lines(out)[:2], _lines(out)[2:]
+    assert [r["id"] for r in second] == ["battery-s1", "battery-s2"]
+    assert {r["scene_digest"] for r in first}.isdisjoint({r["scene_digest"] for r in second})
+    assert json.loads((out / "battery-s1.json").read_text())["goal"][:2] == [0.05, 0.0]
+    # Resumed again, unchanged: nothing runs, no warning.
+    assert main([str(scene), "--seeds", "1:2", "--jobs", "1", "--out", str(out), "--resume"]) == 0
+    assert "warning" not in capsys.readouterr().err and len(_lines(out)) == 4
+
+
+def test_a_bad_scene_among_several_is_named(tmp_path, capsys):
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(Path(BATTERY).read_text().replace("mu: 1.0", "mu: -1.0"))
+    assert main([BATTERY, str(bad), "--seeds", "1", "--out", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"plan: error: {bad}: pusher.mu: ") and err.count("\n") == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_results_file_that_is_a_pipe_is_one_line_before_any_task(tmp_path, capsys):
+    (tmp_path / "out").mkdir()
+    os.mkfifo(tmp_path / "out" / "results.jsonl")
+    assert main([BATTERY, "--seeds", "1", "--out", str(tmp_path / "out"), "--resume"]) == 1
+    assert capsys.readouterr().err == (f"plan: error: --out: cannot use {str(tmp_path / 'out' / 'results.jsonl')!r}: "
+                                       "not a regular file\n")
+
+
+def test_ctrl_c_while_the_workers_start_is_one_line(tmp_path):
+    """Ctrl-C reaches the whole process group, the batch's spawned workers too, which import the
+    planner for a second or so: they start with it ignored, so only the command speaks."""
+    runs = [subprocess.Popen([str(PLAN), *SCENES, "--seeds", "1:20", "--jobs", "2", "--out", str(tmp_path / f"o{k}")],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                             env={**os.environ, "STABLEPUSH_CACHE": str(tmp_path / f"cache{k}")}) for k in range(2)]
+    began = time.monotonic()
+    for after, run in zip((0.8, 1.4), runs):
+        time.sleep(max(0.0, began + after - time.monotonic()))
+        os.killpg(run.pid, signal.SIGINT)
+    for run in runs:
+        _, stderr = run.communicate(timeout=60)
+        assert run.returncode == 130 and "Traceback" not in stderr, stderr
+        assert [line for line in stderr.splitlines() if not line.startswith("[")] == ["plan: interrupted"], stderr

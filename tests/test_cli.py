@@ -591,3 +591,30 @@ def test_an_output_folder_that_cannot_be_made_is_named_as_given(tmp_path, capsys
     assert main([str(SCENES / "battery.yaml"), "--out", str(out)]) == 4
     assert capsys.readouterr().err == f"plan: error: cannot write {str(out)!r}: Permission denied\n"
     assert not out.exists()
+
+
+def test_a_named_pipe_given_as_the_scene_is_refused_at_once(tmp_path, capsys):
+    """Opening a pipe for reading waits for a writer: none comes, so it is refused unopened."""
+    os.mkfifo(tmp_path / "scene.yaml")
+    began = time.monotonic()
+    assert main([str(tmp_path / "scene.yaml"), "--out", str(tmp_path / "out")]) == 1
+    assert time.monotonic() - began < 5
+    assert capsys.readouterr().err == (f"plan: error: scene: {str(tmp_path / 'scene.yaml')!r} is not a regular "
+                                       "file (a named pipe)\n")
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("flags, named", [
+    (["--out", "file/out"], "file/out"),
+    (["--simulate", "1", "--mjcf", "file/model.xml", "--out", "out"], "file/model.xml"),
+], ids=["--out", "--mjcf"])
+def test_an_output_place_that_cannot_be_written_is_refused_before_planning(tmp_path, capsys, monkeypatch, flags, named):
+    """Under a regular file nothing can be made: found before the search (and the simulation),
+    not after them; exit 4, one line naming the place, nothing written."""
+    pytest.importorskip("mujoco")
+    (tmp_path / "file").write_text("a file, not a folder")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr("planner.cli.plan", lambda *args, **kwargs: pytest.fail("planned before the check"))
+    assert main([str(SCENES / "battery.yaml"), *flags]) == 4
+    assert capsys.readouterr().err == f"plan: error: cannot write {named!r}: Not a directory\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]

@@ -87,14 +87,33 @@ def test_a_killed_run_leaves_no_process_and_no_output(slow_scene, tmp_path, sig,
         assert {p.name for p in out.iterdir()} == {"slow.json", "slow.rrd"}
         return
     assert run.returncode == EXIT[sig], stderr
-    assert stderr.strip().splitlines()[-1:] == {signal.SIGKILL: [], signal.SIGTERM: ["plan: terminated"],
-                                               signal.SIGINT: ["plan: interrupted"]}[sig]
+    assert stderr.splitlines() == {signal.SIGKILL: [], signal.SIGTERM: ["plan: terminated"],
+                                   signal.SIGINT: ["plan: interrupted"]}[sig]
     finals = sorted(p.name for p in out.iterdir() if not p.name.endswith(".tmp")) if out.exists() else []
     assert finals == []
     # What a SIGKILL may leave (a temporary file half written) the next run into the folder removes.
     if out.exists():
         remove_orphans(out)
         assert list(out.iterdir()) == []
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT], ids=lambda s: s.name)
+def test_an_interrupt_at_any_moment_of_a_cold_run_is_one_line(slow_scene, tmp_path, sig):
+    """Four cold runs side by side, stopped at 0.2, 0.5, 1.0 and 2.0 s: while the modules load,
+    while the region workers start or compute, in the search. Ctrl-C reaches the terminal's whole
+    process group; SIGTERM, as a scheduler sends it, the command alone (its workers are then
+    stopped by it)."""
+    times = (0.2, 0.5, 1.0, 2.0)
+    runs = [start(slow_scene, "slow.yaml", "--time-limit", "3", "--out", f"out-{after}",
+                  cache=tmp_path / f"cache-{after}") for after in times]
+    began = time.monotonic()
+    for after, run in zip(times, runs):
+        time.sleep(max(0.0, began + after - time.monotonic()))
+        os.killpg(run.pid, sig) if sig == signal.SIGINT else os.kill(run.pid, sig)
+    for after, run in zip(times, runs):
+        _, stderr = run.communicate(timeout=30)
+        line = {signal.SIGTERM: "plan: terminated\n", signal.SIGINT: "plan: interrupted\n"}[sig]
+        assert (run.returncode, stderr) == (EXIT[sig], line), f"{sig.name} at {after} s"
 
 
 def _limit_file_size(limit: int):
@@ -131,9 +150,10 @@ def test_a_full_or_read_only_folder_is_one_line_and_leaves_nothing(tmp_path, cas
     try:
         run = start(tmp_path, str(SCENES / "parking.yaml"), "--out", "out", cache=tmp_path / "cache")
         stdout, stderr = run.communicate(timeout=120)
-        reason = "No space left on device" if case == "full" else "Read-only file system"
+        # A read-only folder is found before planning; a full one only when the recording fills it.
+        named, reason = ("out/parking.rrd", "No space left on device") if case == "full" else ("out", "Read-only file system")
         assert run.returncode == 4
-        assert stderr == f"plan: error: cannot write 'out/parking.rrd': {reason}\n" and stdout == ""
+        assert stderr == f"plan: error: cannot write {named!r}: {reason}\n" and stdout == ""
         assert list(out.iterdir()) == []
     finally:
         subprocess.run(["umount", str(out)], check=True)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -74,8 +75,32 @@ def test_unreadable_files(tmp_path):
     with pytest.raises(SceneError, match="cannot read"):
         load_plan(tmp_path / "missing.json")
     (tmp_path / "broken.json").write_text("{not json")
-    with pytest.raises(SceneError, match="not valid JSON"):
+    with pytest.raises(SceneError, match="malformed JSON"):
         load_plan(tmp_path / "broken.json")
+
+
+@pytest.mark.parametrize("text, problem", [
+    ("[" * 1000 + "]" * 1000, "unsupported JSON: nests deeper than 16"),
+    ('{"format": ' * 100_000, "unsupported JSON: nests deeper than 16"),  # not even closed
+    ("[" + "9" * 5000 + "]", "malformed JSON: Exceeds the limit"),  # an int Python will not convert
+    (" " * 10_000_001, "is larger than 10000000 bytes"),
+    ("\xff", "is not UTF-8 text"),
+], ids=["nested 1000 deep", "nested 100000 deep, unclosed", "5000 digits", "over 10 MB", "not UTF-8"])
+def test_hostile_json_is_one_line_naming_the_plan(tmp_path, text, problem):
+    path = tmp_path / "plan.json"
+    path.write_bytes(text.encode("utf-8", "surrogateescape") if text != "\xff" else b"\xff")
+    with pytest.raises(SceneError) as caught:
+        load_plan(path)
+    assert caught.value.field == "plan" and problem in caught.value.problem and "\n" not in str(caught.value)
+
+
+def test_only_a_regular_file_is_read_as_a_plan(tmp_path):
+    """A named pipe would block the run for ever (nobody writes to it); a folder is no plan."""
+    os.mkfifo(tmp_path / "pipe")
+    with pytest.raises(SceneError, match="is not a regular file \\(a named pipe\\)"):
+        load_plan(tmp_path / "pipe")
+    with pytest.raises(SceneError, match="is not a regular file \\(a folder\\)"):
+        load_plan(tmp_path)
 
 
 @pytest.fixture(scope="module")

@@ -64,6 +64,18 @@ def test_a_broken_or_unwritable_cache_is_ignored(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([cached.name, "file"])
 
 
+def test_a_hostile_cache_file_is_computed_again(tmp_path):
+    """A cache file is read as untrusted JSON: nested 100000 deep, a number of 5000 digits, values
+    of the wrong kinds; whatever it holds, the region is computed again."""
+    good = edge_region(BLOCK, 1, 0.5, None, cache=RegionCache(tmp_path))
+    (cached,) = tmp_path.iterdir()
+    for content in ["[" * 100_000, '{"polygon": ' + "1" * 5000 + "}", '{"polygon": {}, "centre": 1}']:
+        cached.write_text(content)
+        with pytest.raises(AssertionError, match="computed"):
+            edge_region(BLOCK, 1, 0.5, None, cache=RegionCache(tmp_path, compute=refuse))
+    assert edge_region(BLOCK, 1, 0.5, None, cache=RegionCache(tmp_path)).polygon.equals_exact(good.polygon, 0.0)
+
+
 def test_the_cache_keeps_the_most_recently_used_in_memory(tmp_path):
     """A cache of two regions: a third drops the least recently used from memory, which is then
     read from its file, not computed; every file stays."""

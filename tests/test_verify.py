@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import shapely
+import yaml
 
 import planner
 from mechanics import cor_to_twist, point_velocity, stable_region
@@ -311,6 +312,11 @@ def plan_files(tmp_path_factory):
         data.pop(stale)
     bad = folder / "tampered.json"
     bad.write_text(json.dumps(data))
+    # A plan is checked against its scene first: the tampered push ends elsewhere, so it is verified
+    # in a copy of the scene whose goal is where it ends (the mechanics alone then give it away).
+    spec = yaml.safe_load((ROOT / "scenes" / "battery.yaml").read_text())
+    spec["goal"] = [*segment["end"][:2], float(np.degrees(segment["end"][2]))]
+    (folder / "battery.yaml").write_text(yaml.safe_dump(spec))
     return good, bad
 
 
@@ -330,7 +336,7 @@ def test_command_verifies_a_good_plan_file_and_exits_0(plan_files, tmp_path):
 
 def test_command_exits_3_on_a_tampered_plan(plan_files, tmp_path):
     _, bad = plan_files
-    run = subprocess.run([str(PLAN), str(ROOT / "scenes" / "battery.yaml"), "--verify", "6", "--plan", str(bad),
+    run = subprocess.run([str(PLAN), str(bad.with_name("battery.yaml")), "--verify", "6", "--plan", str(bad),
                           "--out", "out"], capture_output=True, text=True, cwd=tmp_path, timeout=60)
     assert run.returncode == 3, run.stderr
     assert "Traceback" not in run.stderr + run.stdout

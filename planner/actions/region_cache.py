@@ -45,7 +45,9 @@ from mechanics import DeadlineExceeded, ExactRegion, Slider, StableRegion, exact
 
 from ..model.fields import SceneError
 from ..model.files import write_atomic
+from ..model.json_file import read_json
 from ..model.processes import cores, die_with_parent, fork_context
+from ..model.stop import quiet_child, signals_blocked
 
 __all__ = ["MEMORY_SIZE", "RegionCache", "cache_folder", "cache_key", "compute_regions", "default_cache",
            "edge_region", "is_cached", "regions_held"]
@@ -58,6 +60,8 @@ _VERSION = 3
 #: Items a :class:`RegionCache` keeps in memory unless told otherwise: every region and analysis
 #: of a 200-edged part twice over, a few megabytes. An item dropped is read again from its file.
 MEMORY_SIZE = 1024
+#: Largest cache file read: a region's polygon of some thousands of vertices, or an analysis.
+MAX_FILE = 10_000_000
 
 
 class RegionCache:
@@ -110,8 +114,8 @@ class RegionCache:
         """The JSON in ``key``'s file, or None if it has none or the file is not JSON (cut short,
         say); the caller checks that the JSON is what it wrote."""
         try:
-            return json.loads(self._path(kind, key).read_text())
-        except (OSError, ValueError):
+            return read_json(self._path(kind, key), "cache", MAX_FILE)
+        except SceneError:  # missing, unreadable, too large or too deep, not JSON
             return None
 
     def write(self, kind: str, key: str, data: Any) -> None:
@@ -341,7 +345,9 @@ class _Workers:
 
     def __init__(self, n: int, context):
         self._done: queue.SimpleQueue = queue.SimpleQueue()
-        self._pool = None if context is None else context.Pool(n, initializer=_worker_start, initargs=(os.getpid(),))
+        with signals_blocked():  # the workers set their own handlers first (_worker_start)
+            self._pool = None if context is None else context.Pool(n, initializer=_worker_start,
+                                                                   initargs=(os.getpid(),))
 
     def submit(self, key, fn: Callable, /, *args, **kwargs) -> None:
         """Begin ``fn(*args, **kwargs)``; :meth:`next_done` gives ``(key, result)``, the result
@@ -373,10 +379,10 @@ class _Workers:
 
 def _worker_start(parent: int) -> None:
     # Ctrl-C reaches every process of the terminal's group: the parent alone handles it (and
-    # kills the workers), instead of each worker printing a traceback. A worker writes nothing, so
-    # SIGKILL is the right end for it when the parent dies.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # kills the workers, by SIGTERM), instead of each worker printing a traceback. A worker writes
+    # nothing, so SIGKILL is the right end for it when the parent dies.
     die_with_parent(parent, signal.SIGKILL)
+    quiet_child()
 
 
 def _workers(n: int) -> _Workers:

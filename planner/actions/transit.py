@@ -39,7 +39,7 @@ from ..model.plan_file import Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
-__all__ = ["AIRBORNE", "ARC_STEP", "TransitPlanner", "contact_pose", "edge_contact_pose", "path_duration", "piece_times",
+__all__ = ["AIRBORNE", "ARC_STEP", "TransitPlanner", "contact_pose", "edge_contact_pose", "in_plane_moves", "path_duration", "piece_times",
            "standoff", "transit_pieces", "transit_poses"]
 
 #: Largest turn of the pusher between two poses of a walk round a corner of the part.
@@ -119,6 +119,20 @@ def transit_pieces(transit: Transit) -> list[tuple[np.ndarray, bool]]:
     if transit.mode == "lift":
         return [(xy[: AIRBORNE + 1], False), (xy[AIRBORNE: AIRBORNE + 2], True), (xy[AIRBORNE + 1:], False)]
     return [(xy, False)]
+
+
+def in_plane_moves(transit: Transit) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The moves of ``transit``'s pusher on the table, each from one pose of its path to the next
+    (a lift's flight is not one).
+
+    >>> lift = Transit(0, 2, "lift", np.array([[0, 0, 0], [-1, 0, 0], [3, 0, 3], [2, 0, 3]]), 6.0, np.zeros(3))
+    >>> [(a[0].item(), b[0].item()) for a, b in in_plane_moves(lift)]
+    [(0.0, -1.0), (3.0, 2.0)]
+    """
+    path = np.asarray(transit.pusher_path, dtype=float)
+    if transit.mode == "lift":
+        return [(path[AIRBORNE - 1], path[AIRBORNE]), (path[AIRBORNE + 1], path[AIRBORNE + 2])]
+    return list(zip(path, path[1:]))
 
 
 def transit_poses(transit: Transit, body: ArrayLike, times: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
@@ -210,9 +224,7 @@ class TransitPlanner:
 
     def _is_free(self, transit: Transit) -> bool:
         """Every in-plane piece of ``transit`` keeps the margin from obstacles and walls."""
-        path = transit.pusher_path
-        pieces = zip(path, path[1:]) if transit.mode == "plane" else ((path[0], path[1]), (path[2], path[3]))
-        return all(self.model.pusher_move_is_free(p, q, self.margin) for p, q in pieces)
+        return all(self.model.pusher_move_is_free(p, q, self.margin) for p, q in in_plane_moves(transit))
 
     def _transit(self, pose: np.ndarray, a: int, b: int, mode: str, path: list[np.ndarray]) -> Transit:
         return Transit(a, b, mode, np.array(path), path_duration(path, self.reach), pose.copy())

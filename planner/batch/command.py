@@ -18,6 +18,7 @@ from pathlib import Path
 
 from ..model.fields import SceneError
 from ..model.options import check_seed
+from ..model.processes import cores
 from .engines import executor
 from .results import summary
 from .run import run_batch
@@ -45,8 +46,22 @@ def run_command(args: argparse.Namespace) -> int:
     tasks = make_tasks(args.scene, seeds, overrides=overrides)
     out = Path(args.out) if args.out else Path("logs") / f"batch-{time.strftime('%Y%m%d-%H%M%S')}"
     with executor(args.engine or "local", args.jobs, args.address) as engine:
+        if (args.engine or "local") == "local" and args.jobs is not None:
+            _note_workers(args.jobs, len(tasks))
         records = run_batch(tasks, out, engine, resume=args.resume)
     failed = sum(r["status"] == "failed" for r in records)
     print(summary(records))
     print(f"{len(records)} tasks, {failed} failed -> {out}/results.jsonl", file=sys.stdout)
     return 2 if failed else 0
+
+
+def _note_workers(jobs: int, tasks: int) -> None:
+    """Say so when ``--jobs`` asks for more workers than there are tasks (a worker is started
+    only for a task) or cores (the workers then share them)."""
+    workers = min(jobs, tasks)
+    notes = [f"{workers} worker{'s' if workers > 1 else ''}, one per task"] if jobs > tasks else []
+    if workers > cores():
+        n = cores()
+        notes.append(f"more than the {n} core{'s' if n > 1 else ''}: the tasks share them, each running slower")
+    if notes:
+        print(f"plan: note: --jobs {jobs}: {'; '.join(notes)}", file=sys.stderr)

@@ -33,15 +33,16 @@ import socket
 import time
 import traceback
 from collections import deque
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from multiprocessing.connection import Connection, wait
 from typing import Any, Protocol
 
 from ..model.processes import cores, die_with_parent
+from ..model.stop import quiet_child, signals_blocked
 
-__all__ = ["Executor", "LocalExecutor", "Outcome", "describe"]
+__all__ = ["Executor", "Feed", "LocalExecutor", "Outcome", "describe"]
 
 
 @dataclass(frozen=True)
@@ -68,7 +69,7 @@ class Executor(Protocol):
 
     workers: int  # calls that run at once
 
-    def run(self, fn: Callable[[Any, Any], Any], items: Sequence, shared: Any = None, *, retries: int = 2,
+    def run(self, fn: Callable[[Any, Any], Any], items: Iterable, shared: Any = None, *, retries: int = 2,
             timeout: float | None = None) -> Iterator[tuple[int, Outcome]]: ...
 
     def close(self) -> None: ...
@@ -86,8 +87,8 @@ def describe(err: BaseException) -> str:
 def _serve(conn: Connection, parent: int) -> None:
     """A worker's life: receive ``("shared", obj)`` and ``("call", index, fn, item)`` messages, answer
     each call with ``(index, value, error, pid, seconds)``, until the pipe closes."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the whole group: the run handles it
     die_with_parent(parent, signal.SIGKILL)  # it writes nothing: SIGKILL is the right end
+    quiet_child()  # Ctrl-C reaches the whole group: the run handles it
     shared = None
     while True:
         try:
@@ -126,6 +127,53 @@ def _one_blas_thread() -> Iterator[None]:
             os.environ.pop(name, None)
 
 
+class Feed:
+    """The items of a run, taken one at a time as workers are free for them (an iterator is read
+    no further ahead than that), calls begun again first, and each call's attempts so far.
+
+    >>> feed = Feed(iter("ab"))
+    >>> feed.take(), feed.peek()
+    ((0, 'a'), (1, 'b'))
+    >>> feed.again(0, "a"); feed.take(), feed.attempts[0]
+    ((0, 'a'), 2)
+    >>> feed.answered(0), feed.take(), feed.take(), feed.peek()
+    (2, (1, 'b'), None, None)
+    """
+
+    def __init__(self, items: Iterable):
+        self._items = enumerate(items)
+        self._again: deque[tuple[int, Any]] = deque()
+        self._next: tuple[int, Any] | None = None
+        self.attempts: dict[int, int] = {}  # of each call begun and not yet answered
+
+    def peek(self) -> tuple[int, Any] | None:
+        """The next ``(index, item)`` to begin, or None when none is left."""
+        if self._again:
+            return self._again[0]
+        if self._next is None:
+            self._next = next(self._items, None)
+        return self._next
+
+    def take(self) -> tuple[int, Any] | None:
+        """:meth:`peek`'s call, now begun (an attempt more)."""
+        call = self.peek()
+        if call is not None:
+            if self._again:
+                self._again.popleft()
+            else:
+                self._next = None
+            self.attempts[call[0]] = self.attempts.get(call[0], 0) + 1
+        return call
+
+    def again(self, index: int, item: Any) -> None:
+        """Begin call ``index`` again, before any other."""
+        self._again.appendleft((index, item))
+
+    def answered(self, index: int) -> int:
+        """Forget call ``index``, answered now; return its attempts."""
+        return self.attempts.pop(index)
+
+
 class _Worker:
     """One spawned worker process and the pipe to it."""
 
@@ -133,11 +181,12 @@ class _Worker:
         self.conn, child = context.Pipe()
         self.process = context.Process(target=_serve, args=(child, os.getpid()), daemon=True,
                                        name="stablepush-batch-worker")
-        with _one_blas_thread():
+        with _one_blas_thread(), signals_blocked():  # until the worker has its own handlers (_serve)
             self.process.start()
         child.close()
         self.conn.send(("shared", shared))
         self.index: int | None = None  # the call it runs
+        self.item: Any = None  # and its item, to begin it again if the worker dies
         self.began = 0.0
 
     def begin(self, index: int, fn: Callable, item: Any) -> None:
@@ -170,30 +219,34 @@ class LocalExecutor:
     def close(self) -> None:
         """Nothing to release: each run stops its own workers."""
 
-    def run(self, fn: Callable[[Any, Any], Any], items: Sequence, shared: Any = None, *, retries: int = 2,
+    def run(self, fn: Callable[[Any, Any], Any], items: Iterable, shared: Any = None, *, retries: int = 2,
             timeout: float | None = None) -> Iterator[tuple[int, Outcome]]:
-        """Call ``fn(item, shared)`` for each item; yield ``(index, Outcome)`` as calls end (module docstring)."""
-        waiting = deque(range(len(items)))
-        attempts = [0] * len(items)
+        """Call ``fn(item, shared)`` for each item, taken from ``items`` as a worker is free for it
+        (a worker is started only for an item waiting, so never more than the items); yield
+        ``(index, Outcome)`` as calls end, ``index`` counting the items from 0 (module docstring)."""
+        feed = Feed(items)
         pool: list[_Worker] = []
         try:
-            while waiting or any(w.index is not None for w in pool):
-                while waiting and len(pool) < self.workers:
-                    pool.append(_Worker(self._context, shared))
-                for worker in list(pool):
-                    if worker.index is None and waiting:
-                        index = waiting.popleft()
-                        try:
-                            worker.begin(index, fn, items[index])
-                        except OSError:  # it died while idle: replaced, the call not begun
-                            waiting.appendleft(index)
-                            pool.remove(worker)
-                            worker.kill()
-                            continue
-                        attempts[index] += 1
+            while True:
+                # A worker is started only for a call waiting for one: never more than the calls.
+                while (call := feed.peek()) is not None:
+                    worker = next((w for w in pool if w.index is None), None)
+                    if worker is None and len(pool) < self.workers:
+                        worker = _Worker(self._context, shared)
+                        pool.append(worker)
+                    if worker is None:
+                        break
+                    try:
+                        worker.begin(call[0], fn, call[1])
+                    except OSError:  # it died while idle: replaced, the call not begun
+                        pool.remove(worker)
+                        worker.kill()
+                        continue
+                    worker.item = call[1]
+                    feed.take()
                 busy = [w for w in pool if w.index is not None]
-                if not busy:  # every worker free died: start others
-                    continue
+                if not busy:
+                    break  # nothing waits: every call is answered
                 soonest = min((w.began + timeout for w in busy), default=None) if timeout else None
                 ready = wait([w.conn for w in busy] + [w.process.sentinel for w in busy],
                              None if soonest is None else max(0.0, soonest - time.monotonic()))
@@ -209,19 +262,19 @@ class LocalExecutor:
                         code = worker.process.exitcode
                         why = (f"its worker died (signal {-code})" if code is not None and code < 0
                                else f"its worker died (exit code {code})")
-                        if attempts[index] <= retries:
-                            waiting.appendleft(index)  # again, first, on a new worker
+                        if feed.attempts[index] <= retries:
+                            feed.again(index, worker.item)  # again, first, on a new worker
                             continue
-                        yield index, Outcome(error=f"{why}, {attempts[index]} times", host=self.host,
-                                             attempts=attempts[index])
+                        yield index, Outcome(error=f"{why}, {feed.attempts[index]} times", host=self.host,
+                                             attempts=feed.answered(index))
                     elif outcome == "late":
                         pool.remove(worker)
                         worker.kill()
                         yield index, Outcome(error=f"stopped after {timeout:g} s, past its time limit",
-                                             host=self.host, attempts=attempts[index])
+                                             host=self.host, attempts=feed.answered(index))
                     else:
-                        worker.index = None
-                        yield index, replace(outcome, attempts=attempts[index])
+                        worker.index = worker.item = None
+                        yield index, replace(outcome, attempts=feed.answered(index))
         finally:
             for worker in pool:
                 worker.kill()

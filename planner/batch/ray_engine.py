@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 from ..model.fields import SceneError
-from .executors import Outcome, describe
+from .executors import Feed, Outcome, describe
 
 __all__ = ["RayExecutor", "needs_ray"]
 
@@ -88,50 +88,49 @@ class RayExecutor:
         if self._started and self._ray.is_initialized():
             self._ray.shutdown()
 
-    def run(self, fn: Callable[[Any, Any], Any], items: Sequence, shared: Any = None, *, retries: int = 2,
+    def run(self, fn: Callable[[Any, Any], Any], items: Iterable, shared: Any = None, *, retries: int = 2,
             timeout: float | None = None) -> Iterator[tuple[int, Outcome]]:
         """Call ``fn(item, shared)`` for each item; yield ``(index, Outcome)`` as calls end."""
         ray = self._ray
         shared_ref = ray.put(shared)
-        attempts = [0] * len(items)
-        waiting = list(range(len(items)))[::-1]
-        running: dict[Any, tuple[int, float]] = {}  # ref: (index, when it was submitted)
+        feed = Feed(items)
+        running: dict[Any, tuple[int, Any, float]] = {}  # ref: (index, item, when it was submitted)
 
         def submit() -> None:
             # Two per worker in flight: one queued behind each running call hides Ray's round trip
             # (about 5 ms), and a task's clock, started when it is submitted, runs at most one
             # call early.
-            while waiting and len(running) < 2 * self.workers:
-                index = waiting.pop()
-                attempts[index] += 1
-                running[self._remote.remote(fn, items[index], shared_ref)] = (index, time.monotonic())
+            while len(running) < 2 * self.workers and (call := feed.take()) is not None:
+                index, item = call
+                running[self._remote.remote(fn, item, shared_ref)] = (index, item, time.monotonic())
 
         try:
             submit()
             while running:
-                soonest = min(began for _, began in running.values()) + timeout if timeout else None
+                soonest = min(began for _, _, began in running.values()) + timeout if timeout else None
                 done, _ = ray.wait(list(running), num_returns=1,
                                    timeout=None if soonest is None else max(0.01, soonest - time.monotonic()))
                 for ref in done:
-                    index, _ = running.pop(ref)
+                    index, item, _ = running.pop(ref)
                     try:
                         value, error, host, pid, seconds = ray.get(ref)
                     except (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError,
                             ray.exceptions.OutOfMemoryError, ray.exceptions.LocalRayletDiedError) as err:
-                        if attempts[index] <= retries:
-                            waiting.append(index)
+                        if feed.attempts[index] <= retries:
+                            feed.again(index, item)
                         else:
-                            yield index, Outcome(error=f"its worker died ({describe(err)}), {attempts[index]} times",
-                                                 attempts=attempts[index])
+                            tries = feed.answered(index)
+                            yield index, Outcome(error=f"its worker died ({describe(err)}), {tries} times",
+                                                 attempts=tries)
                         continue
-                    yield index, Outcome(value, error, host, pid, attempts[index], seconds)
+                    yield index, Outcome(value, error, host, pid, feed.answered(index), seconds)
                 if timeout:
-                    for ref, (index, began) in list(running.items()):
+                    for ref, (index, _, began) in list(running.items()):
                         if time.monotonic() - began > timeout:
                             ray.cancel(ref, force=True)
                             del running[ref]
                             yield index, Outcome(error=f"stopped after {timeout:g} s, past its time limit",
-                                                 attempts=attempts[index])
+                                                 attempts=feed.answered(index))
                 submit()
         finally:
             for ref in running:

@@ -8,70 +8,151 @@ A task's plan file, ``<id>.json`` beside it, is written (atomically) before its 
 means its plan is there.
 
 The columns, in this order, are :data:`COLUMNS`: the task (``id``, ``scene``, ``seed``, ``goal``,
-``overrides``), its ``status`` (``solved``, ``unreachable``: certified at once, ``unknown``: not
+``overrides``, and what its plan depends on besides: ``scene_digest``, the SHA-256 of the scene
+file's bytes, and the planner's ``version``), its ``status`` (``solved``, ``unreachable``: certified at once, ``unknown``: not
 solved within its time limit, ``failed``: ``error`` says why), the plan's ``cost`` (length plus the
 switch cost per switch), ``length`` (of the centre of friction's path), ``pushes`` and ``switches``,
 ``planning_time_s``, ``task_s`` (the whole task's seconds in its worker: reading, certificates,
 planning), ``regions_computed`` (exact regions the worker computed itself), the worker's ``host``,
 the ``attempts`` it took and the ``plan`` file.
 
+A results file is read back (:meth:`ResultsFile.read`) as untrusted input: a line at a time, each
+line bounded in size and nesting and checked field by field (:func:`is_record`); a line that is
+not a whole record is not reused, and its task runs again.
+
 >>> import tempfile
 >>> results = ResultsFile(Path(tempfile.mkdtemp()) / "results.jsonl")
->>> results.append({"id": "a-s1", "status": "solved"})
+>>> results.append(dict.fromkeys(COLUMNS) | {"id": "a-s1", "scene": "a.yaml", "seed": 1, "overrides": {},
+...                 "status": "unknown", "pushes": 0, "switches": 0, "planning_time_s": 1.0, "attempts": 1})
 >>> with open(results.path, "a") as f:
-...     _ = f.write('{"id": "a-s2", "sta')  # a run killed mid-line
->>> sorted(ResultsFile(results.path).read())
-['a-s1']
+...     _ = f.write('{"id": "a-s3"}\\n{"id": "a-s2", "sta')  # a line not a record, then a run killed mid-line
+>>> records, bad = ResultsFile(results.path).read()
+>>> sorted(records), bad
+(['a-s1'], 1)
 """
 
 from __future__ import annotations
 
+import errno
 import json
+import math
 import os
 import statistics
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-__all__ = ["COLUMNS", "STATUSES", "ResultsFile", "summary"]
+from ..model.fields import SceneError
+from ..model.json_file import parse_json
 
-COLUMNS = ("id", "scene", "seed", "goal", "overrides", "status", "cost", "length", "pushes", "switches",
+__all__ = ["COLUMNS", "MAX_LINE", "STATUSES", "ResultsFile", "is_record", "summary"]
+
+COLUMNS = ("id", "scene", "seed", "goal", "overrides", "scene_digest", "version", "status", "cost", "length", "pushes", "switches",
            "planning_time_s", "task_s", "regions_computed", "host", "attempts", "error", "plan")
 STATUSES = ("solved", "unreachable", "unknown", "failed")
+#: Longest results line read (a task's line is some 500 bytes; its overrides are a few numbers).
+MAX_LINE = 100_000
+#: Deepest nesting of a results line (``overrides.cf_offset`` goes 2 deep).
+_MAX_DEPTH = 4
+
+
+def _is_number(value: Any, optional: bool = False, whole: bool = False) -> bool:
+    if value is None:
+        return optional
+    kinds = (int,) if whole else (int, float)
+    if not isinstance(value, kinds) or isinstance(value, bool):
+        return False
+    return (math.isfinite(value) if isinstance(value, float) else True) and value >= 0  # an int may exceed a float
+
+
+def _is_text(value: Any, optional: bool = False) -> bool:
+    return (value is None and optional) or (isinstance(value, str) and len(value) <= MAX_LINE)
+
+
+def is_record(record: Any) -> bool:
+    """Whether ``record`` (a results line as JSON gives it) is a whole record: every column, each
+    of its kind (a ``solved`` one with its cost, length and plan file ``<id>.json``).
+
+    >>> is_record({"id": "battery-s2"}), is_record(dict.fromkeys(COLUMNS))
+    (False, False)
+    """
+    if not isinstance(record, dict) or set(record) != set(COLUMNS):
+        return False
+    r = record
+    goal = r["goal"]
+    solved = r["status"] == "solved"
+    return bool(
+        _is_text(r["id"]) and _is_text(r["scene"]) and _is_number(r["seed"], whole=True)
+        and (goal is None or (isinstance(goal, list) and len(goal) == 3
+                              and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in goal)))
+        and isinstance(r["overrides"], dict) and _is_text(r["scene_digest"], True) and _is_text(r["version"], True)
+        and r["status"] in STATUSES and _is_number(r["cost"], not solved) and _is_number(r["length"], not solved)
+        and all(_is_number(r[k], True, whole=True) for k in ("pushes", "switches", "regions_computed", "attempts"))
+        and all(_is_number(r[k], True) for k in ("planning_time_s", "task_s"))
+        and _is_text(r["host"], True) and _is_text(r["error"], True)
+        and (r["plan"] == f"{r['id']}.json" if solved else _is_text(r["plan"], True)))
 
 
 class ResultsFile:
     """``path``, a results file: :meth:`read` the lines there, :meth:`append` one more. Opening
-    it cuts off a last line left incomplete by a killed run."""
+    it cuts off a last line left incomplete by a killed run.
+
+    Raises
+    ------
+    OSError
+        If ``path`` is there but is not a regular file, or cannot be opened."""
 
     def __init__(self, path: str | Path):
         self.path = Path(path)
+        if self.path.exists() and not self.path.is_file():  # a folder or a pipe: never opened
+            raise OSError(errno.EINVAL, "not a regular file", str(self.path))
         self._drop_torn_line()
 
     def _drop_torn_line(self) -> None:
+        """Cut the file after its last newline, reading back from its end only as far as that."""
         try:
             with open(self.path, "rb+") as f:
-                data = f.read()
-                if data and not data.endswith(b"\n"):
-                    f.truncate(data.rfind(b"\n") + 1)
+                end = f.seek(0, os.SEEK_END)
+                if end == 0:
+                    return
+                f.seek(end - 1)
+                if f.read(1) == b"\n":
+                    return
+                where = end
+                while where > 0:
+                    step = min(1 << 16, where)
+                    where -= step
+                    f.seek(where)
+                    newline = f.read(step).rfind(b"\n")
+                    if newline >= 0:
+                        f.truncate(where + newline + 1)
+                        return
+                f.truncate(0)
         except FileNotFoundError:
             pass
 
-    def read(self) -> dict[str, dict[str, Any]]:
-        """The records in the file by task id (a line that is not a record is skipped)."""
-        records = {}
+    def read(self) -> tuple[dict[str, dict[str, Any]], int]:
+        """The whole records in the file by task id (the last line of an id wins), and how many
+        lines were not whole records (:func:`is_record`: cut, edited, longer than :data:`MAX_LINE`)."""
+        records: dict[str, dict[str, Any]] = {}
+        bad = 0
         try:
-            lines = self.path.read_text().splitlines()
+            f = open(self.path, "rb")
         except FileNotFoundError:
-            return records
-        for line in lines:
-            try:
-                record = json.loads(line)
-            except ValueError:
-                continue
-            if isinstance(record, dict) and isinstance(record.get("id"), str):
-                records[record["id"]] = record
-        return records
+            return records, bad
+        with f:
+            for raw in f:
+                record = None
+                if len(raw) <= MAX_LINE:
+                    try:
+                        record = parse_json(raw.decode("utf-8"), "results", _MAX_DEPTH)
+                    except (UnicodeDecodeError, SceneError):
+                        pass
+                if is_record(record):
+                    records[record["id"]] = record
+                else:
+                    bad += 1
+        return records, bad
 
     def append(self, record: Mapping[str, Any]) -> None:
         """Append ``record`` as one line, written whole and flushed to disk."""

@@ -12,11 +12,18 @@ written, workers started, the idle tail). It also checks that every engine gave 
 times the stable regions computed once in the driver on a cold cache (the workers then compute
 none), and the round trip of an empty call on each engine (its workers started). The Ray rows need
 the ``ray`` extra; they are skipped without it.
+
+``python -m planner.bench.batch --tasks 100000 --dry`` plans nothing: for a hundredth, a tenth and
+all of that many tasks (one scene, a seed range) it times the batch's own bookkeeping, each of
+which must grow linearly with the tasks: making every task and its id, reading a results file of a
+line per task back for ``--resume`` and finding which it answers (a plan file each, as a run
+leaves them), and the records and summary table at the end.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import tempfile
@@ -24,6 +31,8 @@ import time
 from pathlib import Path
 
 from ..batch import LocalExecutor, make_tasks, run_batch
+from ..batch.results import COLUMNS, ResultsFile, summary
+from ..batch.run import batch_records, reusable
 from ..batch.tasks import shared_regions
 
 __all__ = ["main"]
@@ -43,7 +52,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seeds", type=int, default=50, help="seeds per scene (default: %(default)s; 4 scenes)")
     p.add_argument("--time-limit", type=float, default=5.0, metavar="S")
     p.add_argument("--no-ray", action="store_true", help="local workers only")
+    p.add_argument("--dry", action="store_true", help="plan nothing: time the bookkeeping of --tasks tasks")
+    p.add_argument("--tasks", type=int, default=100_000, help="with --dry: the most tasks (default: %(default)s)")
     args = p.parse_args(argv)
+    if args.dry:
+        return _dry(args.tasks)
     # Another program busy on the machine slows the workers, not the one worker alone: say so.
     print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} before the runs")
     root = Path(__file__).resolve().parents[2] / "scenes"
@@ -77,6 +90,40 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{name:<26}{workers:>8}{start:>10.2f}{wall:>9.2f}{busy:>10.2f}{one / (workers * wall):>11.0%}"
               f"{alone / busy:>9.0%}{1000 * (workers * wall - busy) / len(records):>19.1f}{1000 * call:>16.2f}"
               f"{'yes' if _same(records, rows[0][4]) else 'NO':>14}")
+    return 0
+
+
+def _dry(most: int) -> int:
+    """Time the bookkeeping of a batch of ``most // 100``, ``most // 10`` and ``most`` tasks (module docstring)."""
+    scene = Path(__file__).resolve().parents[2] / "scenes" / "battery.yaml"
+    print(f"{'tasks':>8}{'make[s]':>9}{'resume[s]':>11}{'summary[s]':>12}{'make[us/task]':>15}{'resume[us/task]':>17}"
+          f"{'summary[us/task]':>18}")
+    for n in (most // 100, most // 10, most):
+        tasks = make_tasks([scene], range(1, n + 1))
+        clock = time.perf_counter()
+        ids = [t.id for t in tasks]
+        make = time.perf_counter() - clock
+        with tempfile.TemporaryDirectory() as out:
+            folder = Path(out)
+            with open(folder / "results.jsonl", "w") as f:  # as a run leaves it: a line and a plan file a task
+                for task in tasks:
+                    record = dict.fromkeys(COLUMNS) | task.record() | {
+                        "status": "solved", "cost": 1.0, "length": 1.0, "pushes": 1, "switches": 0,
+                        "planning_time_s": 0.1, "task_s": 0.2, "regions_computed": 0, "host": "h", "attempts": 1,
+                        "plan": f"{task.id}.json"}
+                    f.write(json.dumps(record) + "\n")
+                    (folder / record["plan"]).touch()
+            clock = time.perf_counter()
+            done, bad = ResultsFile(folder / "results.jsonl").read()
+            reused = reusable(tasks.find, done, folder)
+            resume = time.perf_counter() - clock
+            assert len(reused) == n and not bad
+            clock = time.perf_counter()
+            table = summary(batch_records(tasks.find, done))
+            end = time.perf_counter() - clock
+            assert f"{n:>7}" in table and len(ids) == n
+        print(f"{n:>8}{make:>9.3f}{resume:>11.3f}{end:>12.3f}{1e6 * make / n:>15.1f}{1e6 * resume / n:>17.1f}"
+              f"{1e6 * end / n:>18.1f}")
     return 0
 
 

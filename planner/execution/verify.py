@@ -36,7 +36,9 @@ where the one before it left the part, every push is on the edge the pusher is o
 transit starts at the contact pose on that edge, ends at the contact pose on the next push's edge,
 and uses a mode the scene allows (a lift only with ``pusher.transit: lift``). The drift treats a
 transit as the identity. Whether a transit's path is collision-free is the planner's rule
-(:mod:`planner.actions.transit`), not checked here.
+(:mod:`planner.actions.transit`), not checked here; a plan read from a file is checked against its
+scene, obstacles included, before it is verified (:mod:`planner.execution.fit`, which uses
+:func:`check_chain`).
 """
 
 from __future__ import annotations
@@ -59,7 +61,7 @@ from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene
 from ..actions.transit import edge_contact_pose
 
-__all__ = ["TOLERANCE", "PushCheck", "Verification", "distributions", "verify"]
+__all__ = ["TOLERANCE", "PushCheck", "Verification", "check_chain", "distributions", "verify"]
 
 #: Default relative tolerance: positions in slider radii, angles in radians (module docstring).
 TOLERANCE = 1e-6
@@ -284,7 +286,7 @@ def _check_transit(scene: Scene, transit: Transit, edge: int | None, name: str) 
                                                     f"pose on edge {e}: {np.round(flush, 6).tolist()}")
 
 
-def _check_chain(scene: Scene, plan: Plan) -> list[tuple[Contact, ...]]:
+def check_chain(scene: Scene, plan: Plan) -> list[tuple[Contact, ...]]:
     """The pusher's contacts for each push, after checking that every segment fits the scene and
     takes over where the one before left the part and the pusher (module docstring)."""
     pose, edge, after = plan.start, None, "the plan's start"
@@ -353,7 +355,7 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
     >>> check.passed, len(check.pushes), check.worst[0] < 1e-12
     (True, 1, True)
     """
-    contacts = _check_chain(scene, plan)
+    contacts = check_chain(scene, plan)
     clock = time.perf_counter()
     supports, kinds = distributions(scene, n, seed)
     limits = (tolerance * scene.slider.radius, tolerance)

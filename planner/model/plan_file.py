@@ -21,10 +21,13 @@ from mechanics import exp_twist, point_velocity, relative_pose, wrap_angle
 
 from .bodies import transform_points
 from .fields import SceneError, integer, keys, number, vector
+from .json_file import read_json
 
-__all__ = ["FORMAT", "TRANSIT_MODES", "Push", "Transit", "Plan", "append_push", "load_plan", "rechain"]
+__all__ = ["FORMAT", "MAX_BYTES", "TRANSIT_MODES", "Push", "Transit", "Plan", "append_push", "load_plan", "rechain"]
 
 FORMAT = "stablepush.plan/1"
+#: Largest plan file read: a plan of ten thousand segments with their transits' paths.
+MAX_BYTES = 10_000_000
 #: How a transit moves the pusher: on the table, or lifted over it between two standoff poses.
 TRANSIT_MODES = ("plane", "lift")
 
@@ -398,12 +401,9 @@ def load_plan(path: str | Path) -> Plan:
     Raises
     ------
     SceneError
-        Naming the field at fault (``plan.segments[2].twist: ...``) or the file if unreadable.
+        Naming the field at fault (``plan.segments[2].twist: ...``), or ``plan`` for a file that
+        cannot be read, is not a regular file, is larger than :data:`MAX_BYTES`, nests deeper than
+        :data:`~planner.model.json_file.MAX_DEPTH` or is not JSON.
     """
-    try:
-        data = json.loads(Path(path).read_text())
-    except OSError as err:
-        raise SceneError("plan", f"cannot read {str(path)!r}: {err.strerror or err}") from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise SceneError("plan", f"{str(path)!r} is not valid JSON: {err}") from None
+    data = read_json(path, "plan", MAX_BYTES)
     return Plan.from_dict(data)

@@ -16,7 +16,7 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-__all__ = ["Terminated", "raise_on_sigterm", "signals_deferred", "terminate"]
+__all__ = ["Terminated", "quiet_child", "raise_on_sigterm", "signals_blocked", "signals_deferred", "terminate"]
 
 
 class Terminated(BaseException):
@@ -74,3 +74,41 @@ def signals_deferred() -> Iterator[list[int]]:
     if noted:
         raise KeyboardInterrupt if noted[0] == signal.SIGINT else Terminated
 
+
+_STOPS = {signal.SIGINT, signal.SIGTERM}
+
+
+@contextmanager
+def signals_blocked() -> Iterator[None]:
+    """Within the block, SIGINT and SIGTERM wait (blocked) and are delivered on leaving it, and
+    SIGINT is ignored, so that a child started within it cannot get either before it has set its
+    own handlers (:func:`quiet_child`): otherwise Ctrl-C in a child's first moments prints its
+    traceback. A forked child keeps the mask; a spawned one (an exec, whose mask multiprocessing
+    clears) keeps SIGINT ignored, and Python then installs no KeyboardInterrupt handler; SIGTERM
+    ends it silently, Python having none for it. (A Ctrl-C between the blocking and the ignoring,
+    microseconds, is lost.)"""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS)
+    handler = signal.getsignal(signal.SIGINT)
+    ignoring = threading.current_thread() is threading.main_thread() and handler is not None
+    if ignoring:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        if ignoring:
+            signal.signal(signal.SIGINT, handler)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
+def quiet_child(on_sigterm=signal.SIG_DFL) -> None:
+    """In a child process started under :func:`signals_blocked`: ignore Ctrl-C (it reaches the
+    whole group; the run handles it and stops its children), handle SIGTERM by ``on_sigterm``
+    (by default it ends the child at once and silently, not as the run's own :class:`Terminated`,
+    inherited over a fork, which would print a traceback there), then take signals again."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, on_sigterm)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)

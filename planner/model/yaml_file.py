@@ -30,6 +30,7 @@ from typing import Any
 import yaml
 
 from .fields import SceneError, member, shown
+from .input_file import read_text
 
 __all__ = ["MAX_BYTES", "MAX_DEPTH", "MAX_NODES", "read_yaml"]
 
@@ -61,18 +62,7 @@ def read_yaml(path: str | Path, name: str) -> Any:
         ("malformed"), or is YAML this reader refuses ("unsupported": beyond :data:`MAX_NODES` or
         :data:`MAX_DEPTH`, an alias to no whole node before it); or if a key is given twice.
     """
-    path = Path(path)
-    try:
-        with path.open("rb") as f:
-            raw = f.read(MAX_BYTES + 1)  # no more: a huge file or a device is refused unread
-    except (OSError, ValueError) as err:  # ValueError: a NUL in the path
-        raise SceneError(name, f"cannot read {shown(str(path))}: {getattr(err, 'strerror', None) or err}") from None
-    if len(raw) > MAX_BYTES:
-        raise SceneError(name, f"{shown(str(path))} is larger than {MAX_BYTES} bytes")
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as err:
-        raise SceneError(name, f"{shown(str(path))} is not UTF-8 text (bad byte at offset {err.start})") from None
+    text = read_text(path, name, MAX_BYTES)  # a regular file of at most MAX_BYTES, UTF-8
     try:
         return _parse_yaml(text, name)
     except yaml.YAMLError as err:

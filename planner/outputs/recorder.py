@@ -31,7 +31,7 @@ from pathlib import Path
 from ..actions.region_cache import RegionCache, default_cache
 from ..model.scene import Scene
 from ..model.processes import die_with_parent, fork_context
-from ..model.stop import Terminated
+from ..model.stop import Terminated, quiet_child, signals_blocked, terminate
 
 __all__ = ["RecordingFailed", "recorder"]
 
@@ -56,9 +56,9 @@ def _child(conn, parents_end, parent: int, scene: Scene, cache: RegionCache) -> 
     is closed here (so the parent's exit is an end of file), and a signal comes if the parent is
     killed. Whatever fails is sent back as one :class:`RecordingFailed`, never printed here."""
     parents_end.close()
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to report
     try:
         die_with_parent(parent)
+        quiet_child(terminate)  # Ctrl-C is the parent's to report; SIGTERM ends this process below
         failed = None
         try:
             import_module(".recording", __package__)  # rerun and the drawing code: the import the parent is spared
@@ -120,7 +120,8 @@ def recorder(scene: Scene, cache: RegionCache | None = None) -> Iterator[Callabl
     conn, theirs = context.Pipe()
     child = context.Process(target=_child, args=(theirs, conn, os.getpid(), scene, cache), name="stablepush-recorder",
                             daemon=True)
-    child.start()
+    with signals_blocked():  # until the child has set its own handlers
+        child.start()
     theirs.close()
 
     sent = []
