@@ -14,7 +14,9 @@ and prints a line per run and a summary line; MuJoCo is imported only then.
 pushes (:func:`planner.queries.reachable_set.reachable_set`, any heading): ``<name>-reach.png`` in the
 output folder and ``/world/reach`` in the recording; with ``--engine`` (and ``--jobs``) its headings
 are computed on the batch executors (:func:`planner.batch.reach.reachable_set_on`). Several scenes,
-or ``--seeds``, make a batch instead (:mod:`planner.batch.command`).
+or ``--seeds``, make a batch instead (:mod:`planner.batch.command`). ``--export-scene FILE`` also
+writes the scene as planned in the plain schema (:func:`planner.model.scene.write_scene`: CAD
+files and boxes resolved to vertices, the CF written out).
 
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
 solved or certified unreachable (:func:`planner.certify_unreachable`, checked before planning; one
@@ -51,7 +53,7 @@ from .outputs.recorder import RecordingFailed, recorder
 from .actions.region_cache import cache_folder
 from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_OPTIMIZE, MAX_SEED, MAX_TIME_LIMIT,
                             PLANNERS, REGIONS, TRANSITS, PlannerOptions, check_optimize, check_seed, check_time_limit)
-from .model.scene import Scene, load_scene
+from .model.scene import Scene, load_scene, write_scene
 from .search import plan
 
 if TYPE_CHECKING:
@@ -135,6 +137,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="with --simulate: move the supports' centre of pressure by this offset from the CF "
                         "(slider frame, m)")
     p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")
+    p.add_argument("--export-scene", metavar="FILE",
+                   help="also write the scene as planned to FILE (YAML, the plain schema: CAD files and boxes "
+                        "resolved to vertices in metres, the CF and the pushed edges written out)")
     batch = p.add_argument_group("batch runs (several scenes, or --seeds; planner.batch)")
     batch.add_argument("--seeds", metavar="A:B", help="plan each scene for seeds A to B (or N, or A,B,C)")
     batch.add_argument("--jobs", type=int, metavar="N", help="tasks at once (default: the cores, or the Ray cluster's CPUs)")
@@ -164,6 +169,7 @@ class Inputs:
     sim_mu: float | None = None  # --sim-mu
     sim_cf_offset: tuple[float, float] = (0.0, 0.0)  # --sim-cf-offset
     mjcf: Path | None = None  # --mjcf FILE
+    export_scene: Path | None = None  # --export-scene FILE
 
 
 def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
@@ -211,12 +217,15 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--out", f"cannot use {shown(str(out))}: {getattr(err, 'strerror', None) or err}") from None
     if taken:  # found now, not after the search
         raise SceneError("--out", f"{shown(str(out))} exists and is not a folder")
+    if args.export_scene is not None and os.path.isdir(args.export_scene):
+        raise SceneError("--export-scene", f"{shown(args.export_scene)} is a folder")
     return Inputs(scene, args.planner or scene.planner.name, limit or scene.planner.time_limit,
                   seed or scene.planner.seed, out, args.verify, args.plan,
                   None if args.plan is None else load_plan(args.plan), args.reach,
                   None if args.engine is None and args.jobs is None else (args.engine or "local", args.jobs, args.address),
                   args.trajectory, args.simulate,
-                  args.sim_mu, tuple(args.sim_cf_offset or (0.0, 0.0)), None if args.mjcf is None else Path(args.mjcf))
+                  args.sim_mu, tuple(args.sim_cf_offset or (0.0, 0.0)), None if args.mjcf is None else Path(args.mjcf),
+                  None if args.export_scene is None else Path(args.export_scene))
 
 
 def _check_simulation(args: argparse.Namespace) -> None:
@@ -244,6 +253,9 @@ def main(argv: list[str] | None = None) -> int:
             if _is_batch(args := _parser().parse_args(argv)):
                 from .batch.command import run_command
 
+                if args.export_scene is not None:
+                    raise SceneError("--export-scene", "is for one plan, not a batch (several scenes or --seeds)")
+
                 return run_command(args)
             return _run(read_inputs(argv))
     except SceneError as err:
@@ -270,6 +282,8 @@ class _NotWritten(Exception):
 
 
 def _run(inputs: Inputs) -> int:
+    for note in inputs.scene.notes:
+        print(f"plan: note: {note}", file=sys.stderr)
     with recorder(inputs.scene) as write:  # rerun is imported beside the search, where it can be
         return _plan_and_write(inputs, write)
 
@@ -320,6 +334,8 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
             from .batch.reach import reachable_set_on
 
             reach = reachable_set_on(scene, inputs.reach, *inputs.engine)
+    if inputs.export_scene is not None:
+        _export_scene(scene, inputs)
     _write_outputs(out, scene, result, check, reach, motion, write_recording, simulation, inputs.mjcf)
     if unreachable:
         print(f"plan: unreachable: {unreachable} (outputs in {out})", file=sys.stderr)
@@ -341,6 +357,15 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         lines[-1] += f" (outputs in {out})"
     print("\n".join(lines))
     return 0 if (check is None or check.passed) and (simulation is None or simulation.passed) else 3
+
+
+def _export_scene(scene: Scene, inputs: Inputs) -> None:
+    """Write ``scene`` as planned, with the run's planner, time limit and seed, to ``--export-scene``'s file."""
+    used = replace(scene.planner, name=inputs.planner, time_limit=inputs.time_limit, seed=inputs.seed)
+    try:
+        write_scene(replace(scene, planner=used), inputs.export_scene)
+    except OSError as err:
+        raise _NotWritten(f"cannot write {shown(str(inputs.export_scene))}: {err.strerror or err}") from None
 
 
 def _first_found(result: Plan) -> str:
