@@ -99,7 +99,7 @@ def _chains(pieces: list[np.ndarray], chord: float) -> tuple[list[np.ndarray], i
     within a hundredth of ``chord`` are taken as one), and how many chains stay open."""
     if not pieces:
         return [], 0
-    lines = shapely.set_precision(shapely.linestrings(pieces), chord / 100)
+    lines = shapely.set_precision([shapely.LineString(piece) for piece in pieces], chord / 100)
     faces, cuts, dangles, invalid = shapely.polygonize_full([shapely.union_all(lines)])
     # A loop inside another is a face of its own, so the faces' outer rings are every loop.
     rings = [np.asarray(face.exterior.coords)[:-1] for face in shapely.get_parts(faces)]

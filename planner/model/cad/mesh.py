@@ -53,7 +53,8 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     triangles = np.concatenate([mesh.triangles for mesh in meshes])
     selection.check_points(triangles.reshape(-1, 3), "the mesh")
     flat = triangles[:, :, :2]
-    seen = np.abs(np.cross(flat[:, 1] - flat[:, 0], flat[:, 2] - flat[:, 0])) > selection.chord ** 2 * 1e-6
+    (ux, uy), (vx, vy) = (flat[:, 1] - flat[:, 0]).T, (flat[:, 2] - flat[:, 0]).T
+    seen = np.abs(ux * vy - uy * vx) > selection.chord ** 2 * 1e-6  # seen from above: not edge-on
     grid = selection.chord / 10  # unions on a grid far below the tolerance: no slivers of rounding
     region = shapely.union_all(shapely.polygons(flat[seen]), grid_size=grid)
     lowest = float(triangles[:, :, 2].min())
