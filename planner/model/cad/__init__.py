@@ -14,6 +14,7 @@ scene names a file of their kind; without them the scene is refused with one lin
 extra. A file is untrusted input: at most :data:`MAX_FILE_BYTES` are read, coordinates are
 checked against the scene's limits before any curve is flattened, and flattening stops at
 :data:`MAX_POINTS` points, so time and memory are bounded by those numbers, not by the file's.
+What the readers rely on in their libraries is in docs/stack.md, "CAD readers".
 """
 
 from __future__ import annotations
