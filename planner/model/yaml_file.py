@@ -31,7 +31,7 @@ import yaml
 
 from .fields import SceneError, member, shown
 
-__all__ = ["MAX_BYTES", "MAX_DEPTH", "MAX_NODES", "read_yaml"]
+__all__ = ["MAX_BYTES", "MAX_DEPTH", "MAX_NODES", "read_bytes", "read_yaml"]
 
 #: Largest file read: a scene is a few kilobytes; a megabyte holds parts of thousands of
 #: vertices and still parses in a few seconds.
@@ -62,13 +62,7 @@ def read_yaml(path: str | Path, name: str) -> Any:
         :data:`MAX_DEPTH`, an alias to no whole node before it); or if a key is given twice.
     """
     path = Path(path)
-    try:
-        with path.open("rb") as f:
-            raw = f.read(MAX_BYTES + 1)  # no more: a huge file or a device is refused unread
-    except (OSError, ValueError) as err:  # ValueError: a NUL in the path
-        raise SceneError(name, f"cannot read {shown(str(path))}: {getattr(err, 'strerror', None) or err}") from None
-    if len(raw) > MAX_BYTES:
-        raise SceneError(name, f"{shown(str(path))} is larger than {MAX_BYTES} bytes")
+    raw = read_bytes(path, name, MAX_BYTES)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as err:
@@ -81,6 +75,20 @@ def read_yaml(path: str | Path, name: str) -> Any:
         problem = getattr(err, "problem", None) or " ".join(str(err).split())  # some messages span two lines
         kind = "unsupported" if isinstance(err, _Refused) else "malformed"
         raise SceneError(name, f"{kind} YAML{where}: {problem}") from None
+
+
+def read_bytes(path: str | Path, name: str, limit: int) -> bytes:
+    """The bytes of the file ``path``, if it has at most ``limit`` of them; else, or if it cannot
+    be read, a :class:`SceneError` naming ``name``. No more than ``limit + 1`` bytes are read, so a
+    huge file or a device is refused unread."""
+    try:
+        with Path(path).open("rb") as f:
+            raw = f.read(limit + 1)
+    except (OSError, ValueError) as err:  # ValueError: a NUL in the path
+        raise SceneError(name, f"cannot read {shown(str(path))}: {getattr(err, 'strerror', None) or err}") from None
+    if len(raw) > limit:
+        raise SceneError(name, f"{shown(str(path))} is larger than {limit} bytes")
+    return raw
 
 
 def _parse_yaml(text: str, name: str) -> Any:

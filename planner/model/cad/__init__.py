@@ -32,6 +32,7 @@ import shapely.ops
 from shapely.validation import explain_validity
 
 from ..fields import ANGLE, LENGTH, SceneError, number, shown, vector
+from ..yaml_file import read_bytes
 
 __all__ = ["CHORD", "FILE_KEYS", "FILE_OPTIONS", "MAX_FILE_BYTES", "MAX_POINTS", "READERS", "UNITS", "Selection",
            "Shape", "read_shapes", "shapes_from_rings", "without_holes"]
@@ -117,7 +118,7 @@ def read_shapes(spec: dict[str, Any], field: str, folder: Path, notes: list[str]
     kind = READERS.get(path.suffix.lower())
     if kind is None:
         raise SceneError(f"{field}.file", f"{shown(file)}: unknown kind of file (known: {', '.join(READERS)})")
-    raw = _read_bytes(path, f"{field}.file")
+    raw = read_bytes(path, f"{field}.file", MAX_FILE_BYTES)
     reader = importlib.import_module(f".{kind}", __name__)
     try:
         for library in reader.NEEDS:
@@ -144,17 +145,6 @@ def read_shapes(spec: dict[str, Any], field: str, folder: Path, notes: list[str]
 def _where(selection: Selection) -> str:
     return "".join(f" {key} {shown(value)}" for key, value in (("on layer", selection.layer),
                                                                ("named", selection.name)) if value is not None)
-
-
-def _read_bytes(path: Path, field: str) -> bytes:
-    try:
-        with path.open("rb") as f:
-            raw = f.read(MAX_FILE_BYTES + 1)  # no more: a huge file or a device is refused unread
-    except (OSError, ValueError) as err:  # ValueError: a NUL in the path
-        raise SceneError(field, f"cannot read {shown(str(path))}: {getattr(err, 'strerror', None) or err}") from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise SceneError(field, f"{shown(str(path))} is larger than {MAX_FILE_BYTES} bytes")
-    return raw
 
 
 def shapes_from_rings(rings: list[np.ndarray], selection: Selection) -> list[Shape]:
