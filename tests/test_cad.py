@@ -133,9 +133,9 @@ def test_a_mesh_outline_is_its_projection_and_its_cf_the_footprints_centroid(tmp
     top = trimesh.creation.box((60, 40, 10)).apply_translation((0, 0, 15))
     trimesh.util.concatenate([foot, top]).export(tmp_path / "mushroom.stl")
     part = load(tmp_path, scene({"file": "mushroom.stl", "units": "mm"})).slider
-    assert part.polygon.bounds == pytest.approx((-0.03, -0.02, 0.04, 0.02))  # the union of both
-    assert part.area == pytest.approx(60 * 40e-6 + 10 * 20e-6)
-    assert part.cf == pytest.approx([0.03, 0.0], abs=1e-9)
+    assert part.polygon.bounds == pytest.approx((-0.03, -0.02, 0.04, 0.02), abs=1e-7)  # the union of both
+    assert part.area == pytest.approx(60 * 40e-6 + 10 * 20e-6, rel=1e-4)
+    assert part.cf == pytest.approx([0.03, 0.0], abs=1e-7)
 
 
 # --- selection, units, placement --------------------------------------------------------------------
@@ -232,6 +232,20 @@ def noise(size: int, suffix: str):
     return make
 
 
+def block_bomb(folder: Path) -> None:
+    """A few hundred bytes of blocks: ten texts, then seven levels of ten references each to the
+    level below, 10 ** 8 texts when expanded."""
+    doc = ezdxf.new()
+    for k in range(10):
+        (doc.blocks.get("B0") or doc.blocks.new("B0")).add_text("x")
+    for level in range(1, 8):
+        block = doc.blocks.new(f"B{level}")
+        for k in range(10):
+            block.add_blockref(f"B{level - 1}", (k, 0))
+    doc.modelspace().add_blockref("B7", (0, 0))
+    doc.saveas(folder / "part.dxf")
+
+
 def part_on_layer(layer: str):
     return lambda folder: dxf_file(folder, lambda msp: rounded_rectangle(msp, layer))
 
@@ -258,6 +272,8 @@ BAD = {
     "noise as SVG": (noise(200_000, ".svg"), {"file": "part.svg", "units": "mm"}, "slider.file",
                      ["not a readable SVG file"]),
     "noise as STL": (noise(200_000, ".stl"), {"file": "part.stl", "units": "mm"}, "slider.file", []),
+    "blocks of references to blocks": (block_bomb, {"file": "part.dxf", "units": "mm"}, "slider.file",
+                                       ["draws more than 10000 entities"]),
     "an unknown kind of file": (noise(10, ".step"), {"file": "part.step", "units": "mm"}, "slider.file",
                                 ["unknown kind of file"]),
     "a chord below a micron": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "chord": 1e-9},
@@ -295,7 +311,7 @@ def test_bad_cad_input_exits_1_with_one_line_and_writes_nothing(case, tmp_path, 
     assert all(word in captured.err for word in words), captured.err
     assert len(captured.err) <= 301
     assert_nothing_written(tmp_path, before)
-    assert seconds < 3.0 and peak < 100e6  # bounded by the cap, not by the file
+    assert seconds < 5.0 and peak < 100e6  # bounded by the caps, not by the file (tracemalloc slows it 2-5x)
 
 
 def test_without_the_cad_extra_a_file_is_one_line_naming_it(tmp_path, monkeypatch, capsys):
@@ -366,7 +382,7 @@ def test_a_scene_with_an_stl_part_and_an_svg_fixture_plans_and_verifies(tmp_path
             "tolerance": {"position": 0.02, "angle": 5}}
     (tmp_path / "scene.yaml").write_text(yaml.safe_dump(data))
     exported = plans_and_verifies_against_its_export(tmp_path / "scene.yaml", tmp_path)
-    assert exported["slider"]["cf"] == pytest.approx([0, 0], abs=1e-9)  # the foot's centre, not the top's
+    assert exported["slider"]["cf"] == pytest.approx([0, 0], abs=1e-7)  # the foot's centre, not the top's
 
 
 def test_a_plain_scene_round_trips_through_its_export(tmp_path):

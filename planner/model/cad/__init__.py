@@ -101,11 +101,12 @@ def read_shapes(spec: dict[str, Any], field: str, folder: Path, notes: list[str]
     if not isinstance(file, str) or not file or not file.isprintable():
         raise SceneError(f"{field}.file", f"must be a file name, got {shown(file)}")
     units = spec["units"]
-    if units not in UNITS:
+    if not isinstance(units, str) or units not in UNITS:
         raise SceneError(f"{field}.units", f"must be one of {', '.join(UNITS)}, got {shown(units)}")
     scale = UNITS[units]
     x, y, theta = vector(spec.get("at", [0.0, 0.0, 0.0]), f"{field}.at", 3)
-    LENGTH.check(x, f"{field}.at[0]"), LENGTH.check(y, f"{field}.at[1]")
+    LENGTH.check(x, f"{field}.at[0]")
+    LENGTH.check(y, f"{field}.at[1]")
     theta = math.radians(ANGLE.check(theta, f"{field}.at[2]"))
     chord = number(spec.get("chord", CHORD), f"{field}.chord", positive=True, limit=LENGTH)
     if chord < MIN_CHORD:

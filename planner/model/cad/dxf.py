@@ -25,15 +25,18 @@ import shapely
 from ..fields import SceneError, shown
 from . import MAX_POINTS, Selection, Shape, shapes_from_rings
 
-__all__ = ["NEEDS", "read"]
+__all__ = ["MAX_ENTITIES", "NEEDS", "read"]
 
 #: The libraries read imports (the cad extra's): imported there, so that this module loads without them.
 NEEDS = ("ezdxf",)
 
 #: The entities drawn; every other kind is skipped with a note.
 _DRAWN = {"LWPOLYLINE", "POLYLINE", "LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE"}
-#: Deepest nesting of block references expanded (a block referring to itself is refused by ezdxf).
+#: Deepest nesting of block references expanded.
 _MAX_DEPTH = 8
+#: Most entities read, block references expanded: a drawing of parts holds thousands; a few
+#: hundred bytes of blocks of references to blocks would otherwise expand to billions.
+MAX_ENTITIES = 10_000
 #: Bézier curves per elliptical arc: 16 keep each within 22.5 degrees, where the curve departs
 #: from the arc by less than 7e-8 of its radius (0.07 mm at the 1 km limit).
 _ARC_CURVES = 16
@@ -56,7 +59,7 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     entities = (e for e in space if selection.layer is None or e.dxf.layer.upper() == selection.layer.upper())
     skipped: Counter[str] = Counter()
     rings, pieces, points = [], [], 0
-    for entity in _expanded(entities, 0, skipped):
+    for entity in _expanded(entities, 0, skipped, selection):
         try:
             path = ezdxf.path.make_path(entity, segments=_ARC_CURVES)
         except Exception as err:  # noqa: BLE001 (a malformed entity: refused rather than left out of an outline)
@@ -82,12 +85,18 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     return shapes_from_rings(rings + chained, selection)
 
 
-def _expanded(entities: Iterator, depth: int, skipped: Counter[str]) -> Iterator:
-    """The drawn entities of ``entities``, block references replaced by what they draw."""
+def _expanded(entities: Iterator, depth: int, skipped: Counter[str], selection: Selection,
+              seen: list[int] | None = None) -> Iterator:
+    """The drawn entities of ``entities``, block references replaced by what they draw; skipped
+    kinds are counted in ``skipped``, and more than :data:`MAX_ENTITIES` in all are refused."""
+    seen = [0] if seen is None else seen  # entities visited, shared by the nested calls
     for entity in entities:
+        seen[0] += 1
+        if seen[0] > MAX_ENTITIES:
+            raise SceneError(selection.field, f"draws more than {MAX_ENTITIES} entities (block references expanded)")
         kind = entity.dxftype()
         if kind == "INSERT" and depth < _MAX_DEPTH:
-            yield from _expanded(entity.virtual_entities(), depth + 1, skipped)
+            yield from _expanded(entity.virtual_entities(), depth + 1, skipped, selection, seen)
         elif kind in _DRAWN:
             yield entity
         else:

@@ -50,17 +50,25 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
         raise SceneError(selection.field, f"the mesh has more than {MAX_POINTS} triangles")
     if not meshes:
         raise SceneError(selection.field, "the file holds no triangles")
-    triangles = np.concatenate([mesh.triangles for mesh in meshes])
-    selection.check_points(triangles.reshape(-1, 3), "the mesh")
-    flat = triangles[:, :, :2]
-    (ux, uy), (vx, vy) = (flat[:, 1] - flat[:, 0]).T, (flat[:, 2] - flat[:, 0]).T
-    seen = np.abs(ux * vy - uy * vx) > selection.chord ** 2 * 1e-6  # seen from above: not edge-on
-    grid = selection.chord / 10  # unions on a grid far below the tolerance: no slivers of rounding
-    region = shapely.union_all(shapely.polygons(flat[seen]), grid_size=grid)
-    lowest = float(triangles[:, :, 2].min())
-    on_table = seen & np.all(triangles[:, :, 2] <= lowest + 2 * selection.chord, axis=1)
-    footprint = shapely.union_all(shapely.polygons(flat[on_table]), grid_size=grid)
+    mesh = trimesh.util.concatenate(meshes)
+    selection.check_points(mesh.vertices, "the mesh")
+    mesh.merge_vertices()  # an STL's triangles share no vertices: joined, they form the patches projected below
+    region = _projected(mesh)
+    lowest = float(mesh.vertices[:, 2].min())
+    on_table = np.flatnonzero(np.all(mesh.vertices[mesh.faces][:, :, 2] <= lowest + 2 * selection.chord, axis=1))
+    footprint = _projected(mesh.submesh([on_table], append=True)) if len(on_table) else shapely.Polygon()
     if footprint.area <= 0:
         raise SceneError(selection.field, f"the mesh has no footprint: no face lies flat at its lowest point "
                                           f"(z = {lowest:g}), which it touches only at points or along edges")
-    return [Shape(part, part.intersection(footprint, grid_size=grid)) for part in shapely.get_parts(region)]
+    grid = selection.chord / 10  # far below the tolerance: no slivers of rounding
+    return [Shape(part, part.intersection(footprint, grid_size=grid)) for part in shapely.get_parts(region)
+            if isinstance(part, shapely.Polygon) and part.area > 0]
+
+
+def _projected(mesh) -> shapely.Polygon | shapely.MultiPolygon:
+    """What ``mesh`` covers seen from above: trimesh's projection, which outlines each patch of
+    adjacent faces turned the same way and unions the outlines (docs/stack.md, "CAD readers")."""
+    from trimesh.path.polygons import projected
+
+    shape = projected(mesh, normal=[0.0, 0.0, 1.0])
+    return shapely.Polygon() if shape is None else shapely.make_valid(shape)
