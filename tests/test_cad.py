@@ -167,6 +167,34 @@ def test_a_block_name_picks_its_drawing(tmp_path):
     assert placed.cf == pytest.approx([0.1, 0.1], abs=5e-5)
 
 
+INKSCAPE = 'xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"'
+
+
+def test_an_svg_layer_or_element_id_picks_one_part(tmp_path):
+    (tmp_path / "part.svg").write_text(
+        f'<svg xmlns="http://www.w3.org/2000/svg" {INKSCAPE} viewBox="0 0 200 200">'
+        '<g inkscape:groupmode="layer" inkscape:label="Parts" transform="translate(100, 0)">'
+        '<rect id="small" x="0" y="0" width="10" height="10"/><g id="big"><rect x="0" y="50" width="40" height="20"/>'
+        '</g></g><g inkscape:groupmode="layer" inkscape:label="Guides"><circle cx="20" cy="20" r="5"/></g></svg>')
+    guide = load(tmp_path, scene({"file": "part.svg", "units": "mm", "layer": "Guides"})).slider
+    assert guide.cf == pytest.approx([0.02, -0.02], abs=1e-6)
+    small = load(tmp_path, scene({"file": "part.svg", "units": "mm", "name": "small"})).slider
+    assert small.polygon.bounds == pytest.approx((0.1, -0.01, 0.11, 0.0))  # the layer's transform applied
+    big = load(tmp_path, scene({"file": "part.svg", "units": "mm", "name": "big"})).slider
+    assert big.polygon.bounds == pytest.approx((0.1, -0.07, 0.14, -0.05))
+    with pytest.raises(SceneError, match="holds 2 parts"):
+        load(tmp_path, scene({"file": "part.svg", "units": "mm", "layer": "Parts"}))
+    with pytest.raises(SceneError, match=r"no layer labelled 'Cut' \(layers: 'Guides', 'Parts'\)"):
+        load(tmp_path, scene({"file": "part.svg", "units": "mm", "layer": "Cut"}))
+
+
+def test_at_places_the_files_frame_in_the_slider_frame(tmp_path):
+    svg_file(tmp_path, '<rect x="10" y="-30" width="20" height="10"/>')  # x 10..30, y 20..30 mm
+    part = load(tmp_path, scene({"file": "part.svg", "units": "mm", "at": [-0.02, -0.025, 0], "cf": [0.0, 0.001]}))
+    assert part.slider.polygon.bounds == pytest.approx((-0.01, -0.005, 0.01, 0.005))
+    assert part.slider.cf.tolist() == [0.0, 0.001]  # a cf given is in the slider frame, as always
+
+
 @pytest.mark.parametrize("units, metres", [("mm", 1e-3), ("cm", 1e-2), ("m", 1.0), ("in", 0.0254)])
 def test_units_scale_the_drawing(units, metres, tmp_path):
     svg_file(tmp_path, '<rect x="1" y="2" width="3" height="0.5"/>')
@@ -257,6 +285,8 @@ BAD = {
                                    "slider.file", ["cannot read"]),
     "unknown unit": (part_on_layer("PART"), {"file": "part.dxf", "units": "ft"}, "slider.units",
                      ["must be one of mm, cm, m, in", "'ft'"]),
+    "a unit that is a list": (part_on_layer("PART"), {"file": "part.dxf", "units": ["mm"]}, "slider.units",
+                              ["must be one of mm, cm, m, in", "['mm']"]),
     "no closed outline on the layer": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "layer": "CUT"},
                                        "slider.file", ["holds no closed outline on layer 'CUT'"]),
     "an open polyline only": (lambda folder: dxf_file(folder, lambda msp: msp.add_lwpolyline([(0, 0), (9, 0), (9, 9)])),
