@@ -365,6 +365,13 @@ def test_bad_export_flag_exits_1(argv, words, tmp_path, monkeypatch, capsys):
     assert_nothing_written(tmp_path, set())
 
 
+def test_an_export_that_cannot_be_written_exits_4_naming_it(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main([str(ROOT / "scenes" / "battery.yaml"), "--out", "out", "--export-scene", "no/scene.yaml"]) == 4
+    assert capsys.readouterr().err.startswith("plan: error: cannot write 'no/scene.yaml': No such file or directory")
+    assert not (tmp_path / "no").exists()
+
+
 # --- the example, planned and verified against its exported scene ------------------------------------
 
 def plans_and_verifies_against_its_export(path: Path, tmp_path: Path) -> dict:
