@@ -96,6 +96,28 @@ def test_the_chord_tolerance_is_settable(tmp_path):
     assert len(coarse.vertices) < len(fine.vertices)
 
 
+@pytest.mark.parametrize("kind", ["ELLIPSE", "POLYLINE", "SPLINE"])
+def test_ellipses_polylines_and_splines_are_outlines(kind, tmp_path):
+    def draw(msp):
+        if kind == "ELLIPSE":  # semi-axes 30 and 12 mm
+            msp.add_ellipse((0, 0), major_axis=(30, 0), ratio=0.4)
+        elif kind == "POLYLINE":  # two half circles of radius 20 mm: bulge 1 each
+            msp.add_polyline2d([(-20, 0, 0, 0, 1), (20, 0, 0, 0, 1)], format="xyseb", close=True)
+        else:  # a spline through points round a square, ending where it starts
+            msp.add_spline([(-20, -20), (20, -20), (20, 20), (-20, 20), (-20, -20)])
+
+    dxf_file(tmp_path, draw)
+    part = load(tmp_path, scene({"file": "part.dxf", "units": "mm"})).slider
+    if kind == "ELLIPSE":
+        assert math.pi * (30 - 0.1) * (12 - 0.1) < part.area * 1e6 < math.pi * 30 * 12
+    elif kind == "POLYLINE":
+        assert math.pi * (20 - 0.1) ** 2 < part.area * 1e6 < math.pi * 20 ** 2
+    else:
+        assert part.area * 1e6 > 0.5 * 40 * 40  # a loop round the square, not a sliver
+        return  # a spline through points need not be symmetric
+    assert part.cf == pytest.approx([0, 0], abs=5e-5)
+
+
 def test_svg_outline_with_a_cubic_side_has_the_area_of_a_dense_reference(tmp_path):
     controls = np.array([[60, 10], [90, 20], [90, 40], [60, 50]], float)
     svg_file(tmp_path, '<path d="M 10 10 L 60 10 C 90 20 90 40 60 50 L 10 50 Z"/>')
