@@ -34,7 +34,7 @@ from .kinematics import (
 from .possible_motions import ModeMotions, mode_possible, possible_motions
 from .se2 import exp_twist, log_pose, relative_pose, wrap_angle
 from .slider import Slider
-from .regions import METHODS, stable_region
+from .regions import METHODS, PushRegion, stable_region
 from .stable import DEFAULT_TIP_FACTOR, StableRegion, procedure_stable
 from .stable_pushing import GOALS, classify_goal
 from .steering import StableSteering
@@ -52,6 +52,7 @@ __all__ = [
     "GOALS",
     "LoadBatch",
     "METHODS",
+    "PushRegion",
     "ModeMotions",
     "ExactRegion",
     "Slider",

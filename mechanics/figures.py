@@ -38,8 +38,6 @@ except ModuleNotFoundError:
         sys.exit(f"python -m {_NEEDS}")
     raise ModuleNotFoundError(_NEEDS, name="matplotlib") from None
 
-matplotlib.use("Agg")  # files only: no display needed
-
 import matplotlib.pyplot as plt
 import numpy as np
 import shapely
@@ -213,6 +211,7 @@ def write_figures(out: Path | str, rays: int = 24, steps: int = 8, dpi: int = 10
 
 
 def main(argv: list[str] | None = None) -> None:
+    matplotlib.use("Agg")  # the command draws files only; an importer keeps its own backend
     parser = argparse.ArgumentParser(description="Redraw the figures of Lynch (1992) as PNGs.")
     parser.add_argument("--out", default="docs/figures", help="output directory (default: docs/figures)")
     parser.add_argument("--rays", type=int, default=24, help="rays per sense of the force ray search")

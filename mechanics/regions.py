@@ -7,11 +7,41 @@
 
 from __future__ import annotations
 
+from typing import Protocol
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike
+
 from .exact_region import ExactRegion, exact_region
+from .push_plane import PushPlane
 from .slider import Slider
 from .stable import DEFAULT_TIP_FACTOR, StableRegion, procedure_stable
 
-__all__ = ["METHODS", "stable_region"]
+__all__ = ["METHODS", "PushRegion", "stable_region"]
+
+
+class PushRegion(Protocol):
+    """What every edge's set of stable pushes offers, by either method (:class:`StableRegion`,
+    :class:`ExactRegion`): the planner relies on this and on nothing else of them."""
+
+    edge: int
+    contact: np.ndarray  # [e_L, e_R], slider frame
+    normal: np.ndarray
+    mu: float
+    cf: np.ndarray
+    scale: float
+
+    @property
+    def is_empty(self) -> bool: ...
+    @property
+    def plane(self) -> PushPlane: ...
+    @property
+    def translation_range(self) -> tuple[float, float] | None: ...
+    def contains(self, twist: ArrayLike, tol: float = 1e-9) -> np.ndarray: ...
+    def extremal_twists(self) -> np.ndarray: ...
+    def section(self) -> tuple[shapely.Geometry, np.ndarray]: ...
+    def cor_polygons(self, window: ArrayLike | None = None) -> dict[int, shapely.Polygon]: ...
 
 #: The ways of finding an edge's stable pushes.
 METHODS = ("stable", "exact")
@@ -25,7 +55,7 @@ def stable_region(
     tip_factor: float = DEFAULT_TIP_FACTOR,
     method: str = "stable",
     cf_radius: float = 0.0,
-) -> StableRegion | ExactRegion:
+) -> PushRegion:
     """The stable pushes of a flat pusher of ``width`` centred on ``edge`` with friction ``mu``.
 
     Parameters

@@ -1,5 +1,21 @@
 """Planning guaranteed-stable pushes among obstacles (Lynch & Mason 1996, §4).
 
+A :class:`Planner` session sets a scene up once (its edges' stable regions, the collision model,
+the transits between edges) and then answers many plans, re-plans and reachability queries;
+poses are ``(x, y, theta)`` in metres and **radians** (a scene file's are in degrees):
+
+>>> from planner import Planner, load_scene
+>>> session = Planner(load_scene("scenes/parking.yaml"), {"seed": 1})
+>>> first = session.plan()                        # from the scene's start to its goal
+>>> first.solved, first.cost < 1.0                # metres of the part's path, plus each switch's cost
+(True, True)
+>>> moved = session.plan(start=session.scene.start + [0.005, 0.0, 0.02])  # re-plan: joins the first
+>>> moved.solved
+True
+>>> [a.status for a in session.reachability([[0.3, 0.3, 0.0], [0.0, -0.04, 0.0]])]  # the 2nd is in a wall
+['reachable', 'unreachable']
+
+:func:`plan` and :func:`reachability` are the same asked once of a fresh session.
 :func:`load_scene` reads a YAML scene, :func:`plan` searches with OMPL, :func:`one_step` answers
 the paper's one-step question, :func:`reachability` answers reachable / unreachable (certified) /
 unknown for many goals, :func:`controllability` says what the stable pushes can reach (1996 §2-3),
@@ -18,15 +34,15 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from .execution.verify import Verification, verify
     from .model.fields import SceneError
-    from .model.options import DEFAULT_PLANNER
+    from .model.options import DEFAULT_PLANNER, PlannerOptions
     from .model.plan_file import Plan, Push, Transit, load_plan
     from .model.scene import Scene, load_scene, parse_scene
     from .queries.controllability import SceneControllability, controllability
     from .queries.one_step import OneStep, one_step
-    from .queries.reachability import Reach, certify_unreachable, reachability
-    from .search import plan
+    from .queries.reachability import Reach, certify_unreachable
+    from .queries.session import Planner, plan, reachability
 
-__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Reach", "Scene", "SceneError", "Push", "Transit",
+__all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Planner", "PlannerOptions", "Reach", "Scene", "SceneError", "Push", "Transit",
            "certify_unreachable", "load_plan", "load_scene", "one_step", "parse_scene", "plan", "reachability",
            "Verification", "verify", "SceneControllability", "controllability"]
 
@@ -35,12 +51,13 @@ __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Reach", "Scene", "SceneError",
 #: controllability report (scipy) and the re-simulator are loaded only where used
 #: (tests/test_startup.py).
 _ON_FIRST_USE = {
-    "SceneError": ".model.fields", "DEFAULT_PLANNER": ".model.options",
+    "SceneError": ".model.fields", "DEFAULT_PLANNER": ".model.options", "PlannerOptions": ".model.options",
+    "Planner": ".queries.session",
     "Plan": ".model.plan_file", "Push": ".model.plan_file", "Transit": ".model.plan_file",
     "load_plan": ".model.plan_file", "Scene": ".model.scene", "load_scene": ".model.scene",
     "parse_scene": ".model.scene", "OneStep": ".queries.one_step", "one_step": ".queries.one_step",
     "Reach": ".queries.reachability", "certify_unreachable": ".queries.reachability",
-    "reachability": ".queries.reachability", "plan": ".search",
+    "reachability": ".queries.session", "plan": ".queries.session",
     "SceneControllability": ".queries.controllability", "controllability": ".queries.controllability",
     "Verification": ".execution.verify", "verify": ".execution.verify",
 }

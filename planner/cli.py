@@ -51,10 +51,10 @@ from .model.stop import Terminated, raise_on_sigterm
 from .queries.reachability import certify_unreachable
 from .outputs.recorder import RecordingFailed, recorder
 from .actions.region_cache import cache_folder
-from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_TRANSIT, MAX_OPTIMIZE, MAX_SEED, MAX_TIME_LIMIT,
-                            PLANNERS, REGIONS, TRANSITS, PlannerOptions, check_optimize, check_seed, check_time_limit)
+from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEFAULT_TRANSIT, MAX_OPTIMIZE,
+                            MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS, TRANSITS, PlannerOptions)
 from .model.scene import Scene, load_scene, write_scene
-from .search import plan
+from .queries.session import plan
 
 if TYPE_CHECKING:
     from .execution.trajectory import Trajectory
@@ -110,6 +110,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--transit", choices=TRANSITS,
                    help=f"how the pusher may change edges: walk round the part, be lifted, or never "
                         f"(default: the scene's pusher.transit, else {DEFAULT_TRANSIT})")
+    p.add_argument("--switch-cost", type=float, metavar="M",
+                   help=f"what a switch of edge costs, in metres of the part's path, >= 0 (default: the scene's "
+                        f"planner.switch_cost, else {DEFAULT_SWITCH_COST:g})")
     p.add_argument("--optimize", type=int, metavar="N",
                    help=f"after the first plan, N more searches (0..{MAX_OPTIMIZE}, each with its own seed drawn "
                         "from --seed), keeping the cheapest plan (default: the scene's planner.optimize, else 0)")
@@ -184,8 +187,6 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         On argparse's usage errors (code 2) and ``--help`` (code 0).
     """
     args = _parser().parse_args(argv)
-    limit = None if args.time_limit is None else check_time_limit(args.time_limit, "--time-limit")
-    seed = None if args.seed is None else check_seed(args.seed, "--seed")
     if args.verify is not None and args.verify < 1:
         raise SceneError("--verify", f"must be at least 1 distribution, got {args.verify}")
     if args.plan is not None and args.verify is None and args.simulate is None:
@@ -204,12 +205,9 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         from .execution.mujoco_sim import support_centre
 
         support_centre(scene, args.sim_cf_offset)
-    if args.regions:  # the search, the one-step check and the recording all read it from the scene
-        scene = replace(scene, planner=replace(scene.planner, regions=args.regions))
-    if args.transit:  # and verify checks a plan's lifts against it
-        scene = replace(scene, pusher=replace(scene.pusher, transit=args.transit))
-    if args.optimize is not None:
-        scene = replace(scene, planner=replace(scene.planner, optimize=check_optimize(args.optimize, "--optimize")))
+    # The search, the one-step check, the recording and verify's check of lifts all read the
+    # options from the scene as planned.
+    scene = scene.with_options(options_of(args, scene.planner))
     out = Path(args.out) if args.out else _fresh_folder(Path("logs") / f"{scene.name}-{time.strftime('%Y%m%d-%H%M%S')}")
     try:
         taken = out.exists() and not out.is_dir()
@@ -219,13 +217,44 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--out", f"{shown(str(out))} exists and is not a folder")
     if args.export_scene is not None and os.path.isdir(args.export_scene):
         raise SceneError("--export-scene", f"{shown(args.export_scene)} is a folder")
-    return Inputs(scene, args.planner or scene.planner.name, limit or scene.planner.time_limit,
-                  seed or scene.planner.seed, out, args.verify, args.plan,
+    return Inputs(scene, scene.planner.name, scene.planner.time_limit, scene.planner.seed, out, args.verify, args.plan,
                   None if args.plan is None else load_plan(args.plan), args.reach,
                   None if args.engine is None and args.jobs is None else (args.engine or "local", args.jobs, args.address),
                   args.trajectory, args.simulate,
                   args.sim_mu, tuple(args.sim_cf_offset or (0.0, 0.0)), None if args.mjcf is None else Path(args.mjcf),
                   None if args.export_scene is None else Path(args.export_scene))
+
+
+#: The flag of each planner option (:class:`~planner.model.options.PlannerOptions`' fields).
+FLAGS = {"name": "--planner", "time_limit": "--time-limit", "seed": "--seed", "regions": "--regions",
+         "switch_cost": "--switch-cost", "optimize": "--optimize", "transit": "--transit"}
+
+
+#: The arguments the library names as fields (its errors never name a flag), with their flags
+#: (the options' are :data:`FLAGS`, turned by :func:`options_of`: ``name`` is also a scene's field).
+ARGUMENTS = {"seed": "--seed", "cf_offset": "--sim-cf-offset",
+             **{name: f"--{name.replace('_', '-')}" for name in
+                ("engine", "jobs", "address", "out", "seeds", "resume", "simulate", "verify", "reach",
+                 "trajectory", "sim_mu", "sim_cf_offset", "mjcf")}}
+
+
+def flag_of(field: str) -> str:
+    """The flag of an argument the library names ``field``; any other field as it is.
+
+    >>> flag_of("jobs"), flag_of("cf_offset"), flag_of("slider.cf")
+    ('--jobs', '--sim-cf-offset', 'slider.cf')
+    """
+    return ARGUMENTS.get(field, field)
+
+
+def options_of(args: argparse.Namespace, options: PlannerOptions) -> PlannerOptions:
+    """``options`` with the planner flags given applied; an error names the flag."""
+    changes = {field: value for field, flag in FLAGS.items()
+               if (value := getattr(args, flag[2:].replace("-", "_"), None)) is not None}
+    try:
+        return options.merged(changes)
+    except SceneError as err:
+        raise SceneError(FLAGS[err.field], err.problem) from None
 
 
 def _check_simulation(args: argparse.Namespace) -> None:
@@ -259,7 +288,7 @@ def main(argv: list[str] | None = None) -> int:
                 return run_command(args)
             return _run(read_inputs(argv))
     except SceneError as err:
-        print(f"plan: error: {err}", file=sys.stderr)
+        print(f"plan: error: {SceneError(flag_of(err.field), err.problem)}", file=sys.stderr)
         return 1
     except _NotWritten as err:
         print(f"plan: error: {err}", file=sys.stderr)
@@ -360,10 +389,9 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
 
 
 def _export_scene(scene: Scene, inputs: Inputs) -> None:
-    """Write ``scene`` as planned, with the run's planner, time limit and seed, to ``--export-scene``'s file."""
-    used = replace(scene.planner, name=inputs.planner, time_limit=inputs.time_limit, seed=inputs.seed)
+    """Write ``scene`` as planned (the flags' options merged into it) to ``--export-scene``'s file."""
     try:
-        write_scene(replace(scene, planner=used), inputs.export_scene)
+        write_scene(scene, inputs.export_scene)
     except OSError as err:
         raise _NotWritten(f"cannot write {shown(str(inputs.export_scene))}: {err.strerror or err}") from None
 

@@ -394,6 +394,14 @@ def test_an_export_that_cannot_be_written_exits_4_naming_it(tmp_path, monkeypatc
     assert not (tmp_path / "no").exists()
 
 
+def test_the_export_holds_the_options_the_flags_set(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    argv = ["--out", "out", "--export-scene", "again.yaml", "--transit", "lift", "--switch-cost", "0.1", "--seed", "7"]
+    assert main([str(ROOT / "scenes" / "battery.yaml"), *argv]) == 0
+    again = load_scene(tmp_path / "again.yaml")
+    assert again.pusher.transit == "lift" and again.planner.switch_cost == 0.1 and again.planner.seed == 7
+
+
 # --- the example, planned and verified against its exported scene ------------------------------------
 
 def plans_and_verifies_against_its_export(path: Path, tmp_path: Path) -> dict:

@@ -31,7 +31,7 @@ from planner.model.bodies import cf_poses
 from planner.model.plan_file import Plan, rechain
 from planner.model.scene import load_scene
 from planner.queries.geodesic import geodesic_bound
-from planner.search import plan as plan_of
+from planner import plan as plan_of
 from planner.world.validity import CollisionModel
 from replay import replay_plan
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import DeadlineExceeded, ExactRegion, StableRegion, StableSteering, point_velocity, stable_region
+from mechanics import DeadlineExceeded, PushRegion, StableSteering, point_velocity, stable_region
 
 from ..model.bodies import body_outline
 from ..model.plan_file import Push
@@ -47,7 +47,7 @@ class EdgeControls:
     scale of its twists."""
 
     edge: int
-    region: StableRegion | ExactRegion
+    region: PushRegion
     steering: StableSteering
     outline: np.ndarray  # slider + pusher vertices, slider frame
 

@@ -11,6 +11,7 @@ kept.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Protocol
 
 from ..model.plan_file import Push, Transit
 from ..world.validity import CollisionModel
@@ -18,7 +19,15 @@ from .controls import EdgeControls
 from .push import connect
 from .transit import TransitPlanner
 
-__all__ = ["JoinShortcut", "farthest_first"]
+__all__ = ["JoinShortcut", "Shortcut", "farthest_first"]
+
+
+class Shortcut(Protocol):
+    """A shortening of plans: :class:`JoinShortcut`, the Dubins shortcut and the switch-pose
+    shortcut are each one, applied in turn. What it returns goes between the same two poses as
+    what it is given, every replacement checked like any push or transit."""
+
+    def __call__(self, segments: list[Push | Transit]) -> list[Push | Transit]: ...
 
 
 def farthest_first(items: Sequence, join: Callable[[int, int], list | None], least: int = 1) -> list:

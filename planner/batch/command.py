@@ -33,14 +33,15 @@ def run_command(args: argparse.Namespace) -> int:
     """Run the batch that the ``plan`` command's parsed ``args`` ask for (module docstring)."""
     for name in (*_SINGLE_ONLY, "trajectory"):
         if getattr(args, name) not in (None, False):
-            raise SceneError(f"--{name.replace('_', '-')}", "is for one plan, not a batch (several scenes or --seeds)")
+            raise SceneError(name, "is for one plan, not a batch (several scenes or seeds)")
     if args.resume and not args.out:
-        raise SceneError("--resume", "needs --out DIR, the folder of the batch to resume")
+        raise SceneError("resume", "needs the folder of the batch to resume (out)")
     seeds = (parse_seeds(args.seeds) if args.seeds is not None
-             else None if args.seed is None else [check_seed(args.seed, "--seed")])
+             else None if args.seed is None else [check_seed(args.seed, "seed")])
     overrides = {key: value for key, value in (("planner", args.planner), ("time_limit", args.time_limit),
                                                ("regions", args.regions), ("transit", args.transit),
-                                               ("optimize", args.optimize)) if value is not None}
+                                               ("switch_cost", args.switch_cost), ("optimize", args.optimize))
+                  if value is not None}
     tasks = make_tasks(args.scene, seeds, overrides=overrides)
     out = Path(args.out) if args.out else Path("logs") / f"batch-{time.strftime('%Y%m%d-%H%M%S')}"
     with executor(args.engine or "local", args.jobs, args.address) as engine:

@@ -24,12 +24,12 @@ def executor(engine: str = "local", workers: int | None = None, address: str | N
         For an unknown engine, a worker count below 1, an address without Ray, or Ray not installed.
     """
     if engine not in ENGINES:
-        raise SceneError("--engine", f"must be one of {', '.join(ENGINES)}, got {engine!r}")
+        raise SceneError("engine", f"must be one of {', '.join(ENGINES)}, got {engine!r}")
     if workers is not None and workers < 1:
-        raise SceneError("--jobs", f"must be at least 1, got {workers}")
+        raise SceneError("jobs", f"must be at least 1, got {workers}")
     if engine == "local":
         if address is not None:
-            raise SceneError("--address", "needs --engine ray")
+            raise SceneError("address", "needs the ray engine")
         return LocalExecutor(workers)
     return RayExecutor(workers, address)
 

@@ -36,7 +36,7 @@ def needs_ray():
     try:
         import ray
     except ImportError:
-        raise SceneError("--engine", "ray is not installed: pip install 'stablepush[ray]'") from None
+        raise SceneError("engine", "ray is not installed: pip install 'stablepush[ray]'") from None
     return ray
 
 
@@ -72,7 +72,7 @@ class RayExecutor:
                 else:
                     ray.init(address=address, **options)
             except (ConnectionError, RuntimeError, ValueError) as err:
-                raise SceneError("--address", f"cannot join the Ray cluster at {address}: {describe(err)}") from None
+                raise SceneError("address", f"cannot join the Ray cluster at {address}: {describe(err)}") from None
         cpus = int(ray.cluster_resources().get("CPU", 1))
         self.workers = max(1, min(cpus, workers) if workers else cpus)
         self._remote = ray.remote(num_cpus=1, max_retries=0)(_call)

@@ -63,11 +63,11 @@ def run_batch(tasks: Sequence[Task], out: str | Path, executor: Executor | None 
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as err:
-        raise SceneError("--out", f"cannot make {shown(str(out))}: {err.strerror or err}") from None
+        raise SceneError("out", f"cannot make {shown(str(out))}: {err.strerror or err}") from None
     results = ResultsFile(out / "results.jsonl")
     done = results.read()
     if done and not resume:
-        raise SceneError("--out", f"{shown(str(out))} holds results of a batch already: --resume it, or name "
+        raise SceneError("out", f"{shown(str(out))} holds results of a batch already: resume it, or name "
                                   "another folder")
     todo = [t for t in tasks if t.id not in done]
     own = executor is None

@@ -30,7 +30,7 @@ from ..model.options import (check_optimize, check_planner, check_regions, check
 from ..model.plan_file import Plan
 from ..model.scene import Scene, load_scene
 from ..queries.reachability import certify_unreachable
-from ..search import plan
+from ..queries.session import plan
 
 __all__ = ["OVERRIDES", "Task", "make_tasks", "parse_seeds", "run_task", "shared_regions"]
 
@@ -41,6 +41,11 @@ OVERRIDES = {
     "mu": lambda value, name: number(value, name, positive=True),
     "cf_offset": lambda value, name: _pair(value, name),
 }
+
+
+#: The overrides that are planner options (:class:`~planner.model.options.PlannerOptions`;
+#: ``planner`` is its ``name``).
+_OPTIONS = ("planner", "time_limit", "transit", "regions", "switch_cost", "optimize")
 
 
 def _pair(value: Any, name: str) -> tuple[float, float]:
@@ -66,12 +71,10 @@ class Task:
         scene, o = self.scene, self.overrides
         if self.goal is not None:
             scene = replace(scene, goal=np.asarray(self.goal, dtype=float))
-        options = {k: o[key] for key, k in (("planner", "name"), ("time_limit", "time_limit"), ("regions", "regions"),
-                                             ("switch_cost", "switch_cost"), ("optimize", "optimize")) if key in o}
-        scene = replace(scene, planner=replace(scene.planner, seed=self.seed, **options))
-        pusher = {k: o[k] for k in ("mu", "transit") if k in o}
-        if pusher:
-            scene = replace(scene, pusher=replace(scene.pusher, **pusher))
+        options = {"name" if key == "planner" else key: o[key] for key in _OPTIONS if key in o}
+        scene = scene.with_options(scene.planner.merged({**options, "seed": self.seed}, prefix="overrides."))
+        if "mu" in o:
+            scene = replace(scene, pusher=replace(scene.pusher, mu=o["mu"]))
         if "cf_offset" in o:
             slider = scene.slider
             try:
@@ -102,10 +105,10 @@ def parse_seeds(text: str) -> list[int]:
         else:
             seeds = [int(v) for v in text.split(",")]
     except ValueError:
-        raise SceneError("--seeds", f"must be A:B, N or A,B,C (integers), got {text!r}") from None
+        raise SceneError("seeds", f"must be A:B, N or A,B,C (integers), got {text!r}") from None
     if not seeds:
-        raise SceneError("--seeds", f"{text!r} holds no seed (A:B needs A <= B)")
-    return [check_seed(s, "--seeds") for s in seeds]
+        raise SceneError("seeds", f"{text!r} holds no seed (A:B needs A <= B)")
+    return [check_seed(s, "seeds") for s in seeds]
 
 
 def make_tasks(scenes: Iterable[str | Path | Scene], seeds: Iterable[int] | None = None,

@@ -26,7 +26,7 @@ from ..model.files import write_atomic
 from ..model.plan_file import Plan, load_plan
 from ..model.scene import Scene, load_scene
 from ..queries.geodesic import geodesic_bound
-from ..search import plan
+from ..queries.session import plan
 
 __all__ = ["BUDGET_ROUNDS", "best_known", "main"]
 

@@ -26,7 +26,7 @@ from .ompl_log import Run, log_paths, write_ompl_log
 from ..model.options import PLANNERS, TRANSITS
 from ..model.scene import load_scene
 from ..batch.engines import ENGINES, map_ordered
-from ..search import plan
+from ..queries.session import plan
 
 __all__ = ["main"]
 

@@ -40,7 +40,7 @@ from ..actions.controls import edge_controls
 from ..model.bodies import cf_poses
 from ..model.scene import Scene, load_scene
 from ..batch.engines import map_ordered
-from ..search import plan
+from ..queries.session import plan
 from .optimality import best_known
 
 __all__ = ["TASKS", "dubins_length", "open_task", "main"]

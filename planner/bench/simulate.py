@@ -16,7 +16,7 @@ import sys
 
 from ..execution.mujoco_sim import simulate
 from ..model.scene import load_scene
-from ..search import plan
+from ..queries.session import plan
 
 __all__ = ["main"]
 

@@ -103,11 +103,11 @@ class Feet:
 
 
 def support_centre(scene: Scene, offset: ArrayLike) -> np.ndarray:
-    """The CF moved by ``offset`` (slider frame), or :class:`SceneError` naming ``--sim-cf-offset``
+    """The CF moved by ``offset`` (slider frame), or :class:`SceneError` naming ``cf_offset``
     if that is not inside the part (no support on it has its centre there)."""
     centre = scene.slider.cf + np.asarray(offset, dtype=float)
     if not scene.slider.polygon.contains(shapely.Point(centre)):
-        raise SceneError("--sim-cf-offset", f"puts the centre of pressure {np.round(centre, 6).tolist()} off the part")
+        raise SceneError("cf_offset", f"puts the centre of pressure {np.round(centre, 6).tolist()} off the part")
     return centre
 
 
@@ -274,7 +274,7 @@ def needs_mujoco() -> None:
     try:
         import mujoco  # noqa: F401 (only checked here)
     except ImportError:
-        raise SceneError("--simulate", MISSING) from None
+        raise SceneError("simulate", MISSING) from None
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import difflib
 import re
+import numbers
 import reprlib
 import sys
 from dataclasses import dataclass
@@ -18,7 +19,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "shown",
+from mechanics import wrap_angle
+
+__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "poses", "shown",
            "vector"]
 
 #: Most characters of a bad value a message quotes: enough to recognise it, never a flood.
@@ -139,7 +142,8 @@ ANGLE = Limit(1e6, "degrees")
 def number(value: Any, name: str, positive: bool = False, limit: Limit | None = None) -> float:
     """``value`` as a finite float (> 0 if ``positive``; within ``limit`` if given)."""
     # Comparing (exactly, for ints) rather than math.isfinite(), which raises on ints beyond a float.
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not abs(value) <= sys.float_info.max:
+    if isinstance(value, bool) or not isinstance(value, (numbers.Integral, numbers.Real)) \
+            or not abs(value) <= sys.float_info.max:
         raise SceneError(name, f"must be a finite number, got {shown(value)}")
     if positive and not value > 0:
         raise SceneError(name, f"must be > 0, got {shown(value)}")
@@ -148,9 +152,34 @@ def number(value: Any, name: str, positive: bool = False, limit: Limit | None = 
 
 def integer(value: Any, name: str) -> int:
     """``value`` as an int (booleans are not integers here)."""
-    if isinstance(value, bool) or not isinstance(value, int):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         raise SceneError(name, f"must be an integer, got {shown(value)}")
-    return value
+    return int(value)
+
+
+def poses(value: Any, name: str) -> np.ndarray:
+    """``value`` (one pose ``(x, y, theta)`` or a sequence of them, radians) as finite poses of
+    shape ``(n, 3)``, headings wrapped to ``[-pi, pi)``: what the Python API takes where a scene
+    file takes degrees.
+
+    >>> poses([0.1, 0.2, 4.0], "goal").round(3).tolist()
+    [[0.1, 0.2, -2.283]]
+    >>> poses([[0, 0, 0], [1, 2]], "goals")
+    Traceback (most recent call last):
+    ...
+    planner.model.fields.SceneError: goals: must be poses (x, y, theta) of finite numbers, got [[0, 0, 0], [1, 2]]
+    """
+    try:
+        rows = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        rows = None
+    if rows is not None and rows.ndim == 1:
+        rows = rows[None]
+    if rows is None or rows.ndim != 2 or rows.shape[1] != 3 or isinstance(value, (str, bytes)) \
+            or not np.all(np.isfinite(rows)) or not np.all(np.abs(rows[:, :2]) <= LENGTH.bound):
+        raise SceneError(name, f"must be poses (x, y, theta) of finite numbers, got {shown(value)}")
+    rows[:, 2] = wrap_angle(rows[:, 2])
+    return rows
 
 
 def vector(value: Any, name: str, size: int, limit: Limit | None = None) -> np.ndarray:

@@ -15,7 +15,8 @@ planner.model.fields.SceneError: planner.name: must be one of rrt, kpiece, est, 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from typing import Any
 
 from .fields import LENGTH, SceneError, integer, number, shown
@@ -50,12 +51,41 @@ MAX_TIME_LIMIT = 86400.0
 
 @dataclass(frozen=True)
 class PlannerOptions:
+    """How a scene is planned, apart from what it describes: a scene's ``planner:`` block, the
+    options of a :class:`planner.Planner` session, the ``plan`` command's flags and a batch task's
+    overrides all come down to one of these, made or changed by :meth:`merged` alone.
+
+    ``transit``, where given, replaces the scene's ``pusher.transit`` (None: the scene's).
+
+    >>> PlannerOptions().merged({"seed": 4, "regions": "stable"}).seed
+    4
+    >>> PlannerOptions().merged({"time_limit": -1})
+    Traceback (most recent call last):
+    ...
+    planner.model.fields.SceneError: time_limit: must be > 0, got -1
+    >>> PlannerOptions().merged({"speed": 2}, prefix="planner.")
+    Traceback (most recent call last):
+    ...
+    planner.model.fields.SceneError: planner.speed: is not an option (name, time_limit, seed, regions, switch_cost, optimize, transit)
+    """
+
     name: str = DEFAULT_PLANNER
     time_limit: float = 10.0
     seed: int = 1
     regions: str = DEFAULT_REGIONS
     switch_cost: float = DEFAULT_SWITCH_COST
-    optimize: int = 0  # improvement rounds after the first plan (planner.search.planning.plan)
+    optimize: int = 0  # improvement rounds after the first plan (planner.search.planning.solve)
+    transit: str | None = None
+
+    def merged(self, changes: Mapping[str, Any] | None, prefix: str = "") -> "PlannerOptions":
+        """These options with ``changes`` (field name to value) applied, each checked; a
+        :class:`SceneError` names the field as ``prefix + name``. The one place options are merged."""
+        checked = {}
+        for key, value in (changes or {}).items():
+            if key not in _CHECKS:
+                raise SceneError(f"{prefix}{key}", f"is not an option ({', '.join(_CHECKS)})")
+            checked[key] = _CHECKS[key](value, f"{prefix}{key}")
+        return replace(self, **checked)
 
 
 def _one_of(value: Any, choices: tuple[str, ...], name: str) -> str:
@@ -127,3 +157,7 @@ def check_time_limit(value: Any, name: str) -> float:
     if limit > MAX_TIME_LIMIT:
         raise SceneError(name, f"must be at most {MAX_TIME_LIMIT:g} s, got {shown(value)}")
     return limit
+
+
+_CHECKS = {"name": check_planner, "time_limit": check_time_limit, "seed": check_seed, "regions": check_regions,
+           "switch_cost": check_switch_cost, "optimize": check_optimize, "transit": check_transit}

@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -44,7 +44,7 @@ class Push:
     ([0.0, 0.5, 1.570796326795], 'push')
     """
 
-    kind = "push"
+    kind: ClassVar[Literal["push"]] = "push"
 
     edge: int
     contact: np.ndarray  # (2, 2), slider frame
@@ -120,7 +120,7 @@ class Transit:
     ('transit', [0.0, 0.0, 0.0], [0.0, 0.0, 0.0])
     """
 
-    kind = "transit"
+    kind: ClassVar[Literal["transit"]] = "transit"
 
     from_edge: int
     to_edge: int

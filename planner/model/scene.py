@@ -8,9 +8,8 @@ documented in the README.
 
 from __future__ import annotations
 
-import dataclasses
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -24,14 +23,14 @@ from mechanics import Slider, wrap_angle
 from .bodies import slider_at
 from .files import write_atomic
 from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vector
-from .options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEFAULT_TRANSIT, PlannerOptions,
-                      check_optimize, check_planner, check_regions, check_seed, check_switch_cost, check_time_limit,
-                      check_transit)
+from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
 from .yaml_file import read_yaml
 
 __all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene", "plain_scene",
            "write_scene"]
 
+#: The keys of a scene's ``planner:`` block: the options but ``transit``, which is ``pusher.transit``.
+_PLANNER_KEYS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize")
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
 _MAX_NAME_BYTES = 200
 #: The pusher's width and depth and a box's sides, in metres (a micron): thinner is no body.
@@ -76,6 +75,12 @@ class Scene:
     path: str | None = None  # the file it was read from
     cf_uncertainty: float = 0.0  # radius of the disk about slider.cf holding the true CF (metres)
     notes: tuple[str, ...] = ()  # what was not read from the CAD files it names (text, open chains)
+
+    def with_options(self, options: PlannerOptions) -> "Scene":
+        """This scene as planned with ``options``: its ``planner`` block replaced, and its
+        ``pusher.transit`` where the options name one."""
+        pusher = self.pusher if options.transit is None else replace(self.pusher, transit=options.transit)
+        return replace(self, planner=options, pusher=pusher)
 
     def within_tolerance(self, pose: ArrayLike, goal: ArrayLike | None = None) -> bool:
         """Whether ``pose`` ends the task: its origin within ``tolerance_position`` of ``goal``'s
@@ -147,7 +152,7 @@ def plain_scene(scene: Scene) -> dict[str, Any]:
         "start": [*scene.start[:2].tolist(), _degrees(scene.start[2])],
         "goal": [*scene.goal[:2].tolist(), _degrees(scene.goal[2])],
         "tolerance": {"position": scene.tolerance_position, "angle": _degrees(scene.tolerance_angle)},
-        "planner": dataclasses.asdict(scene.planner),
+        "planner": {key: getattr(scene.planner, key) for key in _PLANNER_KEYS},
     }
 
 
@@ -369,16 +374,8 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     if tol_ang < MIN_TOLERANCE:
         raise SceneError("tolerance.angle", f"must be at least {math.degrees(MIN_TOLERANCE):g} degrees (the rounding "
                                             f"of a plan's headings is about 1e-11 rad), got {math.degrees(tol_ang):g}")
-    opts = keys(spec.get("planner", {}), "planner", (),
-                ("name", "time_limit", "seed", "regions", "switch_cost", "optimize"))
-    planner = PlannerOptions(
-        name=check_planner(opts.get("name", DEFAULT_PLANNER), "planner.name"),
-        time_limit=check_time_limit(opts.get("time_limit", PlannerOptions.time_limit), "planner.time_limit"),
-        seed=check_seed(opts.get("seed", PlannerOptions.seed), "planner.seed"),
-        regions=check_regions(opts.get("regions", DEFAULT_REGIONS), "planner.regions"),
-        switch_cost=check_switch_cost(opts.get("switch_cost", DEFAULT_SWITCH_COST), "planner.switch_cost"),
-        optimize=check_optimize(opts.get("optimize", PlannerOptions.optimize), "planner.optimize"),
-    )
+    opts = keys(spec.get("planner", {}), "planner", (), _PLANNER_KEYS)
+    planner = PlannerOptions().merged(opts, prefix="planner.")
     return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path,
                  cf_uncertainty, tuple(notes))
 

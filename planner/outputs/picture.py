@@ -19,7 +19,7 @@ from mechanics import exp_twist
 from ..model.bodies import pusher_frame_body, pusher_polygon, transform_points
 from ..model.plan_file import Plan, Transit
 from ..model.scene import Scene, load_scene
-from ..search import plan
+from ..queries.session import plan
 from ..actions.transit import transit_pieces, transit_poses
 
 __all__ = ["TRANSIT", "draw_plan", "main"]

@@ -201,11 +201,6 @@ def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
     _log_text(rec, "log", _summary(scene, plan), "INFO" if plan.solved else "WARN")
 
 
-def _outline(region: shapely.Geometry) -> np.ndarray | None:
-    """Closed outline of a convex COR region, or None if it is empty or has no area."""
-    return np.asarray(region.exterior.coords) if isinstance(region, shapely.Polygon) and region.area > 0 else None
-
-
 def _rings(geometry: shapely.Geometry) -> list[np.ndarray]:
     """Closed outer rings of every polygon of ``geometry`` with area."""
     parts = getattr(geometry, "geoms", [geometry])

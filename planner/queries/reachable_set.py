@@ -105,7 +105,8 @@ class ReachableSet:
 
 
 def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, resolution: float | None = None,
-                  *, headings: int = HEADINGS, among: slice | None = None) -> ReachableSet:
+                  *, headings: int = HEADINGS, among: slice | None = None,
+                  controls: list[EdgeControls] | None = None) -> ReachableSet:
     """The map of goal positions reachable from ``scene.start`` in at most ``pushes`` (1 or 2)
     constant stable collision-free pushes (module docstring).
 
@@ -124,6 +125,7 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
     among : slice, optional
         With ``heading`` None, only these of the ``headings`` (a part of the map, which
         :func:`planner.batch.reach.reachable_set_on` computes on another worker).
+    controls : the allowed edges' controls, where the caller has them (a session)
     """
     import time
 
@@ -145,7 +147,7 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
     theta = np.full(nx * ny, np.nan)
     blocked = np.ones(nx * ny, dtype=bool)
 
-    edges, _ = controls_or_reason(scene)
+    edges = controls if controls is not None else controls_or_reason(scene)[0]
     if edges is not None:
         model = CollisionModel(scene, [p.edge for p in edges])
         margin = clearance_margin(scene)
@@ -163,7 +165,8 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
         if pushes == 2:
             for th, ok in zip(thetas, free):  # the cells of a heading as the goals of one region
                 todo = np.flatnonzero(ok & (count == 0))
-                region = GoalRegion(scene, np.column_stack([xy[todo], np.full(todo.size, th)]), edges, model, margin)
+                region = GoalRegion(scene, np.column_stack([xy[todo], np.full(todo.size, th)]), edges, model, margin,
+                                    aim=False)
                 hit: set[int] = set()
                 for k in range(len(edges)):
                     hit |= region.pushes_to(start, k, [i for i in range(todo.size) if i not in hit]).keys()

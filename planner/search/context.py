@@ -1,88 +1,67 @@
-"""What a planning run is asked (:class:`PlanRequest`, validated once) and what it builds once for
-every search it runs (:class:`PlanningContext`): the clock, the edges' controls, the collision
-model, the start edges, the transits and the shortcuts.
+"""What a planning run is asked (:class:`PlanRequest`, checked once), what every run on one scene
+shares (:class:`SearchWorld`: the edges' controls, the collision model, the transits and the
+shortcuts, built once) and what one run adds to it (:class:`PlanningContext`: its clock, start
+and start edges).
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..actions.controls import EdgeControls, RegionTimeout, clearance_margin, edge_controls, step_length
 from ..actions.dubins import DubinsShortcut
-from ..actions.shortcut import JoinShortcut
+from ..actions.region_cache import RegionCache
+from ..actions.shortcut import JoinShortcut, Shortcut
 from ..actions.switch_pose import Grid, SwitchShortcut
 from ..actions.transit import TransitPlanner
-from ..model.plan_file import Plan, Push, Transit
 from ..model.fields import SceneError
-from ..model.options import check_optimize, check_planner, check_regions, check_switch_cost, check_transit
+from ..model.options import PlannerOptions, check_optimize, check_planner, check_seed, check_time_limit
+from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 from .goal_region import GoalRegion
 
-__all__ = ["PlanRequest", "PlanningContext", "Prebuilt", "cost", "length"]
-
-#: The edges' controls and the collision model built for them, as a caller that plans many times
-#: for one part shares them (:func:`planner.reachability`).
-Prebuilt = tuple[list[EdgeControls], CollisionModel]
+__all__ = ["PlanRequest", "PlanningContext", "SearchWorld", "cost", "length"]
 
 
 @dataclass(frozen=True)
 class PlanRequest:
-    """A planning run's options, checked: the scene with the overrides applied, and the seed, time
-    limit, planner and improvement rounds. Made by :meth:`of`.
+    """One run's options, checked: the seed, the time limit, the OMPL planner and the improvement
+    rounds. Made by :meth:`of`, which names the argument at fault.
 
-    >>> from planner import load_scene
-    >>> request = PlanRequest.of(load_scene("scenes/parking.yaml"), seed=3, regions="stable")
-    >>> request.seed, request.planner, request.scene.planner.regions
-    (3, 'rrt', 'stable')
-    >>> PlanRequest.of(request.scene, planner="prm")
+    >>> request = PlanRequest.of(PlannerOptions(), seed=3)
+    >>> request.seed, request.planner, request.time_limit
+    (3, 'rrt', 10.0)
+    >>> PlanRequest.of(PlannerOptions(), planner="prm")
     Traceback (most recent call last):
     ...
     planner.model.fields.SceneError: planner: must be one of rrt, kpiece, est, got 'prm'
     """
 
-    scene: Scene
     seed: int
     time_limit: float
     planner: str
     optimize: int
 
     @classmethod
-    def of(cls, scene: Scene, *, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
-           regions: str | None = None, transit: str | None = None, switch_cost: float | None = None,
-           optimize: int | None = None) -> "PlanRequest":
-        """The request for ``scene``; options left as None take the scene's.
+    def of(cls, options: PlannerOptions, *, seed: object = None, time_limit: object = None,
+           planner: object = None, optimize: object = None) -> "PlanRequest":
+        """The request with ``options``' values where an argument is None.
 
         Raises
         ------
         SceneError
-            Naming the option at fault.
+            Naming the argument at fault (``seed``, ``time_limit``, ``planner`` or ``optimize``).
         """
-        opts = scene.planner
-        if regions is not None:
-            opts = replace(opts, regions=check_regions(regions, "regions"))
-        if switch_cost is not None:
-            opts = replace(opts, switch_cost=check_switch_cost(switch_cost, "switch_cost"))
-        pusher = scene.pusher if transit is None else replace(scene.pusher, transit=check_transit(transit, "transit"))
-        name = check_planner(opts.name if planner is None else planner, "planner")
-        return cls(replace(scene, planner=opts, pusher=pusher), opts.seed if seed is None else seed,
-                   float(opts.time_limit if time_limit is None else time_limit), name,
-                   opts.optimize if optimize is None else check_optimize(optimize, "optimize"))
-
-    def result(self, clock: float, goal: np.ndarray, segments: list[Push | Transit], reason: str = "",
-               note: str = "", tree: np.ndarray | None = None) -> Plan:
-        """The plan for ``goal`` (solved if no ``reason``), timed from ``clock`` (perf_counter)."""
-        found = Plan(self.scene.path, not reason, self.planner, self.seed, 0.0, self.scene.start.copy(), goal.copy(),
-                     segments, f"{reason}; {note}" if reason and note else reason, note,
-                     switch_cost=self.scene.planner.switch_cost, cf=self.scene.slider.cf)
-        if tree is not None:
-            found.tree = tree
-        found.planning_time_s = time.perf_counter() - clock
-        return found
+        return cls(options.seed if seed is None else check_seed(seed, "seed"),
+                   options.time_limit if time_limit is None else check_time_limit(time_limit, "time_limit"),
+                   options.name if planner is None else check_planner(planner, "planner"),
+                   options.optimize if optimize is None else check_optimize(optimize, "optimize"))
 
     @property
     def out_of_time(self) -> str:
@@ -100,71 +79,83 @@ def cost(scene: Scene, segments: list[Push | Transit]) -> float:
     return length(scene, segments) + scene.planner.switch_cost * sum(s.kind == "transit" for s in segments)
 
 
-class PlanningContext:
-    """Everything the searches of one request share, built once when the run starts.
-
-    The time limit bounds the regions and the search together: the regions may take half of it
-    (``note`` says which edges were left out when they did not all finish).
+class SearchWorld:
+    """Everything the runs on one scene share, built once: the allowed edges' controls (their
+    stable regions), the collision model, the transits between edges and the shortcuts.
 
     Parameters
     ----------
-    request : PlanRequest
-    clock : float
-        When the run started (perf_counter): the time limit counts from there.
-    progress : callable, optional
-        ``progress(k, n)`` before computing the ``k``-th of the ``n`` regions not cached.
-    prebuilt : the edges' controls and collision model, shared by a caller planning often
-        (the time limit is then the search's alone)
-
-    Raises
-    ------
-    SceneError
-        If the pusher has no room at the start on any edge (found before any region is computed),
-        or only on edges with no stable push.
-    RegionTimeout
-        If no edge's region was computed within half the time limit.
+    scene : Scene
+        With the options it is planned with (``scene.planner``, ``scene.pusher.transit``).
+    controls : the edges' controls, or None to compute them (:meth:`build`)
+    model : collision model with a body for each allowed edge
+    note : what the user should know of the controls (edges left out at a time-out)
     """
 
-    def __init__(self, request: PlanRequest, clock: float, progress: Callable[[int, int], None] | None = None,
-                 prebuilt: Prebuilt | None = None):
-        self.request = request
-        scene = self.scene = request.scene
-        self.clock = clock
-        self.deadline = self.clock + request.time_limit  # for the regions and the search alike
+    def __init__(self, scene: Scene, controls: list[EdgeControls], model: CollisionModel, note: str = ""):
+        self.scene, self.controls, self.model, self.note = scene, controls, model, note
         self.step, self.margin = step_length(scene), clearance_margin(scene)
-        self.note = ""  # what the regions' time-out left out
-        controls, self.model = prebuilt or (None, CollisionModel(scene, scene.pusher.edges))
-        if not any(self.model.is_clear(scene.start, e, self.step / 2) for e in scene.pusher.edges):
-            raise SceneError("start", f"the pusher has no room on any allowed edge (needs {self.step / 2:.4g} m "
-                                      "clearance)")
-        if controls is None:
-            try:
-                controls = edge_controls(scene, self.clock + request.time_limit / 2, progress)
-            except RegionTimeout as timeout:
-                if not timeout.controls:
-                    raise
-                controls, self.note = timeout.controls, str(timeout)
-        self.controls: list[EdgeControls] = controls
-        self.starts = [k for k, c in enumerate(controls) if self.model.is_clear(scene.start, c.edge, self.step / 2)]
-        if not self.starts:
-            raise SceneError("start", "the pusher has room only on edges with no stable push")
         switching = scene.pusher.transit != "none" and len(controls) > 1
-        self.transits = TransitPlanner(scene, [c.edge for c in controls], self.model,
-                                       self.margin) if switching else None
-        self._joined = JoinShortcut(controls, self.model, self.margin, self.transits)
-        self._dubins = DubinsShortcut(scene, controls, self.model, self.margin)
+        self.transits = TransitPlanner(scene, [c.edge for c in controls], model, self.margin) if switching else None
+        self._joined: Shortcut = JoinShortcut(controls, model, self.margin, self.transits)
+        self._dubins = DubinsShortcut(scene, controls, model, self.margin)
         self._grid = Grid()
-        self._switches = SwitchShortcut(scene, self._dubins.curves, self.model, self.transits,
+        self._switches: Shortcut | None = SwitchShortcut(scene, self._dubins.curves, model, self.transits,
                                         scene.planner.switch_cost, self._grid) if switching else None
 
-    def result(self, goal: np.ndarray, segments: list[Push | Transit], reason: str = "",
-               tree: np.ndarray | None = None) -> Plan:
-        """The plan for ``goal`` (solved if no ``reason``), timed from the start of the run."""
-        return self.request.result(self.clock, goal, segments, reason, self.note, tree)
+    @classmethod
+    def build(cls, scene: Scene, deadline: float | None = None, progress: Callable[[int, int], None] | None = None,
+              cache: RegionCache | None = None, model: CollisionModel | None = None) -> "SearchWorld":
+        """The world of ``scene``, its regions computed (or read from ``cache``) by ``deadline``
+        (perf_counter); ``progress(k, n)`` hears of the ``k``-th of ``n`` regions computed.
 
-    def goal_region(self, goals: np.ndarray) -> GoalRegion:
-        """The goal region of ``goals``, with switches where transits are allowed."""
-        return GoalRegion(self.scene, goals, self.controls, self.model, self.margin, self.transits)
+        Raises
+        ------
+        SceneError
+            If the pusher has no room at the scene's start on any edge (found before any region is
+            computed), or only on edges with no stable push; :class:`NoStablePush` if no edge has one.
+        RegionTimeout
+            If no edge's region was computed by ``deadline``.
+        """
+        model = model or CollisionModel(scene, scene.pusher.edges)
+        step = step_length(scene)
+        if not any(model.is_clear(scene.start, e, step / 2) for e in scene.pusher.edges):
+            raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
+        note = ""
+        try:
+            controls = edge_controls(scene, deadline, progress, cache)
+        except RegionTimeout as timeout:
+            if not timeout.controls:
+                raise
+            controls, note = timeout.controls, str(timeout)
+        world = cls(scene, controls, model, note)
+        world.start_edges(scene.start)
+        return world
+
+    def start_edges(self, start: np.ndarray) -> list[int]:
+        """The indices of the controls whose edge has room for the pusher at ``start``.
+
+        Raises
+        ------
+        SceneError
+            If none has (naming ``start``).
+        """
+        half = self.step / 2
+        starts = [k for k, c in enumerate(self.controls) if self.model.is_clear(start, c.edge, half)]
+        if not starts:
+            if not any(self.model.is_clear(start, e, half) for e in self.scene.pusher.edges):
+                raise SceneError("start", f"the pusher has no room on any allowed edge (needs {half:.4g} m clearance)")
+            raise SceneError("start", "the pusher has room only on edges with no stable push")
+        return starts
+
+    def goal_region(self, goals: ArrayLike, aim: bool = True) -> GoalRegion:
+        """The goal region of ``goals``, with switches where transits are allowed (``aim``: as
+        :class:`~planner.search.goal_region.GoalRegion`'s)."""
+        return GoalRegion(self.scene, goals, self.controls, self.model, self.margin, self.transits, aim)
+
+    def shortcut_cheaply(self, segments: list[Push | Transit]) -> list[Push | Transit]:
+        """:meth:`shortcut` but for the switch poses, which stay where they are."""
+        return self._dubins(self._joined(segments))
 
     def shortcut(self, segments: list[Push | Transit]) -> list[Push | Transit]:
         """Fewer pushes where one joins several, switches moved where the plan is shortest, then
@@ -172,17 +163,79 @@ class PlanningContext:
         joined = self._joined(segments)
         return self._dubins(self._switches(joined) if self._switches is not None else joined)
 
-    def refine(self, segments: list[Push | Transit], level: int) -> list[Push | Transit]:
+    def refine(self, segments: list[Push | Transit], level: int, deadline: float) -> list[Push | Transit]:
         """``segments`` shortened across their switches (or, without switches, through a via
-        pose) on a grid ``level`` times finer than :meth:`shortcut`'s, until the deadline: the
+        pose) on a grid ``level`` times finer than :meth:`shortcut`'s, until ``deadline``: the
         refining grid of the improvement rounds."""
         grid = self._grid.refined(level)
         refined = SwitchShortcut(self.scene, self._dubins.curves, self.model, self.transits,
-                                 self.scene.planner.switch_cost, grid, via=True, deadline=self.deadline)(segments)
+                                 self.scene.planner.switch_cost, grid, via=True, deadline=deadline)(segments)
         return self._dubins(refined)
 
-    def direct(self, region: GoalRegion, goal: int = 0) -> list[Push | Transit] | None:
+
+class PlanningContext:
+    """One run on a :class:`SearchWorld`: its request, start, clock and deadline, and the edges
+    the pusher may start on.
+
+    Parameters
+    ----------
+    world : SearchWorld
+    request : PlanRequest
+    start : the part's start pose (radians)
+    clock : float
+        When the run started (perf_counter): the time limit counts from there.
+
+    Raises
+    ------
+    SceneError
+        If the pusher has no room at ``start`` on an edge with stable pushes.
+    """
+
+    def __init__(self, world: SearchWorld, request: PlanRequest, start: np.ndarray, clock: float):
+        self.world, self.request, self.start, self.clock = world, request, start, clock
+        self.scene, self.controls, self.model, self.step = world.scene, world.controls, world.model, world.step
+        self.deadline = clock + request.time_limit
+        self.starts = world.start_edges(start)
+
+    def result(self, goal: np.ndarray, segments: list[Push | Transit], reason: str = "",
+               tree: np.ndarray | None = None, improvements: list[tuple[float, float, float]] | None = None) -> Plan:
+        """The plan for ``goal`` (solved if no ``reason``), timed from the start of the run."""
+        return plan_result(self.scene, self.request, self.clock, self.start, goal, segments, reason, self.world.note,
+                           tree, improvements)
+
+    def goal_region(self, goals: ArrayLike) -> GoalRegion:
+        return self.world.goal_region(goals)
+
+    def shortcut(self, segments: list[Push | Transit]) -> list[Push | Transit]:
+        return self.world.shortcut(segments)
+
+    def refine(self, segments: list[Push | Transit], level: int) -> list[Push | Transit]:
+        return self.world.refine(segments, level, self.deadline)
+
+    def direct(self, region: GoalRegion, goal: int = 0, shorten: bool = True) -> list[Push | Transit] | None:
         """The cheapest plan of one or two pushes on a start edge, as in the paper's one-step
-        planning, or None."""
-        found = [d for k in self.starts if (d := region.pushes_to(self.scene.start, k, [goal]).get(goal))]
-        return min((self.shortcut(d) for d in found), key=lambda d: cost(self.scene, d)) if found else None
+        planning (each shortened first, unless not ``shorten``), or None."""
+        return self.direct_many(region, [goal], shorten).get(goal)
+
+    def direct_many(self, region: GoalRegion, goals: list[int], shorten: bool = True) -> dict[int, list[Push | Transit]]:
+        """:meth:`direct` for each of ``goals`` (indices) that has one, screened for all at once."""
+        found: dict[int, list[list[Push | Transit]]] = {}
+        for k in self.starts:
+            for g, pushes in region.pushes_to(self.start, k, goals).items():
+                found.setdefault(g, []).append(self.world.shortcut(pushes) if shorten else pushes)
+        return {g: min(options, key=lambda d: cost(self.scene, d)) for g, options in found.items()}
+
+
+def plan_result(scene: Scene, request: PlanRequest, clock: float, start: np.ndarray, goal: np.ndarray,
+                segments: list[Push | Transit], reason: str = "", note: str = "", tree: np.ndarray | None = None,
+                improvements: list[tuple[float, float, float]] | None = None) -> Plan:
+    """The plan for ``goal`` from ``start`` (solved if no ``reason``), timed from ``clock``
+    (perf_counter)."""
+    elapsed = time.perf_counter() - clock
+    if not improvements and not reason:  # a plan found at once: its one improvement is itself
+        improvements = [(elapsed, cost(scene, segments), length(scene, segments))]
+    return Plan(scene=scene.path, solved=not reason, planner=request.planner, seed=request.seed,
+                planning_time_s=elapsed, start=np.array(start, dtype=float), goal=np.array(goal, dtype=float),
+                segments=segments, reason=f"{reason}; {note}" if reason and note else reason, note=note,
+                switch_cost=scene.planner.switch_cost, cf=scene.slider.cf, improvements=list(improvements or []),
+                **({} if tree is None else {"tree": tree}))

@@ -58,11 +58,15 @@ from ..model.scene import Scene
 from ..world.free_space import Components
 from ..world.validity import CollisionModel
 
-__all__ = ["GoalRegion", "REMEMBERED", "TRIES"]
+__all__ = ["AIM_CLEARANCE", "AIM_REACH", "GoalRegion", "REMEMBERED", "TRIES"]
 
 _U1 = np.linspace(0.0, 1.0, 12, endpoint=False)  # around the boundary of the stable cone
 _U2 = (0.5, 1.0)  # half way out, and on the boundary (the sharpest turns)
 _LEGS = (1.0, 2.0, 4.0, 8.0)  # waypoint push lengths, in part radii
+#: A goal is aimed at where the part, with the pusher on the edge, has this many push margins of
+#: clearance; where it has not (a goal drawn against a wall), at the nearest pose that has, within
+#: this share of the position tolerance (a little less than all of it, so rounding keeps it inside).
+AIM_CLEARANCE, AIM_REACH = 2.0, 0.9
 #: Waypoints collision-checked per state and edge: this test runs on every new tree state.
 TRIES = 4
 #: Poses whose answers :meth:`GoalRegion.pushes_to` keeps (per edge and set of goals).
@@ -87,27 +91,54 @@ class GoalRegion:
     model : collision model with a body for each of those edges
     margin : clearance every push must keep
     transits : the pusher's transits between those edges, or None where it may not switch
+    aim : bool
+        Whether pushes may end anywhere within tolerance of a goal where the goal itself has too
+        little room (:meth:`_aims_of`); else they end exactly at it, or not at all.
     """
 
     def __init__(self, scene: Scene, goals: ArrayLike, controls: list[EdgeControls], model: CollisionModel,
-                 margin: float, transits: TransitPlanner | None = None):
+                 margin: float, transits: TransitPlanner | None = None, aim: bool = True):
         self.scene, self.controls, self.model, self.margin, self.transits = scene, controls, model, margin, transits
         self.goals = np.array(goals, dtype=float).reshape(-1, 3)
         self.goals[:, 2] = wrap_angle(self.goals[:, 2])
         grid = np.array([(0.5, 0.0)] + [(a, b) for a in _U1 for b in _U2])
         legs = np.array(_LEGS) * scene.slider.radius
+        self._aims = [self._aims_of(c.edge) if aim else self.goals for c in controls]
         # Per edge: the waypoint pushes (unit speed: duration = distance) and, per goal, the
-        # waypoints themselves, back along each push from the goal, shape (m, n, 3).
+        # waypoints themselves, back along each push from the goal's aim, shape (m, n, 3).
         self._waypoints = []
-        for c in controls:
+        for c, aims in zip(controls, self._aims):
             w = np.repeat(c.control_twist(grid), len(legs), axis=0)
             tau = np.tile(legs, len(grid))
-            self._waypoints.append((exp_twist(self.goals[:, None, :], -w, tau), w, tau))
+            self._waypoints.append((exp_twist(aims[:, None, :], -w, tau), w, tau))
         self._last_leg: dict[tuple[int, int, int], Push | None] = {}
         self._asked: OrderedDict[tuple, dict[int, list[Push]]] = OrderedDict()
         self._cf = scene.slider.cf
         self._pieces = Components(model.cf_room)
-        self._goal_piece = self._pieces.label(self._cf_at(self.goals))
+        # The pieces a goal's aims lie in (None: any, where one is on no piece): others are out of reach.
+        self._goal_pieces: list[set[int] | None] = [set() for _ in self.goals]
+        for aims in self._aims:
+            aimed = np.flatnonzero(~np.isnan(aims[:, 0]))
+            for g, label in zip(aimed.tolist(), self._pieces.label(self._cf_at(aims[aimed])).tolist()):
+                pieces = self._goal_pieces[g]
+                if pieces is not None:
+                    self._goal_pieces[g] = None if label < 0 else pieces | {int(label)}
+
+    def _aims_of(self, edge: int) -> np.ndarray:
+        """Per goal, where pushes on ``edge`` aim: the goal itself where the part with the pusher
+        there has :data:`AIM_CLEARANCE` margins of room, else the nearest pose at its heading within
+        :data:`AIM_REACH` of the tolerance that has (a goal drawn against a wall, say); NaN where
+        none has, so that no push on that edge aims at it."""
+        clearance = AIM_CLEARANCE * self.margin
+        aims = np.full_like(self.goals, np.nan)
+        for g, goal in enumerate(self.goals):
+            if self.model.is_clear(goal, edge, clearance):
+                aims[g] = goal
+            elif (aim := self.model.room.aim(self.model.body_pieces[edge], goal,
+                                             AIM_REACH * self.scene.tolerance_position, clearance)) is not None:
+                if self.model.is_clear(aim, edge, self.margin):
+                    aims[g] = aim
+        return aims
 
     @property
     def goal(self) -> np.ndarray:
@@ -132,7 +163,7 @@ class GoalRegion:
         here = int(self._pieces.label(self._cf_at(np.asarray(pose, dtype=float)[None]))[0])
         if here < 0:
             return list(goals)
-        return [g for g in goals if self._goal_piece[g] in (here, -1)]
+        return [g for g in goals if self._goal_pieces[g] is None or here in self._goal_pieces[g]]
 
     def connections(self, pose: ArrayLike, k: int, goals: Sequence[int]) -> dict[int, list[Push | Transit]]:
         """Per goal index of ``goals`` reached from ``pose`` with the pusher on ``controls[k]``,
@@ -171,14 +202,15 @@ class GoalRegion:
         return self._asked[key]
 
     def _pushes_to(self, pose: np.ndarray, k: int, goals: Sequence[int]) -> dict[int, list[Push]]:
-        controls = self.controls[k]
+        controls, aims = self.controls[k], self._aims[k]
         goals = np.asarray(goals, dtype=int)
+        goals = goals[~np.isnan(aims[goals, 0])]
         found: dict[int, list[Push]] = {}
         if goals.size == 0:
             return found
         poses, w, tau = self._waypoints[k]
-        # One screen for all: COR_total to each goal (column 0) and to each of its waypoints.
-        total = log_pose(pose, np.concatenate([self.goals[goals, None], poses[goals]], axis=1))
+        # One screen for all: COR_total to each goal's aim (column 0) and to each of its waypoints.
+        total = log_pose(pose, np.concatenate([aims[goals, None], poses[goals]], axis=1))
         ok = controls.region.contains(total.reshape(-1, 3)).reshape(total.shape[:2])
         for row, g in enumerate(goals.tolist()):
             # The goal itself first, then the waypoints, shortest two pushes first.
@@ -191,7 +223,7 @@ class GoalRegion:
             along = exp_twist(pose, (total[row, columns] / speed[:, None])[:, None], speed[:, None] * _SAMPLES)
             columns = columns[~self.model.surely_blocked(along).any(axis=1)]
             if columns.size and columns[0] == 0:
-                one = connect(pose, self.goals[g], controls, self.model, self.margin, total=total[row, 0])
+                one = connect(pose, aims[g], controls, self.model, self.margin, total=total[row, 0])
                 if isinstance(one, Push):
                     found[g] = [one]
                     continue
@@ -215,5 +247,5 @@ class GoalRegion:
             start = poses[g, i].copy()
             start[2] = wrap_angle(start[2])
             self._last_leg[(k, g, i)] = (
-                Push(c.edge, c.region.contact, w[i], float(tau[i]), start, self.goals[g].copy()) if free else None)
+                Push(c.edge, c.region.contact, w[i], float(tau[i]), start, self._aims[k][g].copy()) if free else None)
         return self._last_leg[(k, g, i)]

@@ -1,8 +1,8 @@
 """Planning pushes among obstacles with OMPL's control planners (Lynch & Mason 1996, §4).
 
-:func:`plan` answers one goal, :func:`plan_batch` many with one search tree. Each run checks its
-request (:class:`~planner.search.context.PlanRequest`), builds its context once
-(:class:`~planner.search.context.PlanningContext`), tries the direct connection from the start,
+:func:`solve` answers one goal, :func:`solve_many` many with one search tree, each on a
+:class:`~planner.search.context.PlanningContext` (a run of a request on a world built once:
+:class:`~planner.search.context.SearchWorld`). A run tries the direct connection from the start,
 and otherwise grows OMPL trees over the spaces of :mod:`planner.search.spaces` towards the goal
 region of :mod:`planner.search.goal_region`; the path found is decoded with the goal test's own
 connection (:mod:`planner.search.decode`) and shortened (:mod:`planner.actions.shortcut`).
@@ -19,28 +19,25 @@ time, so a seed still gives one plan), and its plan wins if it costs no more.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Container, Iterator
 
 import numpy as np
-from numpy.typing import ArrayLike
 from ompl import base as ob
 from ompl import control as oc
 from ompl import util as ou
 
 from mechanics import wrap_angle
 
-from ..actions.controls import RegionTimeout
-from ..model.plan_file import Plan, Push, Transit
+from ..model.plan_file import Plan, Push, Transit, rechain
 from ..model.options import MAX_SEED
-from ..model.scene import Scene
 from ..model.stop import signals_deferred
 from . import decode
-from .context import PlanningContext, PlanRequest, Prebuilt, cost, length
-from .goal import PushGoal
+from .context import PlanningContext, cost, length
 from .goal_region import GoalRegion
+from .goal import PushGoal
 from .spaces import pose_of, space_information
 
-__all__ = ["plan", "plan_batch", "MAX_REFINEMENT", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
+__all__ = ["solve", "solve_many", "HOP_GOALS", "HOP_REACH", "MAX_REFINEMENT", "ONE_EDGE_ITERATIONS", "ONE_EDGE_MIN_ITERATIONS",
            "ROUND_ITERATIONS", "ROUND_MIN_ITERATIONS"]
 
 #: When the first plan still switches once shortened (the switch-pose shortcut drops a switch
@@ -60,6 +57,9 @@ ROUND_ITERATIONS, ROUND_MIN_ITERATIONS = 2, 1000
 #: also ends at the time limit).
 MAX_REFINEMENT = 3
 _ROUND_SEEDS = 1_000_003
+#: A goal reached is the start of pushes to the goals nearest it not reached yet: this many, within
+#: this many part radii (:class:`_Hops`).
+HOP_GOALS, HOP_REACH = 6, 4.0
 _RECHECK = "a switch of the path found no transit when its poses were re-composed"
 _PLANNERS: dict[str, Callable] = {"rrt": oc.RRT, "kpiece": oc.KPIECE1, "est": oc.EST}
 
@@ -72,64 +72,33 @@ def _seed_ompl(seed: int) -> None:
     ou.setLogLevel(ou.LOG_ERROR)
 
 
-def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
-         regions: str | None = None, transit: str | None = None, switch_cost: float | None = None,
-         progress: Callable[[int, int], None] | None = None, *, optimize: int | None = None,
-         prebuilt: Prebuilt | None = None) -> Plan:
-    """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``.
-
-    Arguments left as ``None`` take the scene's options: ``regions`` is ``'stable'`` (procedure
-    STABLE) or ``'exact'`` (the exact region, the default); ``transit`` is ``'plane'``, ``'lift'``
-    or ``'none'`` (``pusher.transit``); ``switch_cost`` is in metres (``planner.switch_cost``). With a
-    given seed, a run that solves within the time limit returns the same plan every time.
-
-    The time limit bounds the edges' stable regions (computed once per part and cached; they may
-    take half of it: a part with many edges plans with those done in time, and says so in
-    ``Plan.note``, or ends unsolved if none is) and the search together; ``progress(k, n)`` hears of the ``k``-th of the ``n``
-    regions that must be computed.
-
-    ``optimize`` (default: ``planner.optimize``) is a number of improvement rounds: after the
-    first plan, odd rounds search again with a seed of their own (drawn from ``seed``) and twice
-    the first search's iterations, and even rounds shorten the plan so far on a grid of switch
-    (or via) poses finer each time (:data:`MAX_REFINEMENT`); a round's plan replaces the plan if
-    it costs less. Rounds are counted, not timed, so a seed still gives one plan; they stop early at
-    the time limit. ``Plan.improvements`` holds the time, cost and length of the first plan and of
-    each better one. A plan of one or two pushes
-    from the start (found before any search) is not searched again.
-
-    ``prebuilt`` is the edges' pushes and the collision model (built with ``scene.pusher.edges``)
-    for this scene's part, pusher and options, as :func:`planner.reachability` shares them between
-    goals; they are then not rebuilt, and the time limit is the search's alone.
-
-    Raises
-    ------
-    SceneError
-        If an option is invalid or no allowed edge can start pushing.
+def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
+    """Plan guaranteed-stable pushes from ``context.start`` to ``goal`` (radians) on the context's
+    world, within its deadline: the search, the shortcuts and the improvement rounds
+    (``request.optimize``: odd rounds search again with a seed of their own drawn from the
+    request's and twice the first search's iterations, even rounds shorten the plan so far on a
+    grid of switch or via poses finer each time, :data:`MAX_REFINEMENT`; a round's plan replaces
+    the plan if it costs less, and rounds stop early at the deadline). A plan of one or two
+    pushes from the start (found before any search) is not searched again.
     """
-    request = PlanRequest.of(scene, seed=seed, time_limit=time_limit, planner=planner, regions=regions,
-                             transit=transit, switch_cost=switch_cost, optimize=optimize)
-    scene, clock = request.scene, time.perf_counter()
-    try:
-        context = PlanningContext(request, clock, progress, prebuilt)
-    except RegionTimeout as timeout:  # no edge's region in time
-        return request.result(clock, scene.goal, [], str(timeout))
-    if scene.within_tolerance(scene.start):
-        return _found_at_once(context.result(scene.goal, []))
-    region = context.goal_region(scene.goal)
+    request, scene = context.request, context.scene
+    if scene.within_tolerance(context.start, goal):
+        return context.result(goal, [])
+    region = context.goal_region(goal)
     direct = context.direct(region)
     if direct:
-        return _found_at_once(context.result(scene.goal, direct))
+        return context.result(goal, direct)
     search = _Search(context)
     segments, tree, iterations = search.run(region)
     if segments is None:
-        return context.result(scene.goal, [], _RECHECK if tree is None else request.out_of_time, tree)
+        return context.result(goal, [], _RECHECK if tree is None else request.out_of_time, tree)
     segments = context.shortcut(segments)
     if any(s.kind == "transit" for s in segments):
         budget = max(ONE_EDGE_ITERATIONS * iterations, ONE_EDGE_MIN_ITERATIONS)
         plain, _, _ = search.run(region.without_switches(), budget)
         if plain is not None and cost(scene, plain := context.shortcut(plain)) <= cost(scene, segments):
             segments = plain
-    improvements = [(time.perf_counter() - clock, cost(scene, segments), length(scene, segments))]
+    improvements = [(time.perf_counter() - context.clock, cost(scene, segments), length(scene, segments))]
     budget = max(ROUND_ITERATIONS * iterations, ROUND_MIN_ITERATIONS)
     refined: tuple[int, int] | None = None  # the grid level and plan last refined
     for r in range(1, request.optimize + 1):
@@ -146,57 +115,89 @@ def plan(scene: Scene, seed: int | None = None, time_limit: float | None = None,
             other = context.shortcut(other) if other is not None else None
         if other is not None and cost(scene, other) < cost(scene, segments):
             segments = other
-            improvements.append((time.perf_counter() - clock, cost(scene, segments), length(scene, segments)))
-    result = context.result(scene.goal, segments, tree=tree)
-    result.improvements = improvements
-    return result
+            improvements.append((time.perf_counter() - context.clock, cost(scene, segments), length(scene, segments)))
+    return context.result(goal, segments, tree=tree, improvements=improvements)
 
 
-def _found_at_once(result: Plan) -> Plan:
-    """``result``, found before any search: its one improvement is itself."""
-    result.improvements = [(result.planning_time_s, result.cost, result.length)]
-    return result
-
-
-def plan_batch(scene: Scene, goals: ArrayLike, seed: int | None = None, time_limit: float | None = None, *,
-               prebuilt: Prebuilt | None = None) -> list[Plan]:
-    """One :class:`Plan` per goal (rows ``(x, y, theta)``, radians) from ``scene.start``, grown
+def solve_many(context: PlanningContext, goals: np.ndarray, shorten: bool = True,
+               timings: dict[str, float] | None = None) -> list[Plan]:
+    """One :class:`Plan` per goal (rows ``(x, y, theta)``, radians) from ``context.start``, grown
     as one search tree.
 
-    Each goal first gets the direct connection (one or two pushes, as in :func:`plan`); the goals
+    Each goal first gets the direct connection (one or two pushes, as in :func:`solve`); the goals
     left share one OMPL search: every new tree state is tested against all goals not yet reached,
-    and when one is, its path is taken and the same tree grows on towards the rest. The time limit
-    (default: the scene's) bounds that shared search as a whole, so each goal gets the full time
-    limit of tree growth for the price of one. Plans are shortcut as :func:`plan`'s are, but
-    a plan with switches gets no second, one-edge search: a batch answers where the part can go,
-    :func:`plan` also what it costs. ``seed`` and ``prebuilt`` are as for :func:`plan`.
-
-    >>> from planner import load_scene
-    >>> scene = load_scene("scenes/battery.yaml")
-    >>> [p.solved for p in plan_batch(scene, [scene.goal, scene.start])]
-    [True, True]
+    and when one is, its path is taken and the same tree grows on towards the rest, until the
+    context's deadline, so each goal gets the full time of tree growth for the price of one.
+    Plans are shortcut as :func:`solve`'s are (unless not ``shorten``: a plan as found still
+    reaches its goal and verifies), but a plan with switches gets no second, one-edge search: a
+    batch answers where the part can go, :func:`solve` also what it costs. ``timings``, if
+    given, gets the seconds spent on the direct connections (``'connections'``) and on the tree
+    (``'growth'``).
     """
-    request = PlanRequest.of(scene, seed=seed, time_limit=time_limit)
-    scene, clock = request.scene, time.perf_counter()
-    goals = np.array(goals, dtype=float).reshape(-1, 3)
-    goals[:, 2] = wrap_angle(goals[:, 2])
-    try:
-        context = PlanningContext(request, clock, None, prebuilt)
-    except RegionTimeout as timeout:
-        return [request.result(clock, g, [], str(timeout)) for g in goals]
+    clock = time.perf_counter()
+    found: dict[int, list[Push | Transit]] = {}  # segments, as found
+    timed: dict[int, Plan] = {}  # each plan timed when found
     region = context.goal_region(goals)
-    found: dict[int, Plan] = {}  # each timed when found
+    hops = _Hops(context, region, found)
+
+    def take(i: int, segments: list[Push | Transit] | None) -> None:
+        if segments is None:
+            timed[i] = context.result(goals[i], [], _RECHECK)
+            return
+        found[i] = segments
+        timed[i] = context.result(goals[i], context.shortcut(segments) if shorten and segments else segments)
+
     for i, goal in enumerate(goals):
-        if scene.within_tolerance(scene.start, goal):
-            found[i] = context.result(goal, [])
-        elif (direct := context.direct(region, i)) is not None:
-            found[i] = context.result(goal, direct)
-    rest = [i for i in range(len(goals)) if i not in found]
+        if context.scene.within_tolerance(context.start, goal):
+            take(i, [])
+    for i, direct in context.direct_many(region, [i for i in range(len(goals)) if i not in timed], False).items():
+        take(i, direct)
+    for i, segments in hops.spread(list(found)):
+        take(i, segments)
+    grown = time.perf_counter()
+    rest = [i for i in range(len(goals)) if i not in timed]
     if rest:
-        for i, segments in _Search(context).grow(region, rest):
-            found[i] = (context.result(goals[i], [], _RECHECK) if segments is None
-                        else context.result(goals[i], context.shortcut(segments)))
-    return [found[i] if i in found else context.result(g, [], request.out_of_time) for i, g in enumerate(goals)]
+        search = _Search(context).grow(region, rest, timed)
+        for i, segments in search:
+            take(i, segments)
+            for j, hopped in hops.spread([i] if segments is not None else []):
+                take(j, hopped)
+    if timings is not None:
+        timings.update(connections=grown - clock, growth=time.perf_counter() - grown)
+    return [timed[i] if i in timed else context.result(g, [], context.request.out_of_time)
+            for i, g in enumerate(goals)]
+
+
+class _Hops:
+    """Goals reached from goals: from where the plan of a goal reached ends, one or two pushes on
+    the edge the pusher is on (the goal region's) to the nearest goals not reached yet
+    (:data:`HOP_GOALS` of them, within :data:`HOP_REACH` part radii). A grid of goals a part's
+    length or two apart is mostly reached so, a goal from its neighbour, once the first of them is
+    reached at all; the tree reaches the rest."""
+
+    def __init__(self, context: PlanningContext, region: GoalRegion, found: dict[int, list[Push | Transit]]):
+        self.context, self.region, self.found = context, region, found
+        self._index = {c.edge: k for k, c in enumerate(context.controls)}
+        self._reach = HOP_REACH * context.scene.slider.radius
+
+    def spread(self, sources: list[int]) -> Iterator[tuple[int, list[Push | Transit]]]:
+        """Each goal reached, breadth first, from the goals ``sources`` (reached already) and from
+        those reached so, with its segments; until none is left or the deadline."""
+        queue, xy = list(sources), self.region.goals[:, :2]
+        while queue and time.perf_counter() < self.context.deadline:
+            segments = self.found[queue.pop(0)]
+            pose = segments[-1].end if segments else self.context.start
+            rest = np.array([g for g in range(len(xy)) if g not in self.found], dtype=int)
+            if rest.size == 0:
+                return
+            distance = np.hypot(*(xy[rest] - pose[:2]).T)
+            near = rest[np.argsort(distance, kind="stable")[:HOP_GOALS]]
+            near = near[np.hypot(*(xy[near] - pose[:2]).T) <= self._reach].tolist()
+            for k in [self._index[segments[-1].edge]] if segments else self.context.starts:
+                for g, more in self.region.pushes_to(pose, k, [g for g in near if g not in self.found]).items():
+                    self.found[g] = rechain(segments + more)
+                    queue.append(g)
+                    yield g, self.found[g]
 
 
 class _Search:
@@ -208,13 +209,13 @@ class _Search:
     def _setup(self, region: GoalRegion, seed: int | None = None):
         context = self.context
         _seed_ompl(context.request.seed if seed is None else seed)
-        scene = context.scene
-        space, si = space_information(scene, context.controls, context.model, context.step, region.transits)
+        space, si = space_information(context.scene, context.controls, context.model, context.step, region.transits)
         ss = oc.SimpleSetup(si)
+        start = context.start
         for k in context.starts:
             s = space.allocState()
-            s[0].setXY(float(scene.start[0]), float(scene.start[1]))
-            s[0].setYaw(float(wrap_angle(scene.start[2])))
+            s[0].setXY(float(start[0]), float(start[1]))
+            s[0].setYaw(float(wrap_angle(start[2])))
             s[1].value = k
             ss.addStartState(s)
         goal = PushGoal(si, region)
@@ -248,9 +249,11 @@ class _Search:
         segments = self._decoded(ss.getSolutionPath(), goal, 0)
         return segments, tree if segments is not None else None, count[0]
 
-    def grow(self, region: GoalRegion, goals: list[int]) -> Iterator[tuple[int, list[Push | Transit] | None]]:
+    def grow(self, region: GoalRegion, goals: list[int],
+             done: Container[int] = ()) -> Iterator[tuple[int, list[Push | Transit] | None]]:
         """One tree towards all of ``goals``: yields each goal index reached with its segments
-        (None if the plan failed to decode), until every goal is reached or the deadline.
+        (None if the plan failed to decode), until every goal is reached (here, or by the caller
+        between yields: ``done``) or the deadline.
 
         OMPL's planners keep their tree between calls of ``solve`` (only ``clear`` empties it), so
         each call goes on growing it towards the goals left; every state joins the tree tested
@@ -273,6 +276,7 @@ class _Search:
             del path
             goal.active = [g for g in goal.active if g not in hits]
             yield from found
+            goal.active = [g for g in goal.active if g not in done]
 
 
 def _solve(ss, stop: Callable[[], bool]) -> None:

@@ -32,6 +32,7 @@ from mechanics import wrap_angle
 
 from ..model.bodies import body_outline, convex_pieces, pusher_frame_body, pusher_polygon
 from .free_space import SCREEN_SHRINK, disk_free_space
+from .room import Room
 from ..model.scene import Scene
 
 __all__ = ["CollisionModel", "advances", "pose_along"]
@@ -125,10 +126,14 @@ class CollisionModel:
         p = scene.pusher
         # The part's pieces are made once and shared by every edge's body (each check places the
         # pieces it uses first): a part of many edges would otherwise cost as many copies.
-        part = [fcl.CollisionObject(_prism(s)) for s in convex_pieces(scene.slider.polygon)]
+        self.part_pieces = convex_pieces(scene.slider.polygon)
+        part = [fcl.CollisionObject(_prism(s)) for s in self.part_pieces]
+        #: Per edge, the convex pieces of the part and of the pusher on it (slider frame).
+        self.body_pieces: dict[int, list[np.ndarray]] = {}
         for e in edges:
-            pusher = pusher_polygon(scene.slider, e, p.width, p.depth)
-            self._add(e, part + [fcl.CollisionObject(_prism(s)) for s in convex_pieces(pusher)],
+            pusher = convex_pieces(pusher_polygon(scene.slider, e, p.width, p.depth))
+            self.body_pieces[e] = self.part_pieces + pusher
+            self._add(e, part + [fcl.CollisionObject(_prism(s)) for s in pusher],
                       body_outline(scene.slider, e, p.width, p.depth))
         alone = pusher_frame_body(p.width, p.depth)
         self._add(_PUSHER, [fcl.CollisionObject(_prism(alone))], alone)
@@ -138,6 +143,7 @@ class CollisionModel:
         self._cf = slider.cf
         self.cf_room = disk_free_space(scene, slider.cf_depth * (1.0 - SCREEN_SHRINK))
         shapely.prepare(self.cf_room)
+        self.room = Room(scene.obstacles, scene.workspace)
 
     def _add(self, key: int | str, pieces: list[fcl.CollisionObject], outline: np.ndarray) -> None:
         self._bodies[key] = (pieces, outline.tolist(), float(np.linalg.norm(outline, axis=1).max()))

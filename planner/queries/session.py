@@ -1,0 +1,339 @@
+"""A planning session: one scene set up once, then many plans, re-plans and reachability queries.
+
+As OMPL's ``SimpleSetup`` owns a space, a validity checker and a planner and solves many times,
+a :class:`Planner` owns what every query on one scene shares: the edges' stable regions (read
+from the region cache or computed), the collision model, the transits between edges, the
+shortcuts, the certificates' free space. Each query then pays only for its own search.
+
+A session also remembers what its queries found. :meth:`Planner.plan` with ``reuse`` (the
+default) first tries to join a new start to a plan it found before for the same goal, by one or
+two stable pushes (and a switch where the edges differ) onto a pose along that plan: a robot
+re-planning from where the part really is gets an answer in milliseconds. Such a plan depends on
+what the session planned before; ``reuse=False`` gives the plan the seed alone decides, as the
+one-shot :func:`plan` (a fresh session) does.
+
+>>> from planner import Planner, load_scene
+>>> session = Planner(load_scene("scenes/battery.yaml"))
+>>> first = session.plan()
+>>> first.solved, first.contents()
+(True, '1 push')
+>>> again = session.plan(start=session.scene.start + [0.002, 0.0, 0.0])
+>>> again.solved, bool(session.scene.within_tolerance(again.final))
+(True, True)
+>>> [a.status for a in session.reachability([session.scene.goal, [9.0, 9.0, 0.0]])]
+['reachable', 'unreachable']
+"""
+
+from __future__ import annotations
+
+import time
+from collections import OrderedDict
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from mechanics import exp_twist
+
+from ..actions.controls import NoStablePush, RegionTimeout
+from ..actions.region_cache import RegionCache
+from ..model.bodies import cf_poses
+from ..model.fields import SceneError, integer, poses
+from ..model.options import PlannerOptions
+from ..model.plan_file import Plan, Push, Transit, rechain
+from ..model.scene import Scene
+from ..search import PlanningContext, PlanRequest, SearchWorld, solve
+from ..search.context import cost, plan_result
+from ..world.validity import CollisionModel
+from .reachability import Certificates, Reach, answers
+from .reachable_set import ReachableSet, reachable_set
+
+__all__ = ["JOINED_PLANS", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_PLANS", "plan", "reachability"]
+
+#: Without a time limit, :meth:`Planner.reachability` grows its search for this long plus this
+#: much per goal left open by the certificates (at most the options' time limit): on the shipped
+#: scenes nearly every reachable goal of a 200-goal grid is reached well within it
+#: (``python -m planner.bench.reach``).
+REACH_BASE_S, REACH_PER_GOAL_S = 0.5, 0.01
+#: Plans a session keeps for re-planning (the most recent), and how many of the latest for a goal
+#: a new start is joined to.
+REMEMBERED_PLANS, JOINED_PLANS = 16, 2
+#: Poses along a remembered plan that a new start may be joined to: each push's start and these
+#: fractions of it.
+_ALONG = (0.0, 0.25, 0.5, 0.75)
+
+
+class Planner:
+    """A planning session on ``scene``: set up once, asked many times.
+
+    Parameters
+    ----------
+    scene : Scene
+    options : PlannerOptions or mapping, optional
+        How to plan: a :class:`~planner.model.options.PlannerOptions` replaces the scene's
+        ``planner:`` block; a mapping of option names to values (``{"seed": 3, "transit":
+        "lift"}``) changes only those. ``regions``, ``switch_cost`` and ``transit`` shape the
+        session itself; ``seed``, ``time_limit``, ``optimize`` and ``name`` are each query's
+        defaults, and a query may give its own.
+    cache : RegionCache, optional
+        Where the stable regions are kept (default: the process's, in ``$STABLEPUSH_CACHE``).
+    progress : callable, optional
+        ``progress(k, n)`` before computing the ``k``-th of the ``n`` regions not cached.
+
+    Setting up computes the regions within half the options' time limit; edges not done by then
+    are left out (``note`` says which), and a session with none plans nothing (each plan says why).
+
+    Raises
+    ------
+    SceneError
+        If an option is invalid, or the pusher has no room at the scene's start.
+    """
+
+    def __init__(self, scene: Scene, options: PlannerOptions | Mapping[str, Any] | None = None, *,
+                 cache: RegionCache | None = None, progress: Callable[[int, int], None] | None = None):
+        self.clock = time.perf_counter()
+        if not isinstance(scene, Scene):
+            raise SceneError("scene", f"must be a Scene (planner.load_scene), got {type(scene).__name__}")
+        if isinstance(options, PlannerOptions):
+            self.options = PlannerOptions().merged({k: getattr(options, k) for k in _FIELDS
+                                                    if getattr(options, k) is not None})
+        elif options is None or isinstance(options, Mapping):
+            self.options = scene.planner.merged(options)
+        else:
+            raise SceneError("options", f"must be PlannerOptions or a mapping, got {type(options).__name__}")
+        #: The scene as planned: its ``planner`` block is these options.
+        self.scene = scene.with_options(self.options)
+        self.model = CollisionModel(self.scene, self.scene.pusher.edges)
+        self.certificates = Certificates(self.scene, self.model)
+        self.world: SearchWorld | None = None
+        self._no_push: NoStablePush | None = None
+        self._timeout = ""
+        try:
+            self.world = SearchWorld.build(self.scene, self.clock + self.options.time_limit / 2, progress, cache,
+                                           self.model)
+        except NoStablePush as err:
+            self._no_push = err
+        except RegionTimeout as timeout:
+            self._timeout = str(timeout)
+        self._plans: OrderedDict[tuple[float, ...], list[Plan]] = OrderedDict()
+        #: Seconds the last :meth:`reachability` spent on the certificates, the direct connections
+        #: and the tree's growth.
+        self.timings: dict[str, float] = {}
+        #: Seconds setting the session up took (the regions, read or computed, and the rest).
+        self.setup_s = time.perf_counter() - self.clock
+
+    @property
+    def note(self) -> str:
+        """What the user should know of this session's regions (edges left out at the time limit)."""
+        return self.world.note if self.world is not None else self._timeout
+
+    def _request(self, seed: object, time_limit: object, optimize: object = None, planner: object = None) -> PlanRequest:
+        return PlanRequest.of(self.options, seed=seed, time_limit=time_limit, optimize=optimize, planner=planner)
+
+    def _pose(self, value: ArrayLike | None, name: str, default: np.ndarray) -> np.ndarray:
+        if value is None:
+            return default.copy()
+        rows = poses(value, name)
+        if len(rows) != 1:
+            raise SceneError(name, f"must be one pose (x, y, theta), got {len(rows)}")
+        return rows[0]
+
+    def plan(self, start: ArrayLike | None = None, goal: ArrayLike | None = None, *, seed: int | None = None,
+             time_limit: float | None = None, optimize: int | None = None, planner: str | None = None,
+             reuse: bool = True) -> Plan:
+        """A plan of guaranteed-stable pushes from ``start`` to ``goal`` (``(x, y, theta)``,
+        radians; default: the scene's).
+
+        ``seed``, ``time_limit`` (the search's, in seconds), ``optimize`` (improvement rounds) and
+        ``planner`` (``'rrt'``, ``'kpiece'`` or ``'est'``) default to the session's options. With
+        ``reuse``, a plan this session found before for the same goal is tried first: the start
+        joined to it by one or two pushes (module docstring). A plan is always solved or says why
+        not (``Plan.reason``); a start where the pusher has no room is bad input.
+
+        Raises
+        ------
+        SceneError
+            Naming the argument at fault; :class:`~planner.actions.controls.NoStablePush` if no
+            allowed edge has a stable push.
+        """
+        request = self._request(seed, time_limit, optimize, planner)
+        start = self._pose(start, "start", self.scene.start)
+        goal = self._pose(goal, "goal", self.scene.goal)
+        return self._plan(start, goal, request, time.perf_counter(), reuse)
+
+    def _plan(self, start: np.ndarray, goal: np.ndarray, request: PlanRequest, clock: float,
+              reuse: bool = False) -> Plan:
+        if self._no_push is not None:
+            raise self._no_push
+        if self.world is None:
+            return plan_result(self.scene, request, clock, start, goal, [], self._timeout)
+        context = PlanningContext(self.world, request, start, clock)
+        key = tuple(goal.tolist())
+        joined = self._joined(context, goal, self._plans.get(key, [])) if reuse else None
+        found = joined or solve(context, goal)
+        if found.solved and found.segments:
+            self._plans.setdefault(key, []).insert(0, found)
+            self._plans.move_to_end(key)
+            while sum(map(len, self._plans.values())) > REMEMBERED_PLANS:
+                oldest = next(iter(self._plans))
+                self._plans[oldest].pop()
+                if not self._plans[oldest]:
+                    del self._plans[oldest]
+        return found
+
+    def _joined(self, context: PlanningContext, goal: np.ndarray, known: list[Plan]) -> Plan | None:
+        """A plan from ``context.start`` joined by one or two pushes (and a switch where the edges
+        differ) to a pose along one of the :data:`JOINED_PLANS` latest ``known`` plans for
+        ``goal``, the rest of that plan after it: the cheapest found, or None.
+
+        Poses are tried cheapest first by a lower bound (the straight line from the start's CF to
+        theirs, plus the rest of their plan), until no pose left can beat the best join."""
+        world, scene = self.world, self.scene
+        anchors = [a for p in known[:JOINED_PLANS] for a in _anchors(p.segments)]
+        if not anchors:
+            return None
+        region = world.goal_region([pose for pose, _, _ in anchors], aim=False)
+        cf = scene.slider.cf
+        here = cf_poses(cf, context.start[None, :2], context.start[None, 2])[0]
+        rests = [cost(scene, rest) for _, _, rest in anchors]
+        there = cf_poses(cf, np.array([pose[:2] for pose, _, _ in anchors]), np.array([pose[2] for pose, _, _ in anchors]))
+        bounds = np.linalg.norm(there - here, axis=1) + rests
+        best, best_cost = None, np.inf
+        for a in np.argsort(bounds, kind="stable").tolist():
+            if bounds[a] >= best_cost:
+                break
+            pose, edge, rest = anchors[a]
+            for k in context.starts:
+                lead = region.pushes_to(context.start, k, [a]).get(a)
+                if lead is None:
+                    continue
+                joint: list[Push | Transit] = list(lead)
+                if edge != world.controls[k].edge:
+                    transit = world.transits.find(pose, world.controls[k].edge, edge) if world.transits else None
+                    if transit is None:
+                        continue
+                    joint.append(transit)
+                candidate = rechain(joint + rest)
+                if (c := cost(scene, candidate)) < best_cost:
+                    best, best_cost = candidate, c
+        if best is None:
+            return None
+        return context.result(goal, world.shortcut_cheaply(best))
+
+    def reachability(self, goals: ArrayLike | None = None, *, start: ArrayLike | None = None,
+                     pushes: int | None = None, time_limit: float | None = None,
+                     seed: int | None = None) -> list[Reach]:
+        """One :class:`~planner.queries.reachability.Reach` per goal (rows ``(x, y, theta)``,
+        radians; default: the scene's goal) from ``start`` (default: the scene's).
+
+        Each goal gets the certificates of unreachability
+        (:mod:`planner.queries.reachability`); the goals left share one search tree grown towards
+        all of them for ``time_limit`` seconds (default: :data:`REACH_BASE_S` plus
+        :data:`REACH_PER_GOAL_S` per open goal, at most the options' time limit), seeded by
+        ``seed``. Every ``'reachable'`` answer carries a plan (as found, not shortened), every
+        ``'unreachable'`` a certificate; ``pushes`` is a budget of pushes beyond which a plan is
+        answered ``'unknown'``.
+
+        Raises
+        ------
+        SceneError
+            Naming the argument at fault.
+        """
+        start = self._pose(start, "start", self.scene.start)
+        rows = self.scene.goal[None] if goals is None else poses(goals, "goals")
+        if pushes is not None and integer(pushes, "pushes") < 0:
+            raise SceneError("pushes", f"must be >= 0, got {pushes}")
+        if time_limit is not None:
+            self._request(seed, time_limit)  # checked before any work
+        clock = time.perf_counter()
+        reasons = [self.certify_unreachable(g, start=start) for g in rows]
+        self.timings = {"certificates": time.perf_counter() - clock, "connections": 0.0, "growth": 0.0}
+        if time_limit is None:
+            time_limit = min(self.options.time_limit, REACH_BASE_S + REACH_PER_GOAL_S * reasons.count(None))
+        request = self._request(seed, time_limit)
+        clock = time.perf_counter()
+        scene = self.scene if np.array_equal(start, self.scene.start) else replace(self.scene, start=start)
+        if self.world is None and self._no_push is None:  # no region in time: nothing certain but the geometry
+            return [Reach("unreachable", None, r, None, scene, g) if r else Reach("unknown", None, self._timeout, None,
+                                                                                   scene, g)
+                    for g, r in zip(rows, reasons)]
+        context = None if self.world is None else PlanningContext(self.world, request, start, clock)
+        return answers(scene, context, reasons, rows, pushes, self.timings)
+
+    def certify_unreachable(self, goal: ArrayLike | None = None, *, start: ArrayLike | None = None) -> str | None:
+        """Why ``goal`` (default: the scene's) is certainly unreachable from ``start`` (default:
+        the scene's), or None if no certificate shows it (:mod:`planner.queries.reachability`)."""
+        start = self._pose(start, "start", self.scene.start)
+        goal = self._pose(goal, "goal", self.scene.goal)
+        reason = self.certificates(goal, start)
+        if reason is None and self._no_push is not None and not self.scene.within_tolerance(start, goal):
+            reason = f"no stable push: {self._no_push.problem}"
+        return reason
+
+    def reachable_set(self, pushes: int = 1, heading: float | None = None, resolution: float | None = None,
+                      **kwargs: Any) -> ReachableSet:
+        """The map of goal positions reachable from the scene's start in at most ``pushes`` (1 or
+        2) stable pushes (:func:`planner.queries.reachable_set.reachable_set`), on this session's
+        regions and collision model."""
+        return reachable_set(self.scene, pushes, heading, resolution,
+                             controls=None if self.world is None else self.world.controls, **kwargs)
+
+
+_FIELDS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize", "transit")
+
+
+def _anchors(segments: list[Push | Transit]) -> list[tuple[np.ndarray, int, list[Push | Transit]]]:
+    """Poses along a plan that a new start may join: per push, its start and points along it
+    (:data:`_ALONG`), each with the push's edge and the plan's segments from there on."""
+    out = []
+    for i, s in enumerate(segments):
+        if s.kind != "push":
+            continue
+        for f in _ALONG:
+            if f == 0.0:
+                out.append((s.start, s.edge, segments[i:]))
+            else:
+                pose = exp_twist(s.start, s.twist, f * s.duration)
+                rest = Push.along(s.edge, s.contact, s.twist, (1.0 - f) * s.duration, pose)
+                out.append((rest.start, s.edge, [rest, *segments[i + 1:]]))
+    return out
+
+
+def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
+         regions: str | None = None, transit: str | None = None, switch_cost: float | None = None,
+         optimize: int | None = None, progress: Callable[[int, int], None] | None = None) -> Plan:
+    """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``: a fresh
+    :class:`Planner` session asked once.
+
+    Arguments left as None take the scene's options (``planner:`` block, ``pusher.transit``):
+    ``regions`` is ``'stable'`` (procedure STABLE) or ``'exact'`` (the default); ``transit``
+    ``'plane'``, ``'lift'`` or ``'none'``; ``switch_cost`` in metres; ``optimize`` a number of
+    improvement rounds. With a given seed, a run that solves within the time limit returns the
+    same plan every time. The time limit bounds the stable regions (which may take half of it;
+    edges not done are left out, as ``Plan.note`` says) and the search together.
+
+    Raises
+    ------
+    SceneError
+        Naming the argument at fault, or if no allowed edge can start pushing.
+    """
+    clock = time.perf_counter()
+    session = Planner(scene, {k: v for k, v in (("time_limit", time_limit), ("seed", seed), ("regions", regions),
+                                                ("switch_cost", switch_cost), ("optimize", optimize),
+                                                ("transit", transit)) if v is not None}, progress=progress)
+    return session._plan(session.scene.start, session.scene.goal, session._request(None, None, None, planner), clock)
+
+
+def reachability(scene: Scene, goals: ArrayLike | None = None, *, pushes: int | None = None,
+                 time_limit: float | None = None, seed: int | None = None) -> list[Reach]:
+    """:meth:`Planner.reachability` of a fresh session: one answer per goal (rows ``(x, y,
+    theta)``, radians; default: the scene's goal) from the scene's start.
+
+    >>> from planner import load_scene
+    >>> scene = load_scene("scenes/battery.yaml")
+    >>> [(r.status, r.pushes) for r in reachability(scene, [scene.goal, [9.0, 9.0, 0.0]])]
+    [('reachable', 1), ('unreachable', None)]
+    """
+    return Planner(scene).reachability(goals, pushes=pushes, time_limit=time_limit, seed=seed)
