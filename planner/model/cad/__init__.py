@@ -128,9 +128,11 @@ def read_shapes(spec: dict[str, Any], field: str, folder: Path, notes: list[str]
         raise SceneError(f"{field}.file", f"reading {path.suffix.lower()} files needs the cad extra: "
                                           f"pip install 'stablepush[cad]' ({err})") from None
     selection = Selection(select["layer"], select["name"], chord / 2 / scale, LENGTH.bound / scale, f"{field}.file")
+    noted = len(notes)
     shapes = reader.read(raw, path.suffix.lower(), selection, notes)
-    if not shapes:
-        raise SceneError(f"{field}.file", f"{shown(file)} holds no closed outline{_where(selection)}")
+    if not shapes:  # what was not read may say why (open chains, text)
+        why = "".join(f"; {note.removeprefix(selection.field + ': ')}" for note in notes[noted:])
+        raise SceneError(f"{field}.file", f"{shown(file)} holds no closed outline{_where(selection)}{why}")
     c, s = math.cos(theta), math.sin(theta)
     matrix = [scale * c, -scale * s, scale * s, scale * c, x, y]
     placed = []
