@@ -15,7 +15,9 @@ and prints a line per run and a summary line; MuJoCo is imported only then.
 pushes (:func:`planner.queries.reachable_set.reachable_set`, any heading): ``<name>-reach.png`` in the
 output folder and ``/world/reach`` in the recording; with ``--engine`` (and ``--jobs``) its headings
 are computed on the batch executors (:func:`planner.batch.reach.reachable_set_on`). Several scenes,
-or ``--seeds``, make a batch instead (:mod:`planner.batch.command`).
+or ``--seeds``, make a batch instead (:mod:`planner.batch.command`). ``--export-scene FILE`` also
+writes the scene as planned in the plain schema (:func:`planner.model.scene.write_scene`: CAD
+files and boxes resolved to vertices, the CF written out).
 
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
 solved or certified unreachable (:func:`planner.certify_unreachable`, checked before planning; one
@@ -69,7 +71,7 @@ from .outputs.recorder import RecordingFailed, recorder
 from .actions.region_cache import cache_folder
 from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEFAULT_TRANSIT, MAX_OPTIMIZE,
                             MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS, TRANSITS, PlannerOptions)
-from .model.scene import Scene, load_scene
+from .model.scene import Scene, load_scene, write_scene
 from .queries.session import plan
 
 for _signal, _handler in _LOADING.items():  # loaded: main() handles them from here on
@@ -161,6 +163,9 @@ def _parser() -> argparse.ArgumentParser:
                    help="with --simulate: move the supports' centre of pressure by this offset from the CF "
                         "(slider frame, m)")
     p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")
+    p.add_argument("--export-scene", metavar="FILE",
+                   help="also write the scene as planned to FILE (YAML, the plain schema: CAD files and boxes "
+                        "resolved to vertices in metres, the CF and the pushed edges written out)")
     batch = p.add_argument_group("batch runs (several scenes, or --seeds; planner.batch)")
     batch.add_argument("--seeds", metavar="A:B", help="plan each scene for seeds A to B (or N, or A,B,C)")
     batch.add_argument("--jobs", type=int, metavar="N", help="tasks at once (default: the cores, or the Ray cluster's CPUs)")
@@ -190,6 +195,7 @@ class Inputs:
     sim_mu: float | None = None  # --sim-mu
     sim_cf_offset: tuple[float, float] = (0.0, 0.0)  # --sim-cf-offset
     mjcf: Path | None = None  # --mjcf FILE
+    export_scene: Path | None = None  # --export-scene FILE
 
 
 def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
@@ -236,6 +242,8 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     _check_writable(out, out)
     if args.mjcf is not None and _within(Path(args.mjcf), out, out) == Path(args.mjcf):
         _check_writable(Path(args.mjcf).parent, Path(args.mjcf))
+    if args.export_scene is not None and os.path.isdir(args.export_scene):
+        raise SceneError("--export-scene", f"{shown(args.export_scene)} is a folder")
     given = None
     if args.plan is not None:
         from .execution.fit import fit_plan  # with the re-simulator: only for a plan file
@@ -245,7 +253,8 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
                   given, args.reach,
                   None if args.engine is None and args.jobs is None else (args.engine or "local", args.jobs, args.address),
                   args.trajectory, args.simulate,
-                  args.sim_mu, tuple(args.sim_cf_offset or (0.0, 0.0)), None if args.mjcf is None else Path(args.mjcf))
+                  args.sim_mu, tuple(args.sim_cf_offset or (0.0, 0.0)), None if args.mjcf is None else Path(args.mjcf),
+                  None if args.export_scene is None else Path(args.export_scene))
 
 
 #: The flag of each planner option (:class:`~planner.model.options.PlannerOptions`' fields).
@@ -305,6 +314,9 @@ def main(argv: list[str] | None = None) -> int:
             if _is_batch(args := _parser().parse_args(argv)):
                 from .batch.command import run_command
 
+                if args.export_scene is not None:
+                    raise SceneError("--export-scene", "is for one plan, not a batch (several scenes or --seeds)")
+
                 return run_command(args)
             return _run(read_inputs(argv))
     except SceneError as err:
@@ -331,6 +343,8 @@ class _NotWritten(Exception):
 
 
 def _run(inputs: Inputs) -> int:
+    for note in inputs.scene.notes:
+        print(f"plan: note: {note}", file=sys.stderr)
     with recorder(inputs.scene) as write:  # rerun is imported beside the search, where it can be
         return _plan_and_write(inputs, write)
 
@@ -381,6 +395,8 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
             from .batch.reach import reachable_set_on
 
             reach = reachable_set_on(scene, inputs.reach, *inputs.engine)
+    if inputs.export_scene is not None:
+        _export_scene(scene, inputs)
     _write_outputs(out, scene, result, check, reach, motion, write_recording, simulation, inputs.mjcf)
     if unreachable:
         print(f"plan: unreachable: {unreachable} (outputs in {out})", file=sys.stderr)
@@ -402,6 +418,14 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         lines[-1] += f" (outputs in {out})"
     print("\n".join(lines))
     return 0 if (check is None or check.passed) and (simulation is None or simulation.passed) else 3
+
+
+def _export_scene(scene: Scene, inputs: Inputs) -> None:
+    """Write ``scene`` as planned (the flags' options merged into it) to ``--export-scene``'s file."""
+    try:
+        write_scene(scene, inputs.export_scene)
+    except OSError as err:
+        raise _NotWritten(f"cannot write {shown(str(inputs.export_scene))}: {err.strerror or err}") from None
 
 
 def _first_found(result: Plan) -> str:

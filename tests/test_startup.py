@@ -25,8 +25,9 @@ from planner.actions.region_cache import RegionCache, compute_regions, is_cached
 ROOT = Path(__file__).resolve().parent.parent
 #: The CF off the centre: no turn of the block carries one edge onto another, so each is computed.
 BLOCK = Slider([[-0.05, 0.0], [0.05, 0.0], [0.05, 0.06], [-0.05, 0.06]], cf=[0.01, 0.03])
-#: Imported only by what needs them: the controllability report, the simulator and the pictures.
-HEAVY = ("scipy.optimize", "scipy.linalg", "matplotlib")
+#: Imported only by what needs them: the controllability report, the simulator, the pictures and
+#: the CAD readers (a plain scene loads none of these).
+HEAVY = ("scipy.optimize", "scipy.linalg", "matplotlib", "ezdxf", "svgelements", "trimesh")
 #: Left out by ``import planner`` until their public names are used: the controllability report
 #: (scipy) and the quasi-static re-simulator.
 ON_FIRST_USE = ("planner.queries.controllability", "planner.execution.verify", "mechanics.quasistatic")

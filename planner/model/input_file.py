@@ -21,7 +21,7 @@ from pathlib import Path
 
 from .fields import SceneError, shown
 
-__all__ = ["read_text"]
+__all__ = ["read_bytes", "read_text"]
 
 _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a named pipe"), (stat.S_ISCHR, "a character device"),
           (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
@@ -36,6 +36,16 @@ def read_text(path: str | Path, name: str, max_bytes: int) -> str:
         Naming ``name``: the file cannot be opened, is not a regular file, is larger than
         ``max_bytes`` or is not UTF-8.
     """
+    raw = read_bytes(path, name, max_bytes)
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise SceneError(name, f"{shown(str(path))} is not UTF-8 text (bad byte at offset {err.start})") from None
+
+
+def read_bytes(path: str | Path, name: str, max_bytes: int) -> bytes:
+    """The bytes of the regular file ``path``, at most ``max_bytes`` of them (no more is read: a
+    huge file is refused unread); else a :class:`SceneError` naming ``name``."""
     shown_path = shown(str(path))
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
@@ -53,7 +63,4 @@ def read_text(path: str | Path, name: str, max_bytes: int) -> str:
             raise SceneError(name, f"cannot read {shown_path}: {err.strerror or err}") from None
     if len(raw) > max_bytes:
         raise SceneError(name, f"{shown_path} is larger than {max_bytes} bytes")
-    try:
-        return raw.decode("utf-8")
-    except UnicodeDecodeError as err:
-        raise SceneError(name, f"{shown_path} is not UTF-8 text (bad byte at offset {err.start})") from None
+    return raw

@@ -15,17 +15,22 @@ from typing import Any
 
 import numpy as np
 import shapely
+import yaml
 from numpy.typing import ArrayLike
 
 from mechanics import Slider, wrap_angle
 
 from .bodies import slider_at
+from .files import write_atomic
 from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vector
 from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
 from .yaml_file import read_yaml
 
-__all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene"]
+__all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene", "plain_scene",
+           "write_scene"]
 
+#: The keys of a scene's ``planner:`` block: the options but ``transit``, which is ``pusher.transit``.
+_PLANNER_KEYS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize")
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
 _MAX_NAME_BYTES = 200
 #: The pusher's width and depth and a box's sides, in metres (a micron): thinner is no body.
@@ -69,6 +74,7 @@ class Scene:
     planner: PlannerOptions = field(default_factory=PlannerOptions)
     path: str | None = None  # the file it was read from
     cf_uncertainty: float = 0.0  # radius of the disk about slider.cf holding the true CF (metres)
+    notes: tuple[str, ...] = ()  # what was not read from the CAD files it names (text, open chains)
 
     def with_options(self, options: PlannerOptions) -> "Scene":
         """This scene as planned with ``options``: its ``planner`` block replaced, and its
@@ -120,6 +126,55 @@ def load_scene(path: str | Path) -> Scene:
     return parse_scene(read_yaml(path, "scene"), default_name=path.stem, path=str(path))
 
 
+def plain_scene(scene: Scene) -> dict[str, Any]:
+    """``scene`` as :func:`parse_scene` reads it back, in the plain schema: every polygon as its
+    vertices in metres (obstacle boxes and CAD files resolved), poses in degrees, the CF and the
+    pushed edges written out.
+
+    >>> scene = load_scene("scenes/battery.yaml")
+    >>> data = plain_scene(scene)
+    >>> data["slider"]["cf"], data["pusher"]["edges"], len(data["obstacles"][0]["polygon"])
+    ([0.0, 0.0], [3], 4)
+    >>> again = parse_scene(data)
+    >>> again.slider.vertices.tolist() == scene.slider.vertices.tolist(), again.obstacles == scene.obstacles
+    (True, True)
+    """
+    pusher = scene.pusher
+    return {
+        "name": scene.name,
+        "slider": {"vertices": scene.slider.vertices.tolist(), "cf": scene.slider.cf.tolist(),
+                   "cf_uncertainty": scene.cf_uncertainty},
+        "pusher": {"width": pusher.width, "depth": pusher.depth,
+                   "mu": pusher.mu if pusher.mu_high is None else [pusher.mu, pusher.mu_high],
+                   "edges": list(pusher.edges), "transit": pusher.transit},
+        "obstacles": [{"polygon": np.asarray(o.exterior.coords)[:-1].tolist()} for o in scene.obstacles],
+        "workspace": {"min": list(scene.workspace[:2]), "max": list(scene.workspace[2:])},
+        "start": [*scene.start[:2].tolist(), _degrees(scene.start[2])],
+        "goal": [*scene.goal[:2].tolist(), _degrees(scene.goal[2])],
+        "tolerance": {"position": scene.tolerance_position, "angle": _degrees(scene.tolerance_angle)},
+        "planner": {key: getattr(scene.planner, key) for key in _PLANNER_KEYS},
+    }
+
+
+def _degrees(radians: float) -> float:
+    """``radians`` in degrees, to 1e-10 of a degree (as angles are read, :data:`.fields.ANGLE`), so
+    that the degrees a scene gave come back as given: 30, not 29.999999999999993."""
+    return round(math.degrees(radians), 10) + 0.0  # no -0.0
+
+
+def write_scene(scene: Scene, path: str | Path) -> None:
+    """Write :func:`plain_scene` of ``scene`` to ``path`` as YAML, atomically.
+
+    Raises
+    ------
+    OSError
+        Naming ``path``, if it cannot be written.
+    """
+    source = f" from {scene.path}" if scene.path else ""
+    text = yaml.safe_dump(plain_scene(scene), sort_keys=False, default_flow_style=None, width=120)
+    write_atomic(path, f"# The scene{source} as planned: plan --export-scene writes what the planner used.\n{text}")
+
+
 def _points(value: Any, name: str) -> np.ndarray:
     if not isinstance(value, (list, tuple)):
         raise SceneError(name, "must be a list of [x, y] points")
@@ -145,11 +200,18 @@ def _simple_polygon(pts: np.ndarray, name: str) -> shapely.Polygon:
     return shapely.Polygon(pts)
 
 
-def _obstacle(value: Any, name: str) -> shapely.Polygon:
+def _obstacles(value: Any, name: str, folder: Path, notes: list[str]) -> list[shapely.Polygon]:
+    """The obstacles of one entry of ``obstacles``: a polygon, a box, or those a file draws (each
+    of its bodies, cut where it has holes: :func:`.cad.without_holes`)."""
+    if isinstance(value, dict) and "file" in value:
+        from .cad import FILE_KEYS, FILE_OPTIONS, read_shapes, without_holes
+
+        shapes = read_shapes(keys(value, name, FILE_KEYS, FILE_OPTIONS), name, folder, notes)
+        return [piece for shape in shapes for piece in without_holes(shape.region)]
     if not isinstance(value, dict) or len(value) != 1 or next(iter(value)) not in ("polygon", "box"):
-        raise SceneError(name, "must be {polygon: [[x, y], ...]} or {box: {center, size, angle}}")
+        raise SceneError(name, "must be {polygon: [[x, y], ...]}, {box: {center, size, angle}} or {file, units}")
     if "polygon" in value:
-        return _polygon(value["polygon"], f"{name}.polygon")
+        return [_polygon(value["polygon"], f"{name}.polygon")]
     box = keys(value["box"], f"{name}.box", ("center", "size"), ("angle",))
     cx, cy = vector(box["center"], f"{name}.box.center", 2, LENGTH)
     w, h = vector(box["size"], f"{name}.box.size", 2, LENGTH)
@@ -159,28 +221,53 @@ def _obstacle(value: Any, name: str) -> shapely.Polygon:
     angle = math.radians(number(box.get("angle", 0.0), f"{name}.box.angle", limit=ANGLE))
     corners = np.array([[-w, -h], [w, -h], [w, h], [-w, h]]) / 2
     rot = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
-    return shapely.Polygon(corners @ rot.T + [cx, cy])
+    return [shapely.Polygon(corners @ rot.T + [cx, cy])]
 
 
-def _slider(value: Any) -> Slider:
+def _slider(value: Any, folder: Path, notes: list[str]) -> Slider:
+    if isinstance(value, dict) and "file" in value:
+        return _slider_from_file(value, folder, notes)
     spec = keys(value, "slider", ("vertices",), ("cf", "cf_uncertainty"))
     vertices = _points(spec["vertices"], "slider.vertices")
-    _simple_polygon(vertices, "slider.vertices")
+    return _checked_slider(vertices, spec, "slider.vertices")
+
+
+def _slider_from_file(value: dict, folder: Path, notes: list[str]) -> Slider:
+    """The part a file draws: its outline is what the pusher touches, and its default CF the
+    centroid of its footprint, holes left out (a hole carries no weight)."""
+    from .cad import FILE_KEYS, FILE_OPTIONS, read_shapes
+
+    spec = keys(value, "slider", FILE_KEYS, FILE_OPTIONS + ("cf", "cf_uncertainty"))
+    shapes = read_shapes(spec, "slider", folder, notes)
+    if len(shapes) > 1:
+        raise SceneError("slider.file", f"holds {len(shapes)} parts: pick one with layer or name")
+    (shape,) = shapes
+    if shape.footprint.area <= 0:
+        raise SceneError("slider.file", "the part has no footprint on the table")
+    vertices = np.asarray(shape.region.exterior.coords)[:-1]
+    cf = np.asarray(shape.footprint.centroid.coords[0])
+    return _checked_slider(vertices, {"cf": cf.tolist(), **spec}, "slider.file")
+
+
+def _checked_slider(vertices: np.ndarray, spec: dict, field: str) -> Slider:
+    """The part of ``vertices`` and ``spec``'s ``cf`` (default: the area centroid), checked;
+    ``field`` is where the vertices came from."""
+    _simple_polygon(vertices, field)
     # A repeated vertex makes an edge of no length, with no normal to push along; shapely accepts it.
     # Nearly repeated is as bad: the edge's direction is rounding noise, or its square underflows to 0.
     repeated = np.flatnonzero(np.hypot(*(vertices - np.roll(vertices, -1, axis=0)).T) < MIN_SIZE)
     if len(repeated):
         k = int(repeated[0])
-        raise SceneError("slider.vertices", f"vertices {k} and {(k + 1) % len(vertices)} coincide (closer than "
-                                            f"{MIN_SIZE:g} m), so edge {k} has no length (do not repeat the first "
-                                            "vertex at the end)")
+        raise SceneError(field, f"vertices {k} and {(k + 1) % len(vertices)} coincide (closer than "
+                                f"{MIN_SIZE:g} m), so edge {k} has no length (do not repeat the first "
+                                "vertex at the end)")
     try:
         part = Slider(vertices)
     except ValueError as err:
-        raise SceneError("slider.vertices", str(err)) from None
+        raise SceneError(field, str(err)) from None
     if not part.pushable_edges:  # a star: otherwise each edge would be refused later, as unstable
-        raise SceneError("slider.vertices", "no edge lies on the part's convex hull, so a flat pusher cannot push "
-                                            "any (each edge has a vertex beyond its line)")
+        raise SceneError(field, "no edge lies on the part's convex hull, so a flat pusher cannot push "
+                                "any (each edge has a vertex beyond its line)")
     if "cf" not in spec:
         return part
     cf = vector(spec["cf"], "slider.cf", 2, LENGTH)  # outside the try: a SceneError is a ValueError too
@@ -254,17 +341,19 @@ def _pose(value: Any, name: str, slider: Slider, obstacles: tuple[shapely.Polygo
 
 
 def parse_scene(data: Any, default_name: str = "scene", path: str | None = None) -> Scene:
-    """Validate a scene given as the parsed YAML mapping (see :func:`load_scene`)."""
+    """Validate a scene given as the parsed YAML mapping (see :func:`load_scene`); the files it
+    names are relative to the folder of ``path`` (the working folder if None)."""
     spec = keys(data, "scene", ("slider", "pusher", "workspace", "start", "goal"),
                  ("name", "obstacles", "tolerance", "planner"))
     name = _name(spec.get("name", default_name))
-    slider = _slider(spec["slider"])
+    folder, notes = Path(path).parent if path else Path(), []
+    slider = _slider(spec["slider"], folder, notes)
     cf_uncertainty = _cf_uncertainty(spec["slider"], slider)
     pusher = _pusher(spec["pusher"], slider)
     obstacles_spec = [] if spec.get("obstacles") is None else spec["obstacles"]  # None: a bare "obstacles:"
     if not isinstance(obstacles_spec, list):
         raise SceneError("obstacles", "must be a list")
-    obstacles = tuple(_obstacle(o, f"obstacles[{k}]") for k, o in enumerate(obstacles_spec))
+    obstacles = tuple(p for k, o in enumerate(obstacles_spec) for p in _obstacles(o, f"obstacles[{k}]", folder, notes))
     ws = keys(spec["workspace"], "workspace", ("min", "max"))
     lo, hi = vector(ws["min"], "workspace.min", 2, LENGTH), vector(ws["max"], "workspace.max", 2, LENGTH)
     if not np.all(hi > lo):
@@ -285,11 +374,10 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     if tol_ang < MIN_TOLERANCE:
         raise SceneError("tolerance.angle", f"must be at least {math.degrees(MIN_TOLERANCE):g} degrees (the rounding "
                                             f"of a plan's headings is about 1e-11 rad), got {math.degrees(tol_ang):g}")
-    opts = keys(spec.get("planner", {}), "planner", (),
-                ("name", "time_limit", "seed", "regions", "switch_cost", "optimize"))
+    opts = keys(spec.get("planner", {}), "planner", (), _PLANNER_KEYS)
     planner = PlannerOptions().merged(opts, prefix="planner.")
     return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path,
-                 cf_uncertainty)
+                 cf_uncertainty, tuple(notes))
 
 
 def _cf_uncertainty(spec: dict, slider: Slider) -> float:

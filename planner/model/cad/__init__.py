@@ -1,0 +1,210 @@
+"""Parts and obstacles read from CAD files: DXF drawings (:mod:`.dxf`), SVG drawings (:mod:`.svg`)
+and meshes (:mod:`.mesh`: STL, OBJ, PLY).
+
+Wherever a scene takes a polygon it may name a file instead, ``{file, units, at, layer, name,
+chord}`` (:data:`FILE_KEYS`, :data:`FILE_OPTIONS`; the README's "Parts and obstacles from CAD
+files"). :func:`read_shapes` reads it into :class:`Shape`\\ s in metres, placed by ``at``: each
+is what the body covers seen from above (``region``, holes open) and what of it rests on the
+table (``footprint``). Curves are flattened to within half the chord tolerance of the curve and
+the result simplified within the other half, so that no point of an outline is farther than the
+chord tolerance from the drawing.
+
+The readers' libraries (ezdxf, svgelements, trimesh: the ``cad`` extra) are imported only when a
+scene names a file of their kind; without them the scene is refused with one line naming the
+extra. A file is untrusted input: at most :data:`MAX_FILE_BYTES` are read, coordinates are
+checked against the scene's limits before any curve is flattened, and flattening stops at
+:data:`MAX_POINTS` points, so time and memory are bounded by those numbers, not by the file's.
+What the readers rely on in their libraries is in docs/stack.md, "CAD readers".
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import shapely
+import shapely.affinity
+import shapely.ops
+from shapely.validation import explain_validity
+
+from ..fields import ANGLE, LENGTH, SceneError, number, shown, vector
+from ..input_file import read_bytes
+
+__all__ = ["CHORD", "FILE_KEYS", "FILE_OPTIONS", "MAX_FILE_BYTES", "MAX_POINTS", "READERS", "UNITS", "Selection",
+           "Shape", "read_shapes", "shapes_from_rings", "without_holes"]
+
+#: Required keys of a file reference, and its optional ones.
+FILE_KEYS = ("file", "units")
+FILE_OPTIONS = ("at", "layer", "name", "chord")
+#: Metres per unit of the file's numbers.
+UNITS = {"mm": 1e-3, "cm": 1e-2, "m": 1.0, "in": 0.0254}
+#: Default chord tolerance, in metres (0.1 mm), and the least one taken (a micron: the least edge
+#: of a part, :data:`..scene.MIN_SIZE`).
+CHORD = 1e-4
+MIN_CHORD = 1e-6
+#: Largest file read: a drawing of a part or fixture is kilobytes; ten megabytes is a detailed
+#: mesh of some 200000 triangles, and the readers' memory stays within a few hundred megabytes.
+MAX_FILE_BYTES = 10_000_000
+#: Most points the curves of one file may flatten to (or triangles a mesh may hold).
+MAX_POINTS = 200_000
+#: The reader module for each file suffix.
+READERS = {".dxf": "dxf", ".svg": "svg", ".stl": "mesh", ".obj": "mesh", ".ply": "mesh"}
+
+
+@dataclass(frozen=True)
+class Shape:
+    """One body of a file: ``region``, what it covers seen from above (its outline with through
+    holes open), and ``footprint``, what of it rests on the table. A drawing's two are the same;
+    a mesh's footprint is its lowest faces."""
+
+    region: shapely.Polygon
+    footprint: shapely.Polygon | shapely.MultiPolygon
+
+
+@dataclass(frozen=True)
+class Selection:
+    """What a reader is asked for: the ``layer`` and ``name`` given (None if not), the flattening
+    tolerance ``chord`` and the largest coordinate magnitude ``limit``, both in the file's units,
+    and ``field``, the file's field for messages."""
+
+    layer: str | None
+    name: str | None
+    chord: float
+    limit: float
+    field: str
+
+    def check_points(self, points: np.ndarray, what: str) -> None:
+        """Refuse ``points`` (file units) that are not finite or lie beyond ``limit``."""
+        if points.size and not np.all(np.abs(points) <= self.limit):  # NaN fails too
+            bad = points[~np.all(np.abs(points) <= self.limit, axis=-1)][0]
+            raise SceneError(self.field, f"{what} has a point beyond the {LENGTH.bound:g} m limit: {shown(bad)}")
+
+
+def read_shapes(spec: dict[str, Any], field: str, folder: Path, notes: list[str]) -> list[Shape]:
+    """The shapes of the file that ``spec`` (a mapping with :data:`FILE_KEYS` and perhaps
+    :data:`FILE_OPTIONS`, already checked for unknown keys) names, relative to ``folder``, in
+    metres and placed by its ``at``. Notes about what the file held and was not read (text, open
+    chains) are appended to ``notes``.
+
+    Raises
+    ------
+    SceneError
+        Naming ``field`` (or its key at fault): the file cannot be read, is too large, is not of
+        its kind, holds no closed outline, or an outline crosses itself or another; or a key's
+        value is bad; or the reader's library (the ``cad`` extra) is not installed.
+    """
+    file = spec["file"]
+    if not isinstance(file, str) or not file or not file.isprintable():
+        raise SceneError(f"{field}.file", f"must be a file name, got {shown(file)}")
+    units = spec["units"]
+    if not isinstance(units, str) or units not in UNITS:
+        raise SceneError(f"{field}.units", f"must be one of {', '.join(UNITS)}, got {shown(units)}")
+    scale = UNITS[units]
+    x, y, theta = vector(spec.get("at", [0.0, 0.0, 0.0]), f"{field}.at", 3)
+    LENGTH.check(x, f"{field}.at[0]")
+    LENGTH.check(y, f"{field}.at[1]")
+    theta = math.radians(ANGLE.check(theta, f"{field}.at[2]"))
+    chord = number(spec.get("chord", CHORD), f"{field}.chord", positive=True, limit=LENGTH)
+    if chord < MIN_CHORD:
+        raise SceneError(f"{field}.chord", f"must be at least {MIN_CHORD:g} m, got {shown(chord)}")
+    select = {key: spec.get(key) for key in ("layer", "name")}
+    for key, value in select.items():
+        if value is not None and (not isinstance(value, str) or not value):
+            raise SceneError(f"{field}.{key}", f"must be a non-empty string, got {shown(value)}")
+    path = folder / file
+    kind = READERS.get(path.suffix.lower())
+    if kind is None:
+        raise SceneError(f"{field}.file", f"{shown(file)}: unknown kind of file (known: {', '.join(READERS)})")
+    raw = read_bytes(path, f"{field}.file", MAX_FILE_BYTES)
+    reader = importlib.import_module(f".{kind}", __name__)
+    try:
+        for library in reader.NEEDS:
+            importlib.import_module(library)
+    except ImportError as err:
+        raise SceneError(f"{field}.file", f"reading {path.suffix.lower()} files needs the cad extra: "
+                                          f"pip install 'stablepush[cad]' ({err})") from None
+    selection = Selection(select["layer"], select["name"], chord / 2 / scale, LENGTH.bound / scale, f"{field}.file")
+    noted = len(notes)
+    shapes = reader.read(raw, path.suffix.lower(), selection, notes)
+    if not shapes:  # what was not read may say why (open chains, text)
+        why = "".join(f"; {note.removeprefix(selection.field + ': ')}" for note in notes[noted:])
+        raise SceneError(f"{field}.file", f"{shown(file)} holds no closed outline{_where(selection)}{why}")
+    c, s = math.cos(theta), math.sin(theta)
+    matrix = [scale * c, -scale * s, scale * s, scale * c, x, y]
+    placed = []
+    for shape in shapes:
+        region, footprint = (shapely.affinity.affine_transform(g, matrix) for g in (shape.region, shape.footprint))
+        LENGTH.check(float(np.max(np.abs(region.bounds))), f"{field}.at")  # `at` moved it beyond the limit
+        # Simplified within the other half of the chord tolerance; the topology kept, so a valid
+        # region stays valid.
+        placed.append(Shape(region.simplify(chord / 2), footprint.simplify(chord / 2)))
+    return placed
+
+
+def _where(selection: Selection) -> str:
+    return "".join(f" {key} {shown(value)}" for key, value in (("on layer", selection.layer),
+                                                               ("named", selection.name)) if value is not None)
+
+
+def shapes_from_rings(rings: list[np.ndarray], selection: Selection) -> list[Shape]:
+    """The bodies that closed ``rings`` (each ``(n, 2)``, file units, not repeating the first
+    point) draw: each outline not inside another is a body; one inside exactly one other is a hole
+    of it; one inside a hole is a body again (even-odd nesting, as a laser cutter reads a drawing).
+    Outlines may nest but not cross, and none may cross itself.
+
+    >>> square = np.array([[0, 0], [4, 0], [4, 4], [0, 4]], float)
+    >>> shapes = shapes_from_rings([square, square / 4 + 1, square / 8 + 1.25], Selection(None, None, 0.1, 1e3, "f"))
+    >>> [(s.footprint.area, len(s.footprint.interiors)) for s in shapes]
+    [(15.0, 1), (0.25, 0)]
+    >>> shapes_from_rings([square, square + 2], Selection(None, None, 0.1, 1e3, "f"))
+    Traceback (most recent call last):
+    ...
+    planner.model.fields.SceneError: f: outlines 0 and 1 cross each other (or touch)
+    """
+    polygons = []
+    for k, ring in enumerate(rings):
+        if len(ring) < 3 or shapely.MultiPoint(ring).convex_hull.area <= (selection.chord * 1e-3) ** 2:
+            continue  # a point or a line drawn as a closed curve: no outline
+        if not shapely.LinearRing(ring).is_simple:
+            raise SceneError(selection.field, f"outline {k} intersects itself "
+                                              f"({explain_validity(shapely.Polygon(ring)).lower()})")
+        polygons.append(shapely.Polygon(ring))
+    if not polygons:
+        return []
+    tree = shapely.STRtree([p.exterior for p in polygons])
+    pairs = tree.query([p.exterior for p in polygons], predicate="intersects")
+    crossing = pairs[:, pairs[0] < pairs[1]]
+    if crossing.size:
+        raise SceneError(selection.field, f"outlines {crossing[0, 0]} and {crossing[1, 0]} cross each other (or touch)")
+    inside: list[list[int]] = [[] for _ in polygons]  # the outlines each is inside
+    for outer, inner in shapely.STRtree(polygons).query(polygons, predicate="contains_properly").T:
+        inside[inner].append(outer)
+    bodies = {k: [] for k in range(len(polygons)) if len(inside[k]) % 2 == 0}
+    for k, outer in enumerate(inside):
+        if len(outer) % 2:  # a hole: of the body that holds it most tightly
+            bodies[max(outer, key=lambda j: len(inside[j]))].append(polygons[k].exterior)
+    shapes = []
+    for k, holes in bodies.items():
+        region = shapely.Polygon(polygons[k].exterior, holes)
+        shapes.append(Shape(region, region))
+    return shapes
+
+
+def without_holes(region: shapely.Polygon) -> list[shapely.Polygon]:
+    """``region`` cut into polygons without holes by a line across each hole (the scene's
+    obstacles are plain polygons).
+
+    >>> frame = shapely.box(0, 0, 4, 4).difference(shapely.box(1, 1, 3, 3))
+    >>> sorted(p.area for p in without_holes(frame))
+    [6.0, 6.0]
+    """
+    if not region.interiors:
+        return [region]
+    _, ymin, _, ymax = region.bounds
+    cuts = shapely.MultiLineString([[(x, ymin - 1), (x, ymax + 1)]
+                                    for x in (shapely.Polygon(h).representative_point().x for h in region.interiors)])
+    return [p for p in shapely.ops.split(region, cuts).geoms if isinstance(p, shapely.Polygon) and p.area > 0]

@@ -1,0 +1,74 @@
+"""Meshes (STL, OBJ, PLY), read by trimesh: a body's projection on the table and its footprint.
+
+The table is the plane z = lowest z of the mesh, seen from above (z up, so x and y are the
+table's). A body's region is the union of its triangles projected on the table (a hole through
+the body, top to bottom, stays open; its outline is what a pusher can touch), and its footprint
+the union of the triangles lying on the table: those whose three corners are within the chord
+tolerance of the lowest z. The footprint is what carries the part's weight, so its centroid is the
+part's default centre of friction. A mesh that touches the table only at points or along edges
+(a cone on its tip, a sphere) has no footprint and is refused.
+
+``name`` picks a body of a file of several named ones (an OBJ's objects, say); meshes have no
+layers.
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import shapely
+
+from ..fields import SceneError, shown
+from . import MAX_POINTS, Selection, Shape
+
+__all__ = ["NEEDS", "read"]
+
+#: The libraries read imports (the cad extra's): imported there, so that this module loads without them.
+NEEDS = ("trimesh",)
+
+
+def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> list[Shape]:
+    """The bodies of the mesh file ``raw`` (of kind ``suffix``), or the one ``selection`` names (module docstring)."""
+    import trimesh
+
+    if selection.layer is not None:
+        raise SceneError(selection.field, "a mesh has no layers (name picks one of its bodies)")
+    try:
+        loaded = trimesh.load(io.BytesIO(raw), file_type=suffix[1:], process=False)
+    except Exception as err:  # noqa: BLE001 (untrusted bytes: any failure of the parser is "not a mesh")
+        raise SceneError(selection.field, f"not a readable {suffix[1:].upper()} file ({type(err).__name__}: "
+                                          f"{err})") from None
+    bodies = dict(loaded.geometry) if isinstance(loaded, trimesh.Scene) else {None: loaded}
+    if selection.name is not None:
+        if selection.name not in bodies:
+            known = ", ".join(shown(name) for name in bodies if name) or "none"
+            raise SceneError(selection.field, f"no body named {shown(selection.name)} (bodies: {known})")
+        bodies = {selection.name: bodies[selection.name]}
+    meshes = [mesh for mesh in bodies.values() if isinstance(mesh, trimesh.Trimesh) and len(mesh.faces)]
+    if sum(len(mesh.faces) for mesh in meshes) > MAX_POINTS:
+        raise SceneError(selection.field, f"the mesh has more than {MAX_POINTS} triangles")
+    if not meshes:
+        raise SceneError(selection.field, "the file holds no triangles")
+    mesh = trimesh.util.concatenate(meshes)
+    selection.check_points(mesh.vertices, "the mesh")
+    mesh.merge_vertices()  # an STL's triangles share no vertices: joined, they form the patches projected below
+    region = _projected(mesh)
+    lowest = float(mesh.vertices[:, 2].min())
+    on_table = np.flatnonzero(np.all(mesh.vertices[mesh.faces][:, :, 2] <= lowest + 2 * selection.chord, axis=1))
+    footprint = _projected(mesh.submesh([on_table], append=True)) if len(on_table) else shapely.Polygon()
+    if footprint.area <= 0:
+        raise SceneError(selection.field, f"the mesh has no footprint: no face lies flat at its lowest point "
+                                          f"(z = {lowest:g}), which it touches only at points or along edges")
+    grid = selection.chord / 10  # far below the tolerance: no slivers of rounding
+    return [Shape(part, part.intersection(footprint, grid_size=grid)) for part in shapely.get_parts(region)
+            if isinstance(part, shapely.Polygon) and part.area > 0]
+
+
+def _projected(mesh) -> shapely.Polygon | shapely.MultiPolygon:
+    """What ``mesh`` covers seen from above: trimesh's projection, which outlines each patch of
+    adjacent faces turned the same way and unions the outlines (docs/stack.md, "CAD readers")."""
+    from trimesh.path.polygons import projected
+
+    shape = projected(mesh, normal=[0.0, 0.0, 1.0])
+    return shapely.Polygon() if shape is None else shapely.make_valid(shape)
