@@ -304,7 +304,7 @@ BAD = {
     # (what to write, the slider's file reference, the field named, words of the problem)
     "missing file": (lambda folder: None, {"file": "none.dxf", "units": "mm"}, "slider.file", ["cannot read"]),
     "unreadable file (a folder)": (lambda folder: (folder / "dir.svg").mkdir(), {"file": "dir.svg", "units": "mm"},
-                                   "slider.file", ["cannot read"]),
+                                   "slider.file", ["not a regular file (a folder)"]),
     "unknown unit": (part_on_layer("PART"), {"file": "part.dxf", "units": "ft"}, "slider.units",
                      ["must be one of mm, cm, m, in", "'ft'"]),
     "a unit that is a list": (part_on_layer("PART"), {"file": "part.dxf", "units": ["mm"]}, "slider.units",
