@@ -362,8 +362,9 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         clock = time.perf_counter()
         # The geometric certificates need no stable region: a sealed-off goal is answered at once.
         unreachable = certify_unreachable(scene, regions=False)
-        result = (Plan(scene.path, False, name, seed, time.perf_counter() - clock, scene.start.copy(),
-                       scene.goal.copy(), reason=unreachable) if unreachable
+        result = (Plan(scene=scene.path, solved=False, planner=name, seed=seed,
+                       planning_time_s=time.perf_counter() - clock, start=scene.start.copy(),
+                       goal=scene.goal.copy(), reason=unreachable) if unreachable
                   else plan(scene, seed=seed, time_limit=limit, planner=name, progress=_progress if tty else None))
         if tty:
             print("\r\033[K", end="", file=sys.stderr, flush=True)  # clear the progress line
@@ -432,7 +433,8 @@ def _first_found(result: Plan) -> str:
     """What the first plan cost and when it was found, when improvement rounds found better ones
     (cost against time: the answer only got better), else nothing.
 
-    >>> plan = Plan(None, True, "rrt", 1, 2.5, [0, 0, 0], [0, 0, 0], improvements=[(0.4, 1.2, 0.95), (1.1, 0.8, 0.55)])
+    >>> plan = Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=2.5, start=[0, 0, 0],
+    ...             goal=[0, 0, 0], improvements=[(0.4, 1.2, 0.95), (1.1, 0.8, 0.55)])
     >>> _first_found(plan)
     ' (first plan: cost 1.200 m at 0.40 s; 1 better, the last at 1.10 s)'
     """

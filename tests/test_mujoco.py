@@ -127,7 +127,8 @@ def test_a_lift_alone_leaves_the_part_where_it_is():
     scene = load_scene(ROOT / "scenes" / "narrow_junction.yaml")
     result = plan(scene, seed=1)
     lift = next(s for s in result.segments if s.kind == "transit" and s.mode == "lift")
-    alone = Plan(None, True, "rrt", 1, 0.0, lift.pose, lift.pose, [lift])
+    alone = Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=lift.pose, goal=lift.pose,
+                 segments=[lift])
     (run,) = simulate(scene, alone, n=1).runs
     assert run.collisions == 0 and run.final_error[0] < 5e-5 and run.final_error[1] < 1e-3
     assert run.deviation < 5e-5

@@ -281,8 +281,9 @@ def test_the_centre_of_a_turn_stays_put_and_lies_in_its_stable_region(turn, stra
 
 def test_an_unsolved_plan_records_the_scene_and_the_tree(tmp_path):
     scene = write_scene(tmp_path, "stuck", [0.12, 0.0, 0.0])
-    plan = planner.Plan(scene.path, False, "rrt", 1, 0.0, scene.start, scene.goal, reason="no plan found")
-    plan.tree = np.array([[[0.0, 0.0], [0.05, 0.01]], [[0.05, 0.01], [0.08, -0.02]]])
+    plan = planner.Plan(scene=scene.path, solved=False, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
+                        goal=scene.goal, reason="no plan found",
+                        tree=np.array([[[0.0, 0.0], [0.05, 0.01]], [[0.05, 0.01], [0.08, -0.02]]]))
     path = tmp_path / "stuck.rrd"
     recording.write_recording(path, scene, plan)
     verify(path)
@@ -312,7 +313,8 @@ def test_a_long_plan_is_capped_and_its_cf_path_thinned(straight, tmp_path):
         end = exp_twist(pose, twist, duration)
         segments.append(planner.Push(3, np.array(SLIDER[3::-3]), np.array(twist), duration, pose, end))
         pose = end
-    plan = planner.Plan(scene.path, True, "rrt", 1, 0.0, scene.start, pose, segments)
+    plan = planner.Plan(scene=scene.path, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
+                        goal=pose, segments=segments)
     path = tmp_path / "long.rrd"
     recording.write_recording(path, scene, plan)
     slider = rrd_rows(path, "/world/slider", "LineStrips3D:strips", "step")

@@ -230,7 +230,8 @@ def test_a_straight_push_takes_the_time_optimal_time(length, jerk, case):
     push = Push.along(0, np.array(scene.slider.edge(0)), [0.0, 1.0, 0.0], length, scene.start)  # 1 m/s per unit s
     found, expected = _rest_to_rest_time(length, SPEED, ACCEL, jerk)
     assert found == case
-    run = trajectory(scene, Plan(None, True, "rrt", 1, 0.0, scene.start, scene.goal, [push]), SPEED, ACCEL, jerk)
+    run = trajectory(scene, Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
+                                 goal=scene.goal, segments=[push]), SPEED, ACCEL, jerk)
     assert run.duration == pytest.approx(expected, rel=0.05)
 
 

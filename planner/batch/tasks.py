@@ -336,7 +336,8 @@ def run_task(task: Task, shared: Mapping[str, Any] | None) -> dict[str, Any]:
                   for e in p.edges)
     unreachable = certify_unreachable(scene, regions=False)
     if unreachable:
-        result = Plan(scene.path, False, scene.planner.name, task.seed, 0.0, scene.start.copy(), scene.goal.copy(),
+        result = Plan(scene=scene.path, solved=False, planner=scene.planner.name, seed=task.seed, planning_time_s=0.0,
+                      start=scene.start.copy(), goal=scene.goal.copy(),
                       reason=unreachable)
     else:
         result = plan(scene, seed=task.seed)

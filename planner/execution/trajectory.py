@@ -242,7 +242,8 @@ def trajectory(scene: Scene, plan: Plan, max_speed: float = MAX_SPEED, max_accel
     >>> from planner.model.scene import load_scene
     >>> scene = load_scene("scenes/junction.yaml")
     >>> push = Push.along(0, np.zeros((2, 2)), [0.0, 1.0, 0.0], 0.3, scene.start)  # 0.3 m straight
-    >>> run = trajectory(scene, Plan(None, True, "rrt", 1, 0.0, scene.start, scene.goal, [push]))
+    >>> run = trajectory(scene, Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0,
+    ...                              start=scene.start, goal=scene.goal, segments=[push]))
     >>> run.duration, len(run.t), float(run.vy.max()), float(run.vx.max())  # 0.3/0.05 + 0.05/0.5 + 0.5/5
     (6.2, 621, 0.05, 0.0)
     """

@@ -227,9 +227,9 @@ def rechain(segments: list, start: ArrayLike | None = None) -> list:
     return out
 
 
-@dataclass
+@dataclass(frozen=True, kw_only=True)
 class Plan:
-    """The result of :func:`planner.plan`."""
+    """The result of :func:`planner.plan`: made by keyword, once, never changed after."""
 
     scene: str | None
     solved: bool
@@ -265,7 +265,8 @@ class Plan:
     def contents(self, joiner: str = ", ") -> str:
         """What the plan is made of, in words: ``'3 pushes'``, ``'1 push, 2 switches'``.
 
-        >>> Plan(None, True, "rrt", 1, 0.0, np.zeros(3), np.zeros(3)).contents()
+        >>> Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=np.zeros(3),
+        ...      goal=np.zeros(3)).contents()
         '0 pushes'
         """
         def count(n: int, word: str, plural: str) -> str:
@@ -290,8 +291,8 @@ class Plan:
 
         >>> push = Push.along(0, np.zeros((2, 2)), [1.0, 0.0, 0.0], 0.5, np.zeros(3))
         >>> transit = Transit(0, 2, "lift", np.zeros((4, 3)), 0.1, push.end)
-        >>> plan = Plan(None, True, "rrt", 1, 0.0, np.zeros(3), push.end, [push, transit], switch_cost=0.25,
-        ...             cf=np.zeros(2))
+        >>> plan = Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=np.zeros(3),
+        ...             goal=push.end, segments=[push, transit], switch_cost=0.25, cf=np.zeros(2))
         >>> plan.length, plan.cost
         (0.5, 0.75)
         """
@@ -344,21 +345,22 @@ class Plan:
             raise SceneError("plan.solved", f"must be true or false, got {spec['solved']!r}")
         if not isinstance(spec["segments"], list):
             raise SceneError("plan.segments", "must be a list")
+        start = vector(spec["start"], "plan.start", 3)
         plan = cls(
             scene=spec["scene"] if isinstance(spec["scene"], str) else None,
             solved=spec["solved"],
             planner=str(spec["planner"]),
             seed=integer(spec["seed"], "plan.seed"),
             planning_time_s=number(spec["planning_time_s"], "plan.planning_time_s"),
-            start=vector(spec["start"], "plan.start", 3),
+            start=start,
             goal=vector(spec["goal"], "plan.goal", 3),
+            segments=_read_segments(spec["segments"], start),
             reason=str(spec.get("reason", "")),
             switch_cost=number(spec["switch_cost"], "plan.switch_cost") if "switch_cost" in spec else None,
             cf=vector(spec["cf"], "plan.cf", 2) if "cf" in spec else None,
             improvements=[tuple(vector(row, f"plan.improvements[{i}]", 3).tolist())
                           for i, row in enumerate(_list(spec.get("improvements", []), "plan.improvements"))],
         )
-        plan.segments = _read_segments(spec["segments"], plan.start)
         final = vector(spec["final"], "plan.final", 3)
         if not np.allclose(final, plan.final, atol=1e-9):
             raise SceneError("plan.final", "is not the end of the last segment")
