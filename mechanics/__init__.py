@@ -32,7 +32,7 @@ from .kinematics import (
     relative_mode,
 )
 from .possible_motions import ModeMotions, mode_possible, possible_motions
-from .se2 import exp_twist, log_pose, relative_pose, wrap_angle
+from .se2 import compose, exp_twist, inverse, log_pose, relative_pose, transform_points, wrap_angle
 from .slider import Slider
 from .regions import METHODS, PushRegion, stable_region
 from .stable import DEFAULT_TIP_FACTOR, StableRegion, procedure_stable
@@ -71,7 +71,10 @@ __all__ = [
     "edge_regions",
     "effective_cf",
     "exact_region",
+    "compose",
     "exp_twist",
+    "inverse",
+    "transform_points",
     "force_possible",
     "force_status",
     "force_status_regions",

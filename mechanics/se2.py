@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["exp_twist", "log_pose", "relative_pose", "wrap_angle"]
+__all__ = ["compose", "exp_twist", "inverse", "log_pose", "relative_pose", "transform_points", "wrap_angle"]
 
 def wrap_angle(theta: ArrayLike) -> np.ndarray:
     """Angle in ``[-pi, pi)``.
@@ -57,6 +57,46 @@ def exp_twist(pose: ArrayLike, twist: ArrayLike, t: ArrayLike = 1.0) -> np.ndarr
     dy = (b * v[..., 0] + a * v[..., 1]) * t
     c, s = np.cos(q[..., 2]), np.sin(q[..., 2])
     return np.stack([q[..., 0] + c * dx - s * dy, q[..., 1] + s * dx + c * dy, q[..., 2] + phi], axis=-1)
+
+
+def transform_points(p_B: ArrayLike, X_AB: ArrayLike) -> np.ndarray:
+    """Points given in frame B, in frame A, where ``X_AB`` is B's pose in A (``(x, y, theta)``);
+    both broadcast over leading axes: ``(m, 2)`` points and one pose give ``(m, 2)``, one point and
+    ``(n, 3)`` poses give ``(n, 2)``.
+
+    >>> transform_points([[1.0, 0.0]], [0.0, 1.0, np.pi / 2]).round(12).tolist()
+    [[0.0, 2.0]]
+    >>> transform_points([1.0, 0.0], [[0.0, 0.0, 0.0], [0.0, 0.0, np.pi]]).round(12).tolist()
+    [[1.0, 0.0], [-1.0, 0.0]]
+    """
+    p = np.asarray(p_B, dtype=float)
+    X = np.asarray(X_AB, dtype=float)
+    c, s = np.cos(X[..., 2]), np.sin(X[..., 2])
+    return np.stack([X[..., 0] + c * p[..., 0] - s * p[..., 1], X[..., 1] + s * p[..., 0] + c * p[..., 1]], axis=-1)
+
+
+def compose(X_AB: ArrayLike, X_BC: ArrayLike) -> np.ndarray:
+    """``X_AC = X_AB X_BC``: C's pose in A from C's in B and B's in A, angle in ``[-pi, pi)``.
+
+    >>> compose([1.0, 0.0, np.pi / 2], [1.0, 0.0, np.pi / 2]).round(12).tolist()
+    [1.0, 1.0, -3.14159265359]
+    """
+    X_BC = np.asarray(X_BC, dtype=float)
+    xy = transform_points(X_BC[..., :2], X_AB)
+    return np.concatenate([xy, wrap_angle(np.asarray(X_AB, dtype=float)[..., 2] + X_BC[..., 2])[..., None]], axis=-1)
+
+
+def inverse(X_AB: ArrayLike) -> np.ndarray:
+    """``X_BA``: A's pose in B.
+
+    >>> inverse([1.0, 2.0, np.pi / 2]).round(12).tolist()
+    [-2.0, 1.0, -1.570796326795]
+    >>> compose([1.0, 2.0, 0.3], inverse([1.0, 2.0, 0.3])).round(12).tolist()
+    [0.0, 0.0, 0.0]
+    """
+    X = np.asarray(X_AB, dtype=float)
+    c, s = np.cos(X[..., 2]), np.sin(X[..., 2])
+    return np.stack([-(c * X[..., 0] + s * X[..., 1]), s * X[..., 0] - c * X[..., 1], wrap_angle(-X[..., 2])], axis=-1)
 
 
 def relative_pose(q0: ArrayLike, q1: ArrayLike) -> np.ndarray:

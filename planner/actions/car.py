@@ -31,7 +31,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import ExactRegion, wrap_angle
+from mechanics import ExactRegion, transform_points, wrap_angle
 
 from .controls import EdgeControls
 
@@ -95,10 +95,7 @@ class EdgeCar:
         >>> car.pose(car.state([1.0, 2.0, 3.0])).round(12).tolist()
         [1.0, 2.0, 3.0]
         """
-        x, y, th = (float(v) for v in pose)
-        c, s = math.cos(th), math.sin(th)
-        cx, cy = self.cf
-        return np.array([x + c * cx - s * cy, y + s * cx + c * cy, float(wrap_angle(th + self.heading_angle))])
+        return self.states(pose)[0]
 
     def states(self, poses: ArrayLike) -> np.ndarray:
         """:meth:`state` of each slider pose of ``poses`` ``(n, 3)``, as rows.
@@ -108,18 +105,13 @@ class EdgeCar:
         [[1.1, 0.0, 1.570796326795], [0.0, 0.1, -3.14159265359]]
         """
         q = np.asarray(poses, dtype=float).reshape(-1, 3)
-        c, s = np.cos(q[:, 2]), np.sin(q[:, 2])
-        cx, cy = self.cf
-        return np.column_stack([q[:, 0] + c * cx - s * cy, q[:, 1] + s * cx + c * cy,
-                                wrap_angle(q[:, 2] + self.heading_angle)])
+        return np.column_stack([transform_points(self.cf, q), wrap_angle(q[:, 2] + self.heading_angle)])
 
     def pose(self, state: ArrayLike) -> np.ndarray:
         """The slider pose for a car state (inverse of :meth:`state`)."""
         x, y, psi = (float(v) for v in state)
         th = float(wrap_angle(psi - self.heading_angle))
-        c, s = math.cos(th), math.sin(th)
-        cx, cy = self.cf
-        return np.array([x - (c * cx - s * cy), y - (s * cx + c * cy), th])
+        return np.array([*(np.array([x, y]) - transform_points(self.cf, [0.0, 0.0, th])), th])
 
     def reach(self) -> float:
         """Farthest point of the pushed body (part and pusher) from the CF: a body point moves at

@@ -32,9 +32,9 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import Slider, wrap_angle
+from mechanics import Slider, transform_points, wrap_angle
 
-from ..model.bodies import pusher_frame_body, transform_points
+from ..model.bodies import pusher_frame_body
 from ..model.plan_file import Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel

@@ -60,11 +60,11 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import relative_pose, wrap_angle
+from mechanics import relative_pose, transform_points, wrap_angle
 from mechanics.quasistatic import grid_support, tripod_supports
 
 from ..actions.transit import edge_contact_pose
-from ..model.bodies import convex_pieces, pusher_frame_body, transform_points
+from ..model.bodies import convex_pieces, pusher_frame_body
 from ..model.fields import SceneError
 from ..model.files import write_atomic
 from ..model.plan_file import Plan

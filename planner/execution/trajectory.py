@@ -57,10 +57,10 @@ from typing import NamedTuple
 import numpy as np
 import ruckig
 
-from mechanics import exp_twist, point_velocity, wrap_angle
+from mechanics import exp_twist, point_velocity, transform_points, wrap_angle
 
 from ..actions.transit import AIRBORNE, edge_contact_pose, piece_times
-from ..model.bodies import place, pusher_frame_body, transform_points
+from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
 from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene

@@ -50,12 +50,11 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import exp_twist, log_pose, wrap_angle
+from mechanics import exp_twist, log_pose, transform_points, wrap_angle
 from mechanics.quasistatic import (DEFAULT_STEPS, Contact, ContactMode, PushResult, SupportDistribution,
                                    dipod_supports, edge_contacts, grid_support, random_support, simulate_push,
                                    tripod_supports)
 
-from ..model.bodies import transform_points
 from ..model.fields import SceneError
 from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene

@@ -11,22 +11,9 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import Slider
+from mechanics import Slider, transform_points
 
-__all__ = ["body_outline", "cf_poses", "place", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at",
-           "transform_points"]
-
-
-def transform_points(points: ArrayLike, pose: ArrayLike) -> np.ndarray:
-    """Slider-frame points placed at ``pose = (x, y, theta)`` in the world.
-
-    >>> transform_points([[1.0, 0.0]], [0.0, 1.0, np.pi / 2]).round(12).tolist()
-    [[0.0, 2.0]]
-    """
-    p = np.asarray(points, dtype=float)
-    x, y, theta = pose
-    c, s = np.cos(theta), np.sin(theta)
-    return p @ np.array([[c, s], [-s, c]]) + [x, y]
+__all__ = ["body_outline", "cf_poses", "place", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at"]
 
 
 def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
@@ -35,9 +22,7 @@ def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
     >>> place(np.array([[1.0, 0.0]]), np.array([[0.0, 1.0, np.pi / 2]])).round(12).tolist()
     [[[0.0, 2.0]]]
     """
-    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
-    x, y = points[:, 0], points[:, 1]
-    return np.stack([c * x - s * y + poses[:, :1], s * x + c * y + poses[:, 1:2]], axis=-1)
+    return transform_points(np.asarray(points, dtype=float)[None], np.asarray(poses, dtype=float)[:, None])
 
 
 def cf_poses(cf: ArrayLike, xy: ArrayLike, theta: ArrayLike) -> np.ndarray:
@@ -49,9 +34,8 @@ def cf_poses(cf: ArrayLike, xy: ArrayLike, theta: ArrayLike) -> np.ndarray:
     ([[1.0, 0.9, 1.570796326795]], [[1.0, 1.0]])
     """
     xy, theta = np.asarray(xy, dtype=float).reshape(-1, 2), np.asarray(theta, dtype=float).reshape(-1)
-    c, s = np.cos(theta), np.sin(theta)
-    cx, cy = np.asarray(cf, dtype=float)
-    return np.column_stack([xy[:, 0] - (c * cx - s * cy), xy[:, 1] - (s * cx + c * cy), theta])
+    turned = transform_points(cf, np.column_stack([np.zeros((len(theta), 2)), theta]))  # cf turned by each theta
+    return np.column_stack([xy - turned, theta])
 
 
 def slider_at(polygon: shapely.Polygon, pose: ArrayLike) -> shapely.Polygon:

@@ -17,9 +17,8 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import exp_twist, point_velocity, relative_pose, wrap_angle
+from mechanics import exp_twist, point_velocity, relative_pose, transform_points, wrap_angle
 
-from .bodies import transform_points
 from .fields import SceneError, integer, keys, number, vector
 from .json_file import read_json
 

@@ -14,9 +14,9 @@ import sys
 
 import numpy as np
 
-from mechanics import exp_twist
+from mechanics import exp_twist, transform_points
 
-from ..model.bodies import pusher_frame_body, pusher_polygon, transform_points
+from ..model.bodies import pusher_frame_body, pusher_polygon
 from ..model.plan_file import Plan, Transit
 from ..model.scene import Scene, load_scene
 from ..queries.session import plan

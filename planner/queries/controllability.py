@@ -19,8 +19,7 @@ from itertools import combinations
 
 import numpy as np
 
-from mechanics import Controllability
-from mechanics import controllability as twist_controllability
+from mechanics import Controllability, controllability as twist_controllability
 
 from ..model.fields import SceneError
 from ..actions.controls import edge_controls

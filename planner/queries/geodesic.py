@@ -50,7 +50,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from ..model.bodies import transform_points
+from mechanics import transform_points
 from ..model.scene import Scene
 from ..world.free_space import ROUNDING_SHRINK, cover, disk_free_space
 

@@ -43,7 +43,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from ..model.bodies import transform_points
+from mechanics import transform_points
 from .one_step import goal_verdicts
 from ..model.plan_file import Plan
 from ..actions.controls import clearance_margin, controls_or_reason

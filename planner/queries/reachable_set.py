@@ -223,7 +223,7 @@ def write_png(reach: ReachableSet, scene: Scene, path: str) -> None:
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
-    from ..model.bodies import transform_points
+    from mechanics import transform_points
 
     xmin, ymin, xmax, ymax = reach.extent
     fig, ax = plt.subplots(figsize=(6, 6 * (ymax - ymin) / (xmax - xmin)), dpi=110)

@@ -48,7 +48,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import exp_twist, log_pose, wrap_angle
+from mechanics import exp_twist, log_pose, transform_points, wrap_angle
 
 from ..actions.controls import EdgeControls
 from ..actions.push import connect
@@ -156,9 +156,7 @@ class GoalRegion:
         return plain
 
     def _cf_at(self, poses: np.ndarray) -> np.ndarray:
-        c, s = np.cos(poses[..., 2]), np.sin(poses[..., 2])
-        return np.stack([poses[..., 0] + c * self._cf[0] - s * self._cf[1],
-                         poses[..., 1] + s * self._cf[0] + c * self._cf[1]], axis=-1)
+        return transform_points(self._cf, poses)
 
     def within_reach(self, pose: ArrayLike, goals: Sequence[int]) -> list[int]:
         """Those of ``goals`` (indices) in the free-space piece of ``pose``'s CF: the others no

@@ -28,7 +28,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import wrap_angle
+from mechanics import transform_points, wrap_angle
 
 from ..model.bodies import body_outline, convex_pieces, pusher_frame_body, pusher_polygon
 from .free_space import SCREEN_SHRINK, disk_free_space
@@ -174,11 +174,7 @@ class CollisionModel:
         >>> CollisionModel(scene, [0]).surely_blocked([scene.start, [0.0, 0.0, 0.0]]).tolist()
         [False, True]
         """
-        q = np.asarray(poses, dtype=float)
-        c, s = np.cos(q[..., 2]), np.sin(q[..., 2])
-        x = q[..., 0] + c * self._cf[0] - s * self._cf[1]
-        y = q[..., 1] + s * self._cf[0] + c * self._cf[1]
-        return self.cf_blocked(np.stack([x, y], axis=-1))
+        return self.cf_blocked(transform_points(self._cf, poses))
 
     def cf_blocked(self, points: ArrayLike) -> np.ndarray:
         """:meth:`surely_blocked` of the poses whose CF is at each of ``points`` (shape
