@@ -210,3 +210,23 @@ def test_library_errors_name_no_flag():
                     if isinstance(text, ast.Constant) and isinstance(text.value, str) and flag.search(text.value):
                         found.append(f"{path.relative_to(ROOT)}:{node.lineno}: {text.value!r}")
     assert found == []
+
+
+def test_a_query_serves_the_next(parking):
+    """What one reachability query reached serves the next from the same start: its goals are
+    answered by their plans, its certificates stand, the second query goes on from there (from
+    where those plans end), and a plan it adds replays."""
+    goals = grid(parking, 6)
+    session = Planner(parking)
+    first = session.reachability(goals, seed=1, time_limit=0.2)
+    second = session.reachability(goals, seed=2, time_limit=0.2)
+    for a, b in zip(first, second):
+        if a.status == "reachable":
+            assert b.status == "reachable" and b.plan.to_dict()["segments"] == a.plan.to_dict()["segments"]
+        if a.status == "unreachable":
+            assert (b.status, b.reason) == ("unreachable", a.reason)
+    assert sum(a.status == "reachable" for a in second) >= sum(a.status == "reachable" for a in first)
+    new = [b for a, b in zip(first, second) if a.status != "reachable" and b.status == "reachable"]
+    spec = yaml.safe_load(PARKING.read_text())
+    for answer in sorted(new, key=lambda a: a.plan.length)[:1]:
+        replay_plan(spec, answer.plan.to_dict(), answer.goal)

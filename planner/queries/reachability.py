@@ -35,6 +35,7 @@ A start within tolerance of the goal is reachable by no push at all, and no cert
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING
@@ -45,7 +46,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import transform_points
 from .one_step import goal_verdicts
-from ..model.plan_file import Plan
+from ..model.plan_file import Plan, Push, Transit
 from ..actions.controls import clearance_margin, controls_or_reason
 from ..model.fields import poses
 from ..model.scene import Scene
@@ -165,7 +166,8 @@ def _no_stable_push_reason(why: str | None) -> str | None:
 
 
 def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | None], goals: np.ndarray,
-            pushes: int | None = None, timings: dict[str, float] | None = None) -> list[Reach]:
+            pushes: int | None = None, timings: dict[str, float] | None = None,
+            known: Mapping[tuple[float, ...], list[Push | Transit]] | None = None) -> list[Reach]:
     """One :class:`Reach` per goal (rows ``(x, y, theta)``, radians) from ``scene.start`` (the
     context's), given each goal's certificate (``reasons``, None where none fired).
 
@@ -175,7 +177,7 @@ def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | N
     are as found, not shortened: they reach their goals and verify, and
     :meth:`planner.Planner.plan` gives a short one. ``pushes`` is a budget: a plan with more
     pushes is answered ``'unknown'``. Without a ``context`` (no edge has a stable push) every
-    open goal is the start, reached by no push at all. ``timings`` as
+    open goal is the start, reached by no push at all. ``timings`` and ``known`` as
     :func:`~planner.search.planning.solve_many`'s.
     """
     open_goals = [i for i, reason in enumerate(reasons) if reason is None]
@@ -184,7 +186,8 @@ def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | N
         plans = {i: Plan(scene=scene.path, solved=True, planner=scene.planner.name, seed=scene.planner.seed,
                          planning_time_s=0.0, start=scene.start.copy(), goal=goals[i].copy()) for i in open_goals}
     elif open_goals:
-        plans = dict(zip(open_goals, solve_many(context, goals[open_goals], shorten=False, timings=timings)))
+        plans = dict(zip(open_goals, solve_many(context, goals[open_goals], shorten=False, timings=timings,
+                                                          known=known)))
     out = []
     for i, goal in enumerate(goals):
         found = plans.get(i)

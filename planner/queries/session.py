@@ -50,7 +50,8 @@ from ..world.validity import CollisionModel
 from .reachability import Certificates, Reach, answers
 from .reachable_set import ReachableSet, reachable_set
 
-__all__ = ["JOINED_PLANS", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_PLANS", "plan", "reachability"]
+__all__ = ["JOINED_PLANS", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
+           "reachability"]
 
 #: Without a time limit, :meth:`Planner.reachability` grows its search for this long plus this
 #: much per goal left open by the certificates (at most the options' time limit): on the shipped
@@ -60,6 +61,9 @@ REACH_BASE_S, REACH_PER_GOAL_S = 0.5, 0.01
 #: Plans a session keeps for re-planning (the most recent), and how many of the latest for a goal
 #: a new start is joined to.
 REMEMBERED_PLANS, JOINED_PLANS = 16, 2
+#: Goals reached by reachability queries whose plans a session keeps (the most recent), for the
+#: queries after them.
+REMEMBERED_GOALS = 20_000
 #: Poses along a remembered plan that a new start may be joined to: each push's start and these
 #: fractions of it.
 _ALONG = (0.0, 0.25, 0.5, 0.75)
@@ -118,6 +122,7 @@ class Planner:
         except RegionTimeout as timeout:
             self._timeout = str(timeout)
         self._plans: OrderedDict[tuple[float, ...], list[Plan]] = OrderedDict()
+        self._reached: OrderedDict[tuple[float, ...], OrderedDict[tuple[float, ...], list[Push | Transit]]] = OrderedDict()
         #: Seconds the last :meth:`reachability` spent on the certificates, the direct connections
         #: and the tree's growth.
         self.timings: dict[str, float] = {}
@@ -224,7 +229,7 @@ class Planner:
 
     def reachability(self, goals: ArrayLike | None = None, *, start: ArrayLike | None = None,
                      pushes: int | None = None, time_limit: float | None = None,
-                     seed: int | None = None) -> list[Reach]:
+                     seed: int | None = None, reuse: bool = True) -> list[Reach]:
         """One :class:`~planner.queries.reachability.Reach` per goal (rows ``(x, y, theta)``,
         radians; default: the scene's goal) from ``start`` (default: the scene's).
 
@@ -234,7 +239,10 @@ class Planner:
         :data:`REACH_PER_GOAL_S` per open goal, at most the options' time limit), seeded by
         ``seed``. Every ``'reachable'`` answer carries a plan (as found, not shortened), every
         ``'unreachable'`` a certificate; ``pushes`` is a budget of pushes beyond which a plan is
-        answered ``'unknown'``.
+        answered ``'unknown'``. With ``reuse``, what earlier queries from the same start reached
+        serves this one: a goal reached before is answered by its plan, and goals are also reached
+        from where plans to goals near them end (the session keeps :data:`REMEMBERED_GOALS` of
+        them); the answers then depend on the queries before, as a map drawn goal by goal grows.
 
         Raises
         ------
@@ -260,7 +268,18 @@ class Planner:
                                                                                    scene, g)
                     for g, r in zip(rows, reasons)]
         context = None if self.world is None else PlanningContext(self.world, request, start, clock)
-        return answers(scene, context, reasons, rows, pushes, self.timings)
+        reached = self._reached.setdefault(tuple(start.tolist()), OrderedDict()) if reuse else None
+        found = answers(scene, context, reasons, rows, pushes, self.timings, reached)
+        if reached is not None:
+            for answer in found:
+                if answer.plan is not None and answer.plan.solved and answer.plan.segments:
+                    reached[tuple(answer.goal.tolist())] = answer.plan.segments
+            while sum(map(len, self._reached.values())) > REMEMBERED_GOALS:
+                oldest = next(iter(self._reached.values()))
+                oldest.popitem(last=False)
+                if not oldest:
+                    self._reached.pop(next(iter(self._reached)))
+        return found
 
     def certify_unreachable(self, goal: ArrayLike | None = None, *, start: ArrayLike | None = None) -> str | None:
         """Why ``goal`` (default: the scene's) is certainly unreachable from ``start`` (default:

@@ -19,7 +19,8 @@ time, so a seed still gives one plan), and its plan wins if it costs no more.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Container, Iterator
+from collections import deque
+from collections.abc import Callable, Container, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
 from ompl import base as ob
@@ -60,6 +61,8 @@ _ROUND_SEEDS = 1_000_003
 #: A goal reached is the start of pushes to the goals nearest it not reached yet: this many, within
 #: this many part radii (:class:`_Hops`).
 HOP_GOALS, HOP_REACH = 6, 4.0
+#: Plans found before (:func:`solve_many`'s ``known``) that goals are reached from, at most.
+HOP_SOURCES = 256
 #: A tree grown towards many goals tests each new state against this many goals nearest it, within
 #: this many part radii (:attr:`~planner.search.goal.PushGoal.nearest`).
 GROW_GOALS, GROW_REACH = 8, 16.0
@@ -123,7 +126,8 @@ def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
 
 
 def solve_many(context: PlanningContext, goals: np.ndarray, shorten: bool = True,
-               timings: dict[str, float] | None = None) -> list[Plan]:
+               timings: dict[str, float] | None = None,
+               known: Mapping[tuple[float, ...], list[Push | Transit]] | None = None) -> list[Plan]:
     """One :class:`Plan` per goal (rows ``(x, y, theta)``, radians) from ``context.start``, grown
     as one search tree.
 
@@ -135,7 +139,9 @@ def solve_many(context: PlanningContext, goals: np.ndarray, shorten: bool = True
     reaches its goal and verifies), but a plan with switches gets no second, one-edge search: a
     batch answers where the part can go, :func:`solve` also what it costs. ``timings``, if
     given, gets the seconds spent on the direct connections (``'connections'``) and on the tree
-    (``'growth'``).
+    (``'growth'``). ``known`` maps goals (as tuples) to plans from the start found before: a goal
+    among them is answered by its plan, and goals are also reached from where those near them end,
+    as from the goals reached here.
     """
     clock = time.perf_counter()
     found: dict[int, list[Push | Transit]] = {}  # segments, as found
@@ -150,12 +156,15 @@ def solve_many(context: PlanningContext, goals: np.ndarray, shorten: bool = True
         found[i] = segments
         timed[i] = context.result(goals[i], context.shortcut(segments) if shorten and segments else segments)
 
+    known = known or {}
     for i, goal in enumerate(goals):
         if context.scene.within_tolerance(context.start, goal):
             take(i, [])
+        elif (before := known.get(tuple(goal.tolist()))) is not None:
+            take(i, before)
     for i, direct in context.direct_many(region, [i for i in range(len(goals)) if i not in timed], False).items():
         take(i, direct)
-    for i, segments in hops.spread(list(found)):
+    for i, segments in hops.spread([*hops.near_open(known.values()), *found.values()]):
         take(i, segments)
     grown = time.perf_counter()
     rest = [i for i in range(len(goals)) if i not in timed]
@@ -163,7 +172,7 @@ def solve_many(context: PlanningContext, goals: np.ndarray, shorten: bool = True
         search = _Search(context).grow(region, rest, timed)
         for i, segments in search:
             take(i, segments)
-            for j, hopped in hops.spread([i] if segments is not None else []):
+            for j, hopped in hops.spread([segments] if segments is not None else []):
                 take(j, hopped)
     if timings is not None:
         timings.update(connections=grown - clock, growth=time.perf_counter() - grown)
@@ -183,12 +192,24 @@ class _Hops:
         self._index = {c.edge: k for k, c in enumerate(context.controls)}
         self._reach = HOP_REACH * context.scene.slider.radius
 
-    def spread(self, sources: list[int]) -> Iterator[tuple[int, list[Push | Transit]]]:
-        """Each goal reached, breadth first, from the goals ``sources`` (reached already) and from
-        those reached so, with its segments; until none is left or the deadline."""
-        queue, xy = list(sources), self.region.goals[:, :2]
+    def near_open(self, plans: Iterable[list[Push | Transit]]) -> list[list[Push | Transit]]:
+        """Those of ``plans`` (each ending with a push) that end within hopping reach of a goal not
+        reached yet, nearest first (:data:`HOP_SOURCES` at most)."""
+        plans = [p for p in plans if p]
+        rest = [g for g in range(len(self.region.goals)) if g not in self.found]
+        if not plans or not rest:
+            return []
+        ends = np.array([p[-1].end[:2] for p in plans])
+        nearest = np.linalg.norm(ends[:, None, :] - self.region.goals[rest][None, :, :2], axis=-1).min(axis=1)
+        order = [i for i in np.argsort(nearest, kind="stable")[:HOP_SOURCES] if nearest[i] <= self._reach]
+        return [plans[i] for i in order]
+
+    def spread(self, sources: Sequence[list[Push | Transit]]) -> Iterator[tuple[int, list[Push | Transit]]]:
+        """Each goal reached, breadth first, from where the plans ``sources`` end and from the
+        goals reached so, with its segments; until none is left or the deadline."""
+        queue, xy = deque(sources), self.region.goals[:, :2]
         while queue and time.perf_counter() < self.context.deadline:
-            segments = self.found[queue.pop(0)]
+            segments = queue.popleft()
             pose = segments[-1].end if segments else self.context.start
             rest = np.array([g for g in range(len(xy)) if g not in self.found], dtype=int)
             if rest.size == 0:
@@ -199,7 +220,7 @@ class _Hops:
             for k in [self._index[segments[-1].edge]] if segments else self.context.starts:
                 for g, more in self.region.pushes_to(pose, k, [g for g in near if g not in self.found]).items():
                     self.found[g] = rechain(segments + more)
-                    queue.append(g)
+                    queue.append(self.found[g])
                     yield g, self.found[g]
 
 
