@@ -33,6 +33,8 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from .execution.fit import fit_plan
+    from .execution.mujoco_sim import Simulation, simulate
+    from .execution.trajectory import Trajectory, trajectory
     from .execution.verify import Verification, verify
     from .model.fields import SceneError
     from .model.options import DEFAULT_PLANNER, PlannerOptions
@@ -41,11 +43,13 @@ if TYPE_CHECKING:
     from .queries.controllability import SceneControllability, controllability
     from .queries.one_step import OneStep, one_step
     from .queries.reachability import Reach, certify_unreachable
+    from .queries.reachable_set import ReachableSet, reachable_set
     from .queries.session import Planner, plan, reachability
 
 __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Planner", "PlannerOptions", "Reach", "Scene", "SceneError", "Push", "Transit",
            "certify_unreachable", "load_plan", "load_scene", "one_step", "parse_scene", "plan", "reachability",
-           "Verification", "verify", "fit_plan", "SceneControllability", "controllability"]
+           "Verification", "verify", "fit_plan", "SceneControllability", "controllability", "ReachableSet",
+           "reachable_set", "Trajectory", "trajectory", "Simulation", "simulate"]
 
 #: Every public name is imported on first use, from its module: ``import planner`` itself loads
 #: nothing (the ``plan`` command sets up the process before numpy is loaded, planner.cli), and the
@@ -61,6 +65,9 @@ _ON_FIRST_USE = {
     "reachability": ".queries.session", "plan": ".queries.session",
     "SceneControllability": ".queries.controllability", "controllability": ".queries.controllability",
     "Verification": ".execution.verify", "verify": ".execution.verify", "fit_plan": ".execution.fit",
+    "ReachableSet": ".queries.reachable_set", "reachable_set": ".queries.reachable_set",
+    "Trajectory": ".execution.trajectory", "trajectory": ".execution.trajectory",
+    "Simulation": ".execution.mujoco_sim", "simulate": ".execution.mujoco_sim",
 }
 
 
