@@ -65,7 +65,7 @@ def signals_deferred() -> Iterator[list[int]]:
         yield noted
         return
     previous = {s: signal.signal(s, lambda signum, frame: noted.append(signum))
-                for s in (signal.SIGINT, signal.SIGTERM)}
+                for s in (signal.SIGINT, signal.SIGTERM) if signal.getsignal(s) is not signal.SIG_IGN}
     try:
         yield noted
     finally:
