@@ -10,6 +10,7 @@ the way (:mod:`planner.actions.transit`). Angles are radians.
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, ClassVar, Literal
@@ -22,7 +23,8 @@ from mechanics import exp_twist, point_velocity, relative_pose, transform_points
 from .fields import SceneError, integer, keys, number, vector
 from .json_file import read_json
 
-__all__ = ["FORMAT", "MAX_BYTES", "TRANSIT_MODES", "Push", "Transit", "Plan", "append_push", "load_plan", "rechain"]
+__all__ = ["FORMAT", "MAX_BYTES", "TRANSIT_MODES", "Push", "Transit", "Plan", "append_push", "load_plan", "path_cost",
+           "path_length", "rechain"]
 
 FORMAT = "stablepush.plan/1"
 #: Largest plan file read: a plan of ten thousand segments with their transits' paths.
@@ -208,6 +210,18 @@ def append_push(segments: list, push: Push) -> None:
         segments.append(push)
 
 
+def path_length(segments: Sequence[Push | Transit], cf: ArrayLike) -> float:
+    """Length of the path of the centre of friction ``cf`` (slider frame) along ``segments``."""
+    return sum(s.cf_path_length(np.asarray(cf, dtype=float)) for s in segments)
+
+
+def path_cost(segments: Sequence[Push | Transit], cf: ArrayLike, switch_cost: float) -> float:
+    """What the planner minimises (Lynch & Mason 1996, §4: a cost per contact change): the centre
+    of friction's path length plus ``switch_cost`` per switch (transit). The one definition: a
+    plan's :attr:`Plan.cost`, the search's and the benchmarks' all come from it."""
+    return path_length(segments, cf) + switch_cost * sum(s.kind == "transit" for s in segments)
+
+
 def rechain(segments: list, start: ArrayLike | None = None) -> list:
     """Each segment re-anchored where the one before it ends, the first at ``start`` (default:
     where it begins): a push begun there, a transit's path moved rigidly with the part. Pieces
@@ -276,7 +290,7 @@ class Plan:
 
     def path_length(self, cf: np.ndarray) -> float:
         """Length of the path of the centre of friction ``cf`` (slider frame)."""
-        return sum(s.cf_path_length(cf) for s in self.segments)
+        return path_length(self.segments, cf)
 
     @property
     def length(self) -> float | None:
@@ -295,8 +309,7 @@ class Plan:
         >>> plan.length, plan.cost
         (0.5, 0.75)
         """
-        length = self.length
-        return None if length is None or self.switch_cost is None else length + self.switch_cost * self.switches
+        return None if self.cf is None or self.switch_cost is None else path_cost(self.segments, self.cf, self.switch_cost)
 
     def to_dict(self) -> dict:
         return {

@@ -21,7 +21,7 @@ from ..actions.switch_pose import Grid, SwitchShortcut
 from ..actions.transit import TransitPlanner
 from ..model.fields import SceneError
 from ..model.options import PlannerOptions, check_optimize, check_planner, check_seed, check_time_limit
-from ..model.plan_file import Plan, Push, Transit
+from ..model.plan_file import Plan, Push, Transit, path_cost, path_length
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 from .goal_region import GoalRegion
@@ -71,12 +71,12 @@ class PlanRequest:
 
 def length(scene: Scene, segments: list[Push | Transit]) -> float:
     """Length of the centre of friction's path."""
-    return sum(s.cf_path_length(scene.slider.cf) for s in segments)
+    return path_length(segments, scene.slider.cf)
 
 
 def cost(scene: Scene, segments: list[Push | Transit]) -> float:
     """Length of the centre of friction's path plus the switch cost per switch."""
-    return length(scene, segments) + scene.planner.switch_cost * sum(s.kind == "transit" for s in segments)
+    return path_cost(segments, scene.slider.cf, scene.planner.switch_cost)
 
 
 class SearchWorld:
