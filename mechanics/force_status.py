@@ -43,7 +43,7 @@ from .cones import Cone
 from .support import SupportModel, unit_loads
 from .twist import cor_to_twist
 
-__all__ = ["Verdict", "force_possible", "force_status", "force_status_regions", "ray_twist"]
+__all__ = ["Verdict", "force_possible", "force_status", "force_status_regions", "possible_or_not", "ray_twist"]
 
 
 @dataclass(frozen=True)
@@ -204,18 +204,41 @@ def force_possible(twists: ArrayLike, cone: Cone, support: SupportModel, refinem
     >>> force_possible(twists, cone, SupportModel.of_slider(block, "footprint")).tolist()
     [True, True, False, True, False]
     """
+    return possible_or_not(twists, cone, support, refinements)[0]
+
+
+def possible_or_not(twists: ArrayLike, cone: Cone, support: SupportModel,
+                    refinements: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """``(proven, disproven)`` for each of ``twists`` (shape ``(..., 3)``): P proven (as
+    :func:`force_possible`), or P disproven by a sample distribution whose load leaves ``cone`` (a
+    real distribution, so the twist is certainly not P). Neither: open at the finest level tried.
+
+    The refinements go only to the twists still open, so a batch whose twists lie far from the
+    boundary of the P set costs one level.
+
+    >>> from mechanics import ContactConfiguration, Slider, contact_wrench_cone, cor_to_twist
+    >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+    >>> cone = contact_wrench_cone(ContactConfiguration.slider_edge(block, 0, 0.5), "ss")
+    >>> proven, disproven = possible_or_not(cor_to_twist([[-3, 0.5], [-3, 0.5]], [1, -1]), cone,
+    ...                                     SupportModel.of_slider(block, "footprint"))
+    >>> proven.tolist(), disproven.tolist()
+    ([True, False], [False, True])
+    """
     v = np.asarray(twists, dtype=float)
     flat = v.reshape(-1, 3)
     known = [_without_samples(twist, cone, support) for twist in flat]
-    out = np.array([verdict is not None and verdict.status == "P" for verdict in known], dtype=bool)
+    proven = np.array([verdict is not None and verdict.status == "P" for verdict in known], dtype=bool)
+    disproven = np.array([verdict is not None and verdict.status != "P" and "P" not in verdict.consistent
+                          for verdict in known], dtype=bool)
     open_ = np.array([k for k, verdict in enumerate(known) if verdict is None], dtype=int)
     for level in range(refinements + 1):
         if len(open_) == 0:
             break
         certified, refuted = _sticking(flat[open_], cone, support, level)
-        out[open_[certified]] = True
+        proven[open_[certified]] = True
+        disproven[open_[refuted]] = True
         open_ = open_[~certified & ~refuted]
-    return out.reshape(v.shape[:-1])
+    return proven.reshape(v.shape[:-1]), disproven.reshape(v.shape[:-1])
 
 
 def ray_twist(cf: ArrayLike, angle: float, tau: ArrayLike, sense: int, scale: float) -> np.ndarray:
