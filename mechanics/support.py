@@ -153,11 +153,13 @@ class SupportCells:
         """Cells from convex vertex rings; ``inside(points)`` says which nodes are samples."""
         ring = np.concatenate(polygons)
         nodes, index = np.unique(np.round(ring, 12), axis=0, return_inverse=True)
-        size = max(len(p) for p in polygons)
-        start = np.cumsum([0] + [len(p) for p in polygons[:-1]])
+        index = index.ravel()
+        counts = np.array([len(p) for p in polygons])
+        start = np.cumsum(counts) - counts
         # Pad each cell with its first vertex: repeats do not change a maximum over vertices.
-        cells = np.array([np.r_[index[s:s + len(p)], np.full(size - len(p), index[s])] for s, p in zip(start, polygons)])
-        anchors = np.array([p.mean(axis=0) for p in polygons])
+        column = np.arange(counts.max())
+        cells = index[start[:, None] + np.where(column[None] < counts[:, None], column[None], 0)]
+        anchors = np.add.reduceat(ring, start, axis=0) / counts[:, None]
         reach = np.linalg.norm(nodes[cells] - anchors[:, None], axis=2).max(axis=1)
         return cls(nodes[inside(nodes)], nodes, cells, anchors, reach)
 
@@ -217,9 +219,16 @@ def _footprint_cells(polygon: shapely.Polygon, cf: np.ndarray, h: float) -> list
     j = np.arange(np.floor((y0 - cf[1]) / h), np.ceil((y1 - cf[1]) / h))
     ii, jj = (a.ravel() for a in np.meshgrid(i, j))
     boxes = shapely.box(cf[0] + ii * h, cf[1] + jj * h, cf[0] + (ii + 1) * h, cf[1] + (jj + 1) * h)
-    pieces = shapely.convex_hull(shapely.intersection(boxes, polygon))
+    shapely.prepare(polygon)
+    inside = shapely.contains_properly(polygon, boxes)  # whole squares: nothing to clip
+    edge = ~inside & shapely.intersects(polygon, boxes)
+    pieces = boxes.copy()
+    pieces[edge] = shapely.convex_hull(shapely.intersection(boxes[edge], polygon))
+    pieces = pieces[inside | edge]
     pieces = pieces[shapely.area(pieces) > 1e-12 * h * h]
-    return [np.asarray(p.exterior.coords)[:-1] for p in pieces]
+    coords, which = shapely.get_coordinates(shapely.get_exterior_ring(pieces), return_index=True)
+    rings = np.split(coords, np.flatnonzero(np.diff(which)) + 1)
+    return [ring[:-1] for ring in rings]
 
 
 class SupportModel:
