@@ -357,7 +357,7 @@ def exact_region(
         return base, np.minimum(_REACH * size, strip) * (1 - 1e-9), strip
 
     def bracket(e: np.ndarray, base: np.ndarray, cap: np.ndarray, reach: np.ndarray,
-                near: np.ndarray) -> tuple[np.ndarray, ...]:
+                near: np.ndarray | bool) -> tuple[np.ndarray, ...]:
         """Each ray's bracket from the points ``reach`` (``k, j``, increasing) along it, certified
         in one batch: ``(lo, hi, margin at lo, margin at hi, nearest proven unstable)``, ``lo`` the
         last certified point before the first that is not (one crossing per ray is assumed)."""
