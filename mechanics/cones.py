@@ -194,7 +194,7 @@ class Cone:
             return np.ones(len(self.rows), dtype=bool)
         return np.all(np.abs(self.rows @ self.generators.T) <= 1e-9, axis=1)
 
-    @property
+    @cached_property
     def dimension(self) -> int:
         """Dimension of the cone's span: 0 (zero cone) to 3."""
         return 0 if len(self.generators) == 0 else int(np.linalg.matrix_rank(self.generators, tol=1e-9))

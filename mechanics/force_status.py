@@ -43,7 +43,7 @@ from .cones import Cone
 from .support import SupportModel, unit_loads
 from .twist import cor_to_twist
 
-__all__ = ["Verdict", "force_possible", "force_status", "force_status_regions", "ray_twist"]
+__all__ = ["Verdict", "force_possible", "force_status", "force_status_regions", "possible_or_not", "ray_twist"]
 
 
 @dataclass(frozen=True)
@@ -72,24 +72,28 @@ def _tolerance(support: SupportModel) -> float:
     return 1e-9 * (1.0 + float(np.linalg.norm(support.cf)) + support.radius)
 
 
-def _sticking(twists: np.ndarray, cone: Cone, support: SupportModel, level: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(certified, refuted)`` per rotation of ``twists`` (``K, 3``) with the samples of ``level``:
-    every row's support value certified ``<= 0`` (P proven), or some sample distribution's load
-    violating a row (P disproven)."""
+def _sticking(twists: np.ndarray, cone: Cone, support: SupportModel,
+              level: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(certified, refuted, margin)`` per rotation of ``twists`` (``K, 3``) with the samples of
+    ``level``: every row's support value certified ``<= 0`` (P proven), or some sample
+    distribution's load violating a row (P disproven); ``margin`` is the largest row's certified
+    bound (the largest sample value where refuted): ``<= 0`` exactly where certified."""
     batch = support.batch(twists, level)
     values, lams = batch.sample_support(-cone.rows)
-    refuted = np.any(values > _tolerance(support), axis=1)
+    margin = values.max(axis=1)
+    refuted = margin > _tolerance(support)
     certified = np.zeros(len(twists), dtype=bool)
     if not refuted.all():  # bounding the cells costs more than the LPs: only where it can help
         rest = support.batch(twists[~refuted], level)
-        certified[~refuted] = np.all(rest.upper_bound(-cone.rows, lams[~refuted]) <= 0, axis=1)
-    return certified, refuted
+        margin[~refuted] = rest.upper_bound(-cone.rows, lams[~refuted]).max(axis=1)
+        certified[~refuted] = margin[~refuted] <= 0
+    return certified, refuted, margin
 
 
 def _statuses_at(twists: np.ndarray, cone: Cone, support: SupportModel, level: int) -> list[set[str]]:
     """The statuses not ruled out for each rotation of ``twists`` (``K, 3``) with the samples of
     ``level``: the P proofs in one batch, then the I proofs of the others in another."""
-    certified, refuted = _sticking(twists, cone, support, level)
+    certified, refuted, _ = _sticking(twists, cone, support, level)
     tol = _tolerance(support)
     value = np.full(len(twists), np.nan)
     impossible = np.zeros(len(twists), dtype=bool)
@@ -204,18 +208,47 @@ def force_possible(twists: ArrayLike, cone: Cone, support: SupportModel, refinem
     >>> force_possible(twists, cone, SupportModel.of_slider(block, "footprint")).tolist()
     [True, True, False, True, False]
     """
+    return possible_or_not(twists, cone, support, refinements)[0]
+
+
+def possible_or_not(twists: ArrayLike, cone: Cone, support: SupportModel, refinements: int = 1,
+                    start: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(proven, disproven, margin)`` for each of ``twists`` (shape ``(..., 3)``): P proven (as
+    :func:`force_possible`), or P disproven by a sample distribution whose load leaves ``cone`` (a
+    real distribution, so the twist is certainly not P); neither: open at the finest level tried.
+    ``margin`` is the certificate's largest row bound at the last level tried (``<= 0`` exactly
+    where proven; NaN for a twist settled without samples, a translation): a continuous measure
+    of how far a twist is from being certified, for root finding.
+
+    The levels run from ``start`` to ``refinements``, each only for the twists still open, so a
+    batch whose twists lie far from the boundary of the P set costs one level (``start``
+    skips levels known to leave twists near that boundary open).
+
+    >>> from mechanics import ContactConfiguration, Slider, contact_wrench_cone, cor_to_twist
+    >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+    >>> cone = contact_wrench_cone(ContactConfiguration.slider_edge(block, 0, 0.5), "ss")
+    >>> proven, disproven, margin = possible_or_not(cor_to_twist([[-3, 0.5], [-3, 0.5]], [1, -1]), cone,
+    ...                                             SupportModel.of_slider(block, "footprint"))
+    >>> proven.tolist(), disproven.tolist(), bool(margin[0] <= 0 < margin[1])
+    ([True, False], [False, True], True)
+    """
     v = np.asarray(twists, dtype=float)
     flat = v.reshape(-1, 3)
     known = [_without_samples(twist, cone, support) for twist in flat]
-    out = np.array([verdict is not None and verdict.status == "P" for verdict in known], dtype=bool)
+    proven = np.array([verdict is not None and verdict.status == "P" for verdict in known], dtype=bool)
+    disproven = np.array([verdict is not None and verdict.status != "P" and "P" not in verdict.consistent
+                          for verdict in known], dtype=bool)
+    margin = np.full(len(flat), np.nan)
     open_ = np.array([k for k, verdict in enumerate(known) if verdict is None], dtype=int)
-    for level in range(refinements + 1):
+    for level in range(min(start, refinements), refinements + 1):
         if len(open_) == 0:
             break
-        certified, refuted = _sticking(flat[open_], cone, support, level)
-        out[open_[certified]] = True
+        certified, refuted, margin[open_] = _sticking(flat[open_], cone, support, level)
+        proven[open_[certified]] = True
+        disproven[open_[refuted]] = True
         open_ = open_[~certified & ~refuted]
-    return out.reshape(v.shape[:-1])
+    shape = v.shape[:-1]
+    return proven.reshape(shape), disproven.reshape(shape), margin.reshape(shape)
 
 
 def ray_twist(cf: ArrayLike, angle: float, tau: ArrayLike, sense: int, scale: float) -> np.ndarray:

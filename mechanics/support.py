@@ -153,11 +153,13 @@ class SupportCells:
         """Cells from convex vertex rings; ``inside(points)`` says which nodes are samples."""
         ring = np.concatenate(polygons)
         nodes, index = np.unique(np.round(ring, 12), axis=0, return_inverse=True)
-        size = max(len(p) for p in polygons)
-        start = np.cumsum([0] + [len(p) for p in polygons[:-1]])
+        index = index.ravel()
+        counts = np.array([len(p) for p in polygons])
+        start = np.cumsum(counts) - counts
         # Pad each cell with its first vertex: repeats do not change a maximum over vertices.
-        cells = np.array([np.r_[index[s:s + len(p)], np.full(size - len(p), index[s])] for s, p in zip(start, polygons)])
-        anchors = np.array([p.mean(axis=0) for p in polygons])
+        column = np.arange(counts.max())
+        cells = index[start[:, None] + np.where(column[None] < counts[:, None], column[None], 0)]
+        anchors = np.add.reduceat(ring, start, axis=0) / counts[:, None]
         reach = np.linalg.norm(nodes[cells] - anchors[:, None], axis=2).max(axis=1)
         return cls(nodes[inside(nodes)], nodes, cells, anchors, reach)
 
@@ -217,9 +219,16 @@ def _footprint_cells(polygon: shapely.Polygon, cf: np.ndarray, h: float) -> list
     j = np.arange(np.floor((y0 - cf[1]) / h), np.ceil((y1 - cf[1]) / h))
     ii, jj = (a.ravel() for a in np.meshgrid(i, j))
     boxes = shapely.box(cf[0] + ii * h, cf[1] + jj * h, cf[0] + (ii + 1) * h, cf[1] + (jj + 1) * h)
-    pieces = shapely.convex_hull(shapely.intersection(boxes, polygon))
+    shapely.prepare(polygon)
+    inside = shapely.contains_properly(polygon, boxes)  # whole squares: nothing to clip
+    edge = ~inside & shapely.intersects(polygon, boxes)
+    pieces = boxes.copy()
+    pieces[edge] = shapely.convex_hull(shapely.intersection(boxes[edge], polygon))
+    pieces = pieces[inside | edge]
     pieces = pieces[shapely.area(pieces) > 1e-12 * h * h]
-    return [np.asarray(p.exterior.coords)[:-1] for p in pieces]
+    coords, which = shapely.get_coordinates(shapely.get_exterior_ring(pieces), return_index=True)
+    rings = np.split(coords, np.flatnonzero(np.diff(which)) + 1)
+    return [ring[:-1] for ring in rings]
 
 
 class SupportModel:
@@ -426,66 +435,85 @@ class LoadBatch:
         duals, _ = batched_simplex(costs.reshape(k * r, -1), columns, rhs, np.broadcast_to(start, (k * r, len(rhs))))
         return (duals @ rhs).reshape(k, r), (-duals[:, 1:3] / self.model.radius).reshape(k, r, 2)
 
-    @cached_property
-    def _cell_geometry(self) -> tuple[np.ndarray, ...]:
-        """Per twist and cell, seen from the COR ``c``: the cell's distance (0 if it holds ``c``),
-        the largest distance to a vertex, the angular range ``[lo, hi]`` of the directions from
-        ``c`` to its points, measured from the direction of its anchor (exact for a convex cell),
-        and that anchor direction; shapes ``(K, C)`` and ``(K, C, 2)``."""
+    def _cell_geometry(self, k: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, ...]:
+        """For twist ``k[p]`` and cell ``c[p]`` of each pair ``p``, seen from the COR: the cell's
+        distance (0 if it holds the COR), the largest distance to a vertex, the angular range
+        ``[lo, hi]`` of the directions from the COR to its points, measured from the direction of
+        its anchor (exact for a convex cell), and that anchor direction; shapes ``(P,)`` and ``(P, 2)``."""
         cells = self.cells
-        # Components apart, (K, cells, vertices) each: the vertices relative to c, and the edges.
-        corners = cells.nodes[cells.cells]
-        vx, vy = (corners[None, ..., i] - self.cor[:, None, None, i] for i in (0, 1))
-        ex, ey = np.roll(vx, -1, axis=2) - vx, np.roll(vy, -1, axis=2) - vy
+        # Components apart, (pairs, vertices) each: the vertices relative to the COR, and the edges.
+        corners = cells.nodes[cells.cells[c]]
+        cor = self.cor[k]
+        vx, vy = (corners[..., i] - cor[:, None, i] for i in (0, 1))
+        ex, ey = np.roll(vx, -1, axis=1) - vx, np.roll(vy, -1, axis=1) - vy
         length2 = ex * ex + ey * ey
         along = np.clip(np.divide(-(vx * ex + vy * ey), length2, out=np.zeros_like(length2), where=length2 > 0), 0, 1)
-        outside = np.hypot(vx + along * ex, vy + along * ey).min(axis=2)
-        turn = ex * -vy + ey * vx  # side of c for each edge
+        outside = np.hypot(vx + along * ex, vy + along * ey).min(axis=1)
+        turn = ex * -vy + ey * vx  # side of the COR for each edge
         eps = 1e-12 * self.model.radius**2
-        holds = np.all(turn >= -eps, axis=2) | np.all(turn <= eps, axis=2)
-        base = cells.anchors[None] - self.cor[:, None, :]
-        bx, by = base[..., :1], base[..., 1:]
+        holds = np.all(turn >= -eps, axis=1) | np.all(turn <= eps, axis=1)
+        base = cells.anchors[c] - cor
+        bx, by = base[:, :1], base[:, 1:]
         angle = np.arctan2(bx * vy - by * vx, bx * vx + by * vy)
-        return np.where(holds, 0.0, outside), np.hypot(vx, vy).max(axis=2), angle.min(axis=2), angle.max(axis=2), base
+        return np.where(holds, 0.0, outside), np.hypot(vx, vy).max(axis=1), angle.min(axis=1), angle.max(axis=1), base
 
     def cell_bounds(self, ys: ArrayLike, lams: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Upper bounds of ``psi(x) = y . g(x) + lam . (x - CF)`` per cell (``K, R, C``), which cells
         hold the COR ``c`` (``K, C``), and (for those) ``psi``'s envelope ``E`` at ``c`` and its slope
-        ``k`` away from it (``K, R``): ``psi <= E + k |x - c|``. A translation has no COR (``E = -inf``)."""
+        ``k`` away from it (``K, R``): ``psi <= E + k |x - c|``. A translation has no COR (``E = -inf``).
+
+        A cell's bound is tightened (its exact geometry seen from ``c``) only where it could be the
+        largest or decide a sign: a cell whose cheap bound (second order, with its distance from
+        ``c`` bounded below by its anchor's distance less its reach) lies below both the largest
+        vertex value and 0 keeps that bound, which changes neither the maximum nor any sign.
+        """
         ys, cells = self._directions(ys), self.cells
         lams = np.broadcast_to(np.asarray(lams, dtype=float), (*ys.shape[:2], 2))
         linear_nodes = np.einsum("nj,krj->krn", cells.nodes - self.cf, lams)
         psi = np.einsum("knj,krj->krn", unit_loads(self.twists[:, None, :], cells.nodes[None]), ys) + linear_nodes
         vertex_max = psi[..., cells.cells].max(axis=-1)
-        rotation = (self.sense != 0)[:, None, None]
+        rotation = self.sense != 0
         # psi = w . (x - c)/r + sense y_m r + lam . (x - CF), r = |x - c|, w = sense (u_y, -u_x).
         arm = self._arm(ys)
         sense = self.sense[:, None, None]
         w = sense * np.stack([arm[..., 1], -arm[..., 0]], axis=-1)
-        u = np.linalg.norm(w, axis=-1)[..., None]
-        radial = (self.sense[:, None] * ys[..., 2])[..., None]
-        dist, reach_c, lo, hi, base = (g[:, None] for g in self._cell_geometry)
-        away = dist > 0
+        u = np.linalg.norm(w, axis=-1)
+        radial = self.sense[:, None] * ys[..., 2]
+        # Second order: psi + M/2 |x - a|^2 is convex on a cell away from c when M bounds psi's
+        # Hessian from below: the Hessian of w . (x - c)/r is >= -1.5 |w| / r^2, that of
+        # sense y_m r is >= min(0, sense y_m) / r. So psi <= max over vertices + M/2 reach^2;
+        # M falls with the distance r, so a lower bound on it gives a valid (looser) bound.
+        near = np.maximum(np.linalg.norm(cells.anchors[None] - self.cor[:, None], axis=-1) - cells.reach[None], 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            # Second order: psi + M/2 |x - a|^2 is convex on a cell away from c when M bounds psi's
-            # Hessian from below: the Hessian of w . (x - c)/r is >= -1.5 |w| / r^2, that of
-            # sense y_m r is >= min(0, sense y_m) / r. So psi <= max over vertices + M/2 reach^2.
-            curvature = 1.5 * u / dist**2 + np.maximum(0.0, -radial) / dist
-            second = np.where(away, vertex_max + curvature / 2 * cells.reach**2, np.inf)
-        # First order, term by term: w . (x - c)/r over the cell's range of directions, the
-        # radial term at the nearest or farthest point, lam . x at a vertex.
-        phi = np.arctan2(base[..., 0] * w[..., 1:] - base[..., 1] * w[..., :1], base[..., 0] * w[..., :1]
-                         + base[..., 1] * w[..., 1:])
-        direction = np.where((lo <= phi) & (phi <= hi), u, u * np.maximum(np.cos(phi - lo), np.cos(phi - hi)))
-        linear = linear_nodes[..., cells.cells].max(axis=-1)
-        first = direction + radial * np.where(radial > 0, reach_c, dist) + linear
-        # A cell holding c: u . v^ <= |u| and lam . (x - c) <= |lam| r.
-        envelope = u[..., 0] + np.einsum("krj,kj->kr", lams, self.cor - self.cf)
-        slope = radial[..., 0] + np.linalg.norm(lams, axis=-1)
-        first = np.where(away, first, envelope[..., None] + slope[..., None] * np.where(slope[..., None] > 0, reach_c, 0.0))
-        bounds = np.where(rotation, np.minimum(first, second), vertex_max)  # a translation's psi is affine
-        touching = ~away[:, 0] & rotation[:, 0]
-        return bounds, touching, np.where(rotation[..., 0], envelope, -np.inf), np.where(rotation[..., 0], slope, 0.0)
+            curvature = 1.5 * u[..., None] / near[:, None] ** 2 + np.maximum(0.0, -radial)[..., None] / near[:, None]
+            cheap = np.where(near[:, None] > 0, vertex_max + curvature / 2 * cells.reach**2, np.inf)
+        floor = np.minimum(vertex_max.max(axis=-1), 0.0)[..., None]
+        k, c = np.nonzero(rotation[:, None] & np.any(cheap >= floor, axis=1))
+        bounds = np.where(rotation[:, None, None], cheap, vertex_max)
+        envelope = u + np.einsum("krj,kj->kr", lams, self.cor - self.cf)
+        slope = radial + np.linalg.norm(lams, axis=-1)
+        touching = np.zeros(near.shape, dtype=bool)
+        if len(k):
+            dist, reach_c, lo, hi, base = self._cell_geometry(k, c)
+            dist_, reach_, lo_, hi_ = (g[:, None] for g in (dist, reach_c, lo, hi))
+            away = dist_ > 0
+            u_k, radial_k, w_k = u[k], radial[k], w[k]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                curvature = 1.5 * u_k / dist_**2 + np.maximum(0.0, -radial_k) / dist_
+                second = np.where(away, vertex_max[k, :, c] + curvature / 2 * cells.reach[c, None] ** 2, np.inf)
+            # First order, term by term: w . (x - c)/r over the cell's range of directions, the
+            # radial term at the nearest or farthest point, lam . x at a vertex.
+            bx, by = base[:, :1], base[:, 1:]
+            phi = np.arctan2(bx * w_k[..., 1] - by * w_k[..., 0], bx * w_k[..., 0] + by * w_k[..., 1])
+            direction = np.where((lo_ <= phi) & (phi <= hi_), u_k, u_k * np.maximum(np.cos(phi - lo_), np.cos(phi - hi_)))
+            linear = np.einsum("pvj,prj->prv", cells.nodes[cells.cells[c]] - self.cf, lams[k]).max(axis=-1)
+            first = direction + radial_k * np.where(radial_k > 0, reach_, dist_) + linear
+            # A cell holding c: u . v^ <= |u| and lam . (x - c) <= |lam| r.
+            slope_k = slope[k]
+            first = np.where(away, first, envelope[k] + slope_k * np.where(slope_k > 0, reach_, 0.0))
+            bounds[k, :, c] = np.minimum(first, second)
+            touching[k, c] = dist == 0
+        return bounds, touching, np.where(rotation[:, None], envelope, -np.inf), np.where(rotation[:, None], slope, 0.0)
 
     def upper_bound(self, ys: ArrayLike, lams: ArrayLike) -> np.ndarray:
         """Guaranteed upper bounds on ``y . L`` over *all* admissible distributions, shape ``(K, R)``.

@@ -290,3 +290,86 @@ def test_the_simulator_sticks_on_the_exact_regions_corners():
     outside = region.plane.twists(centre + 1.1 * (ring - centre))
     slips = [not all(solve_step(support, line, twist).sticks for support in supports) for twist in outside]
     assert np.mean(slips) >= 0.75, slips
+
+
+# -- completeness: the trace follows needles, hugs the certified boundary, bounds its gap ----------
+
+# A 2 x 1 block pushed by a 1.1-wide face with its CF (0.75, 0.25) beyond the contact's right end,
+# mu = 0.9: the only stable translations tilt far to one side, and the region is a thin needle.
+NEEDLE = dict(vertices=np.array(RECT, float), cf=np.array([0.75, 0.25]), edge=0, mu=0.9, width=1.1)
+
+
+def fine_oracle(g):
+    """The note's LP over explicit distributions on a 24 x 24 grid of the part and 96 points of its
+    boundary (where the extreme distributions that decide a thin region put their weight)."""
+    ref = O.Reference(g["vertices"], g["cf"], g["edge"], g["mu"], g["width"])
+    ring = shapely.Polygon(g["vertices"]).exterior
+    rim = shapely.get_coordinates(shapely.line_interpolate_point(ring, np.linspace(0, 1, 96, endpoint=False), normalized=True))
+    return O.LPOracle(ref, np.vstack([O.support_samples(g["vertices"], 24), rim]))
+
+
+def test_a_needle_is_traced_to_its_tip():
+    """Push-plane points along the needle's axis, from where an even trace of 48 rays with a 2 %
+    margin gave up (0.6 of the way from the centre, found by hand) to 0.95 of the way to the tip,
+    all stuck for every distribution of the independent LP: all are in the region. A point past
+    the tip is not (the LP finds a distribution that breaks sticking)."""
+    region = exact_region(Slider(NEEDLE["vertices"], cf=NEEDLE["cf"]), 0, NEEDLE["mu"], NEEDLE["width"])
+    centre, tip = np.array([0.81963, -0.04673]), np.array([0.45552, -0.81658])
+    along = region.plane.twists(centre + np.array([0.6, 0.8, 0.95, 1.1])[:, None] * (tip - centre))
+    lp = fine_oracle(NEEDLE)
+    violation = [lp.max_violation(v) for v in along]
+    assert max(violation[:3]) < 0 < violation[3], violation
+    assert region.contains(along).tolist() == [True, True, True, False]
+    assert theorem4_ok(along[:3], NEEDLE)
+
+
+@pytest.mark.parametrize("name", ["B", "L"])
+def test_just_inside_the_certified_boundary_is_stable_and_just_outside_is_not(name):
+    """At a dozen of the region's vertices beyond STABLE's region, the twist 1 % closer to the
+    centre is in the region and stuck for every distribution of the independent LP (its optimum is
+    an extreme, two- or three-point distribution); the twist 3 % farther out is outside the region,
+    and for most vertices the LP finds a distribution that breaks sticking there: the polygon hugs
+    the certified boundary, with no safety margin."""
+    g = PARTS[name]
+    region, stable = part(name)
+    polygon, centre = region.section()
+    ring = np.asarray(polygon.exterior.coords)[:-1]
+    beyond = ring[~stable.contains(region.plane.twists(ring))]
+    pick = beyond[np.linspace(0, len(beyond), 12, endpoint=False).astype(int)]
+    inside = region.plane.twists(centre + 0.99 * (pick - centre))
+    outside = region.plane.twists(centre + 1.03 * (pick - centre))
+    assert region.contains(inside).all() and not region.contains(outside).any()
+    lp = fine_oracle(g)
+    assert max(lp.max_violation(v) for v in inside) <= 1e-9
+    broken = [lp.max_violation(v) > 1e-9 or not theorem4_ok(v[None], g) for v in outside]
+    assert np.mean(broken) >= 0.75, broken
+
+
+@pytest.mark.parametrize("name", ["B", "L"])
+def test_the_gap_bound_holds_against_a_dense_brute_force_trace(name):
+    """64 even rays from the region's centre, each bisected 14 times with the certificate: every
+    point certified stable lies within the region's reported gap of its polygon (the gap bounds
+    how much certified stable set the adaptive trace leaves out), and the gap is small."""
+    from mechanics import ContactConfiguration, SupportModel, contact_wrench_cone, force_possible
+
+    g = PARTS[name]
+    slider = Slider(g["vertices"], cf=g["cf"])
+    region, _ = part(name)
+    polygon, centre = region.section()
+    assert 0 < region.gap < 0.5 * np.sqrt(polygon.area)
+    cone = contact_wrench_cone(ContactConfiguration.slider_edge(slider, g["edge"], g["mu"], g["width"]), "ss")
+    support = SupportModel.of_slider(slider, "footprint")
+    w_lo, w_hi = region.plane.theorem4_strip(g["vertices"])
+    angle = 2 * np.pi * np.arange(64) / 64
+    e = np.c_[np.cos(angle), np.sin(angle)]
+    with np.errstate(divide="ignore"):
+        far = np.where(e[:, 1] != 0, np.abs(np.where(e[:, 1] > 0, w_hi, w_lo) - centre[1]) / np.abs(e[:, 1]), np.inf)
+    lo, hi = np.zeros(64), np.minimum(far, 4 * np.sqrt(polygon.area)) * (1 - 1e-9)
+    for _ in range(14):
+        mid = (lo + hi) / 2
+        ok = force_possible(region.plane.twists(centre + mid[:, None] * e), cone, support, refinements=2)
+        lo, hi = np.where(ok, mid, lo), np.where(ok, hi, mid)
+    certified = centre + lo[:, None] * e
+    distance = shapely.distance(polygon, shapely.points(certified))
+    print(f"{name}: largest distance {distance.max():.4f}, gap {region.gap:.4f}, size {np.sqrt(polygon.area):.3f}")
+    assert distance.max() <= region.gap + 1e-9, (distance.max(), region.gap)

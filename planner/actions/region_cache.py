@@ -54,8 +54,9 @@ __all__ = ["MEMORY_SIZE", "RegionCache", "cache_folder", "cache_key", "compute_r
 
 #: Bump when the exact region's construction (or the recording's analysis) changes, so old cache
 #: files are not used. 3: the support LPs by a batched simplex (its duals can differ where the LP
-#: is degenerate).
-_VERSION = 3
+#: is degenerate). 4: the adaptive trace without a safety margin (larger regions), and the gap
+#: bound kept with each region.
+_VERSION = 4
 
 #: Items a :class:`RegionCache` keeps in memory unless told otherwise: every region and analysis
 #: of a 200-edged part twice over, a few megabytes. An item dropped is read again from its file.
@@ -179,11 +180,12 @@ def _region(data: object, stable: StableRegion, cf_radius: float) -> ExactRegion
     try:
         polygon = shapely.Polygon(np.asarray(data["polygon"], dtype=float))
         centre = np.asarray(data["centre"], dtype=float)
+        gap = float(data["gap"])
     except (ValueError, KeyError, TypeError):
         return None
-    if not polygon.is_valid or polygon.area <= 0 or centre.shape != (2,):
+    if not polygon.is_valid or polygon.area <= 0 or centre.shape != (2,) or gap < 0:
         return None
-    return ExactRegion(stable, polygon, centre, cf_radius)
+    return ExactRegion(stable, polygon, centre, cf_radius, gap)
 
 
 def is_cached(slider: Slider, edge: int, mu: float, width: float | None = None, method: str = "exact",
@@ -281,7 +283,8 @@ def _keep(cache: RegionCache, key: str, region: ExactRegion) -> None:
     cache.put(key, region)
     polygon, centre = region.section()
     if isinstance(polygon, shapely.Polygon) and polygon.area > 0:  # a degenerate one is cheap: not stored
-        cache.write("exact", key, {"polygon": np.asarray(polygon.exterior.coords).tolist(), "centre": centre.tolist()})
+        cache.write("exact", key, {"polygon": np.asarray(polygon.exterior.coords).tolist(), "centre": centre.tolist(),
+                                   "gap": region.gap})
 
 
 def compute_regions(slider: Slider, edges: Sequence[int], mu: float, width: float | None = None,
