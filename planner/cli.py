@@ -63,6 +63,7 @@ _LOADING = ({s: signal.signal(s, _stop_while_loading) for s in (signal.SIGINT, s
             if threading.current_thread() is threading.main_thread() else {})
 
 from .model.fields import SceneError, shown  # noqa: E402 (after the environment is set)
+from .model.extras import have, needs
 from .model.files import atomic_path, staged_folder, write_atomic
 from .model.plan_file import Plan, load_plan
 from .model.stop import Terminated, raise_on_sigterm
@@ -87,7 +88,8 @@ __all__ = ["Inputs", "main", "read_inputs"]
 _EPILOG = f"""\
 exit codes:
   0    solved (and verified, with --verify)
-  1    bad input, in the scene (a goal in an obstacle, say), in an option's value (--reach 3) or
+  1    bad input, in the scene (a goal in an obstacle, say), in an option's value (--reach 3),
+       an extra that an option needs and is not installed (--reach without matplotlib) or
        a --plan file that is not a plan for the scene (another start, goal, part, or through a
        wall): one line "plan: error: <field>: <problem>", nothing written
   2    not solved within the time limit, or the goal is certified unreachable (one line
@@ -217,6 +219,8 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     _check_simulation(args)
     if args.reach is not None and args.reach not in (1, 2):
         raise SceneError("--reach", f"must be 1 or 2 pushes, got {args.reach}")
+    if args.reach is not None and not have("matplotlib"):  # found before the work, not after it
+        raise SceneError("--reach", f"the map's PNG {needs('matplotlib')}")
     for flag, value in (("--engine", args.engine), ("--jobs", args.jobs), ("--address", args.address)):
         if value is not None and args.reach is None:
             raise SceneError(flag, "is for a batch (several scenes or --seeds) or a --reach map")

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from planner import load_scene
-from planner.batch import LocalExecutor, make_tasks, run_batch
+from planner.batch import BatchFailed, LocalExecutor, Outcome, make_tasks, run_batch
 from planner.batch.reach import reachable_set_on
 from planner.batch.results import COLUMNS, STATUSES
 from planner.cli import main
@@ -319,3 +319,31 @@ def test_ctrl_c_while_the_workers_start_is_one_line(tmp_path):
         _, stderr = run.communicate(timeout=60)
         assert run.returncode == 130 and "Traceback" not in stderr, stderr
         assert [line for line in stderr.splitlines() if not line.startswith("[")] == ["plan: interrupted"], stderr
+
+
+class _Failing:
+    """An executor whose every call fails, as when a worker cannot run the tasks at all."""
+
+    workers = 1
+
+    def run(self, fn, items, shared=None, **kwargs):
+        for index, _ in enumerate(items):
+            yield index, Outcome(error="OSError: no room left")
+
+    def close(self) -> None:
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        pass
+
+
+def test_a_batch_whose_every_task_fails_raises_and_the_command_exits_2(tmp_path, monkeypatch, capsys):
+    with pytest.raises(BatchFailed, match=r"every task of the batch failed \(2\); battery-s1: OSError: no room"):
+        run_batch(make_tasks([SCENES[0]], [1, 2]), tmp_path / "api", _Failing(), stream=open(os.devnull, "w"))
+    assert len((tmp_path / "api" / "results.jsonl").read_text().splitlines()) == 2  # recorded all the same
+    monkeypatch.setattr("planner.batch.command.executor", lambda *args: _Failing())
+    assert main([SCENES[0], "--seeds", "1:2", "--out", str(tmp_path / "cli")]) == 2
+    assert "2 tasks, 2 failed" in capsys.readouterr().out

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -59,3 +61,16 @@ def test_picture_of_a_plan(tmp_path):
     scene = load_scene(ROOT / "scenes" / "battery.yaml")
     draw_plan(scene, plan(scene, seed=1), str(tmp_path / "battery.png"))
     assert (tmp_path / "battery.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_batch_example_saved_as_a_script_without_a_guard_solves_every_task(tmp_path):
+    """The README's batch snippet as a user saves it: a script with no ``if __name__ ==
+    "__main__":`` guard. Its workers must not run it again (two seeds here, not twenty)."""
+    section = README[README.index("from planner.batch import executor"):]
+    code = section[:section.index("```")]
+    assert "range(1, 21)" in code
+    code = code.replace("range(1, 21)", "range(1, 2)").replace('"scenes/', f'"{ROOT}/scenes/')
+    (tmp_path / "mu.py").write_text(code + 'print(sorted(r["status"] for r in records))\n')
+    run = subprocess.run([sys.executable, "mu.py"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert (run.returncode, run.stdout) == (0, "['solved', 'solved']\n"), run.stderr
+    assert "Traceback" not in run.stderr

@@ -17,6 +17,7 @@ import numpy as np
 from mechanics import exp_twist
 
 from ..model.bodies import pusher_frame_body, pusher_polygon, transform_points
+from ..model.extras import have, needs, pyplot
 from ..model.plan_file import Plan, Transit
 from ..model.scene import Scene, load_scene
 from ..queries.session import plan
@@ -31,10 +32,7 @@ TRANSIT = "#8e44ad"
 def draw_plan(scene: Scene, result: Plan, path: str, copies_per_metre: float = 40.0) -> None:
     """Write a PNG of ``result`` for ``scene`` to ``path``, with ``copies_per_metre`` faint
     copies of the moving body per metre it travels."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()  # first: without matplotlib, one line naming the extra
 
     xmin, ymin, xmax, ymax = scene.workspace
     fig, ax = plt.subplots(figsize=(6, 6 * (ymax - ymin) / (xmax - xmin)), dpi=110)
@@ -92,6 +90,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", required=True, help="PNG file to write")
     p.add_argument("--seed", type=int, default=None)
     args = p.parse_args(argv)
+    if not have("matplotlib"):  # before the planning, one line
+        sys.exit(f"{p.prog}: error: {needs('matplotlib')}")
     scene = load_scene(args.scene)
     draw_plan(scene, plan(scene, seed=args.seed), args.out)
     return 0
