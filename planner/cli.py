@@ -410,7 +410,7 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         return 2
     head = (f"loaded {inputs.plan_path}: {result.contents()}"
             if inputs.given is not None
-            else f"solved: {result.contents()}, cost {result.cost:.3f} m, length {result.length:.3f} m, "
+            else f"solved: {result.headline()}, "
                  f"planning time {result.planning_time_s:.2f} s{_first_found(result)}")
     extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{f', {scene.name}-reach.png' if reach else ''}"
     lines = [f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}"]
