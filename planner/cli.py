@@ -139,8 +139,10 @@ def _parser() -> argparse.ArgumentParser:
                    help=f"what a switch of edge costs, in metres of the part's path, >= 0 (default: the scene's "
                         f"planner.switch_cost, else {DEFAULT_SWITCH_COST:g})")
     p.add_argument("--optimize", type=int, metavar="N",
-                   help=f"after the first plan, N more searches (0..{MAX_OPTIMIZE}, each with its own seed drawn "
-                        "from --seed), keeping the cheapest plan (default: the scene's planner.optimize, else 0)")
+                   help=f"after the first plan, N improvement rounds (0..{MAX_OPTIMIZE}) within --time-limit: odd "
+                        "rounds search again, each with its own seed drawn from --seed; even rounds move the plan's "
+                        "switch poses (or a via pose) on ever finer grids; the cheapest plan is kept (default: the "
+                        "scene's planner.optimize, else 0)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: logs/<name>-<timestamp>/)")
     p.add_argument("--verify", type=int, metavar="N",
                    help="re-simulate the plan under N support distributions; exit 3 if a push slips")
