@@ -56,8 +56,8 @@ def _stop_while_loading(signum: int, frame) -> None:
     os._exit(128 + signum)
 
 
-# Only where the signals are Python's defaults: a batch worker spawned with Ctrl-C ignored imports
-# this module too (as its parent's __main__ did), and must go on ignoring it.
+# Only where the signals are Python's defaults: a process started with Ctrl-C ignored (a child
+# that imports the command's module) must go on ignoring it.
 _LOADING = ({s: signal.signal(s, _stop_while_loading) for s in (signal.SIGINT, signal.SIGTERM)
              if signal.getsignal(s) in (signal.default_int_handler, signal.SIG_DFL)}
             if threading.current_thread() is threading.main_thread() else {})

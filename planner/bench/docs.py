@@ -28,6 +28,7 @@ from collections.abc import Callable
 from functools import cache
 from pathlib import Path
 
+from ..model.extras import have, needs
 from ..model.plan_file import Plan
 from ..model.scene import Scene, load_scene
 from ..queries.session import plan
@@ -130,6 +131,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--check", action="store_true", help="only say which blocks differ (exit 1 if any), write nothing")
     p.add_argument("--no-mujoco", action="store_true", help="keep the committed MuJoCo table (no MuJoCo run)")
     args = p.parse_args(argv)
+    for module, wanted in (("matplotlib", not args.check), ("mujoco", not args.no_mujoco)):
+        if wanted and not have(module):  # one line, before any work
+            p.exit(1, f"{p.prog}: error: {needs(module)}{' (or --no-mujoco)' if module == 'mujoco' else ''}\n")
     text = README.read_text()
     found = {m["name"] for m in BLOCK.finditer(text)}
     made = {name: make() for name, make in blocks(not args.no_mujoco).items() if name in found}

@@ -15,6 +15,7 @@ import math
 import sys
 
 from ..execution.mujoco_sim import Simulation, simulate
+from ..model.extras import have, needs
 from ..model.plan_file import Plan
 from ..model.scene import Scene, load_scene
 from ..queries.session import plan
@@ -47,6 +48,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("scenes", nargs="+", help="scene files (YAML)")
     p.add_argument("--runs", type=int, default=2, help="support distributions per scene (default 2)")
     args = p.parse_args(argv)
+    if not have("mujoco"):
+        p.exit(1, f"{p.prog}: error: {needs('mujoco')}\n")
     print(HEADER, flush=True)
     for path in args.scenes:
         scene = load_scene(path)
