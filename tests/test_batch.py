@@ -346,4 +346,6 @@ def test_a_batch_whose_every_task_fails_raises_and_the_command_exits_2(tmp_path,
     assert len((tmp_path / "api" / "results.jsonl").read_text().splitlines()) == 2  # recorded all the same
     monkeypatch.setattr("planner.batch.command.executor", lambda *args: _Failing())
     assert main([SCENES[0], "--seeds", "1:2", "--out", str(tmp_path / "cli")]) == 2
-    assert "2 tasks, 2 failed" in capsys.readouterr().out
+    out, err = capsys.readouterr()
+    assert "2 tasks, 2 failed" in out
+    assert err.splitlines()[-1] == "plan: every task of the batch failed (2); battery-s1: OSError: no room left"

@@ -50,7 +50,8 @@ def run_command(args: argparse.Namespace) -> int:
             _note_workers(args.jobs, len(tasks))
         try:
             records = run_batch(tasks, out, engine, resume=args.resume)
-        except BatchFailed as err:  # exit 2 and the table below say it
+        except BatchFailed as err:  # said at once, then the table and exit 2 as for any failure
+            print(f"plan: {err}", file=sys.stderr)
             records = err.records
     failed = sum(r["status"] == "failed" for r in records)
     print(summary(records))
