@@ -10,8 +10,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-import pytest
-
 from planner.model.extras import have
 
 ROOT = Path(__file__).resolve().parent.parent

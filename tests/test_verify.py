@@ -393,7 +393,7 @@ def test_command_verifies_a_switching_plan_file_and_refuses_a_tampered_transit(t
                          timeout=60)
     assert run.returncode == 0, run.stderr
     lines = run.stdout.splitlines()[1:-1]
-    assert [line.split()[0] for line in lines] == [s.kind for s in plan.segments] and lines[k].endswith(": ok")
+    assert [line.split()[2] for line in lines] == [s.kind for s in plan.segments] and lines[k].endswith(": ok")
     run = subprocess.run([*command, "bad", "--plan", str(bad)], capture_output=True, text=True, cwd=tmp_path,
                          timeout=60)
     assert run.returncode == 1 and run.stdout == ""

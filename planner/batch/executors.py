@@ -37,7 +37,6 @@ import sys
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from multiprocessing import Pipe
 from multiprocessing.connection import wait
@@ -147,6 +146,15 @@ class Feed:
         return self.attempts.pop(index)
 
 
+def _pidfd(pid: int) -> int | None:
+    """A file descriptor readable when process ``pid`` ends, whoever else holds its end of the
+    connection (Linux 5.3 and later); None elsewhere, where the connection's end alone tells."""
+    try:
+        return os.pidfd_open(pid)
+    except (AttributeError, OSError):
+        return None
+
+
 class _Worker:
     """One worker process (:mod:`planner.batch.worker`) and the connection to it."""
 
@@ -157,8 +165,7 @@ class _Worker:
                 [sys.executable, "-P", "-m", "planner.batch.worker", str(child.fileno()), str(os.getpid())],
                 pass_fds=[child.fileno()], env=_environment(), stdin=subprocess.DEVNULL)
         child.close()
-        # Readable when the worker ends, whoever else holds its end of the connection (Linux).
-        self.sentinel = os.pidfd_open(self.process.pid) if hasattr(os, "pidfd_open") else None
+        self.sentinel = _pidfd(self.process.pid)
         self.conn.send(("path", sys.path))
         self.conn.send(("shared", shared))
         self.index: int | None = None  # the call it runs

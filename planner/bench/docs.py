@@ -101,15 +101,21 @@ def table_plans() -> dict[str, str]:
 
 def mujoco_table() -> str:
     """The ``mujoco-table`` block (needs MuJoCo; minutes)."""
-    from ..execution.mujoco_sim import simulate
+    from ..execution.mujoco_sim import SLIP, simulate
     from .simulate import row
 
     lines = ["| scene | plan | executed | goal error | path deviation | slip | passed |",
              "|---|---|---|---|---|---|---|"]
+    slips = {}
     for name in shipped():
         scene, result = seed_one(name)
-        lines.append(row(scene, result, simulate(scene, result, MUJOCO_RUNS, seed=1) if result.solved else None,
-                         timing=False))
+        simulation = simulate(scene, result, MUJOCO_RUNS, seed=1) if result.solved else None
+        lines.append(row(scene, result, simulation, timing=False))
+        if simulation is not None:
+            slips[name] = max(r.slip for r in simulation.runs)
+    worst = max(slips, key=slips.get)
+    lines += ["", _wrapped(f"The worst slip, {slips[worst] * 1e3:.3f} mm on {worst}, is {slips[worst] / SLIP:.0%} "
+                           f"of the {SLIP * 1e3:g} mm a run may slip.").rstrip("\n")]
     return "\n".join(lines) + "\n"
 
 
