@@ -306,7 +306,7 @@ def test_a_results_file_that_is_a_pipe_is_one_line_before_any_task(tmp_path, cap
 
 
 def test_ctrl_c_while_the_workers_start_is_one_line(tmp_path):
-    """Ctrl-C reaches the whole process group, the batch's spawned workers too, which import the
+    """Ctrl-C reaches the whole process group, the batch's workers too, which import the
     planner for a second or so: they start with it ignored, so only the command speaks."""
     runs = [subprocess.Popen([str(PLAN), *SCENES, "--seeds", "1:20", "--jobs", "2", "--out", str(tmp_path / f"o{k}")],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,

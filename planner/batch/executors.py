@@ -45,7 +45,6 @@ from typing import Any, Protocol
 
 from ..model.processes import cores
 from ..model.stop import signals_blocked
-from .worker import describe
 
 __all__ = ["Executor", "Feed", "LocalExecutor", "Outcome", "describe"]
 
@@ -82,6 +81,15 @@ class Executor(Protocol):
     def __enter__(self) -> Executor: ...
 
     def __exit__(self, *exc) -> None: ...
+
+
+def describe(err: BaseException) -> str:
+    """One line for an exception: its type and message, as a results file records it.
+
+    >>> describe(ValueError("no\\nmore")), describe(KeyError())
+    ('ValueError: no', 'KeyError')
+    """
+    return f"{type(err).__name__}: {err}".splitlines()[0] if str(err) else type(err).__name__
 
 
 def _environment() -> dict[str, str]:

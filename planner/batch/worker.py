@@ -19,17 +19,9 @@ from multiprocessing.connection import Connection
 
 from ..model.processes import die_with_parent
 from ..model.stop import quiet_child
+from .executors import describe  # not the other way: the package must not import this module, run as __main__
 
 __all__ = ["serve"]
-
-
-def describe(err: BaseException) -> str:
-    """One line for an exception: its type and message, as a results file records it.
-
-    >>> describe(ValueError("no\\nmore")), describe(KeyError())
-    ('ValueError: no', 'KeyError')
-    """
-    return f"{type(err).__name__}: {err}".splitlines()[0] if str(err) else type(err).__name__
 
 
 def serve(conn: Connection, parent: int) -> None:
