@@ -349,3 +349,29 @@ def test_a_batch_whose_every_task_fails_raises_and_the_command_exits_2(tmp_path,
     out, err = capsys.readouterr()
     assert "2 tasks, 2 failed" in out
     assert err.splitlines()[-1] == "plan: every task of the batch failed (2); battery-s1: OSError: no room left"
+
+
+_RUNS_ITSELF = '''
+import os
+from planner.batch import LocalExecutor
+
+def square(item, shared):
+    return item * item
+
+if __name__ == "__main__":
+    with LocalExecutor(2) as pool:
+        print(sorted(o.value for _, o in pool.run(square, [2, 3])))
+'''
+
+
+def test_a_function_of_a_module_run_with_dash_m_reaches_the_workers_and_one_of_a_script_is_one_line(tmp_path):
+    (tmp_path / "squares.py").write_text(_RUNS_ITSELF)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    module = subprocess.run([sys.executable, "-m", "squares"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                            timeout=120)
+    assert (module.returncode, module.stdout) == (0, "[4, 9]\n"), module.stderr
+    script = subprocess.run([sys.executable, "squares.py"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                            timeout=120)
+    assert script.returncode == 1 and script.stderr.splitlines()[-1] == (
+        f"TypeError: square is defined in the script being run ({tmp_path / 'squares.py'}), which batch workers "
+        "do not run: define it in a module they can import"), script.stderr

@@ -16,7 +16,7 @@ for ever (:mod:`planner.model.processes`); nor multiprocessing's ``spawn`` or ``
 children, which run the parent's ``__main__`` again (a user's script without its guard would start
 its batch again in every worker). A worker imports the planner once, then plans task after task;
 a call's function and item are pickled, so the function must be importable by its module's name
-(not one of the parent's ``__main__``). A worker dies with the run
+(:func:`importable`: one of a module run as ``python -m`` is found by that name). A worker dies with the run
 (:func:`~planner.model.processes.die_with_parent`), ignores Ctrl-C (the run kills it) and is killed
 by pid when the run ends or is interrupted, so none is left behind. A dead worker breaks nothing
 but its own call, unlike :class:`multiprocessing.pool.Pool` (which hangs) or
@@ -30,6 +30,8 @@ but its own call, unlike :class:`multiprocessing.pool.Pool` (which hangs) or
 
 from __future__ import annotations
 
+import functools
+import importlib
 import os
 import socket
 import subprocess
@@ -46,7 +48,7 @@ from typing import Any, Protocol
 from ..model.processes import cores
 from ..model.stop import signals_blocked
 
-__all__ = ["Executor", "Feed", "LocalExecutor", "Outcome", "describe"]
+__all__ = ["Executor", "Feed", "LocalExecutor", "Outcome", "describe", "importable"]
 
 
 @dataclass(frozen=True)
@@ -90,6 +92,28 @@ def describe(err: BaseException) -> str:
     ('ValueError: no', 'KeyError')
     """
     return f"{type(err).__name__}: {err}".splitlines()[0] if str(err) else type(err).__name__
+
+
+def importable(fn: Callable) -> Callable:
+    """``fn`` as a worker can import it: itself, or, for a function of a module run as ``python -m
+    NAME`` (whose ``__module__`` is ``'__main__'``), the same function reached through ``NAME``.
+    A worker imports modules by name and never runs the parent's ``__main__`` (module docstring).
+
+    Raises
+    ------
+    TypeError
+        For a function of a script run by its path, which a worker cannot import: one line
+        saying to move it into a module.
+    """
+    if getattr(fn, "__module__", None) != "__main__":
+        return fn
+    main = sys.modules["__main__"]
+    name = getattr(getattr(main, "__spec__", None), "name", None)
+    if not name:
+        raise TypeError(f"{getattr(fn, '__qualname__', fn)!s} is defined in the script being run "
+                        f"({getattr(main, '__file__', '__main__')}), which batch workers do not run: "
+                        "define it in a module they can import")
+    return functools.reduce(getattr, fn.__qualname__.split("."), importlib.import_module(name))
 
 
 def _environment() -> dict[str, str]:
@@ -228,6 +252,7 @@ class LocalExecutor:
         """Call ``fn(item, shared)`` for each item, taken from ``items`` as a worker is free for it
         (a worker is started only for an item waiting, so never more than the items); yield
         ``(index, Outcome)`` as calls end, ``index`` counting the items from 0 (module docstring)."""
+        fn = importable(fn)
         feed = Feed(items)
         pool: list[_Worker] = []
         try:
