@@ -56,13 +56,14 @@ def _stop_while_loading(signum: int, frame) -> None:
     os._exit(128 + signum)
 
 
-# Only where the signals are Python's defaults: a batch worker spawned with Ctrl-C ignored imports
-# this module too (as its parent's __main__ did), and must go on ignoring it.
+# Only where the signals are Python's defaults: a process started with Ctrl-C ignored (a child
+# that imports the command's module) must go on ignoring it.
 _LOADING = ({s: signal.signal(s, _stop_while_loading) for s in (signal.SIGINT, signal.SIGTERM)
              if signal.getsignal(s) in (signal.default_int_handler, signal.SIG_DFL)}
             if threading.current_thread() is threading.main_thread() else {})
 
 from .model.fields import SceneError, shown  # noqa: E402 (after the environment is set)
+from .model.extras import have, needs
 from .model.files import atomic_path, staged_folder, write_atomic
 from .model.plan_file import Plan, load_plan
 from .model.stop import Terminated, raise_on_sigterm
@@ -87,7 +88,8 @@ __all__ = ["Inputs", "main", "read_inputs"]
 _EPILOG = f"""\
 exit codes:
   0    solved (and verified, with --verify)
-  1    bad input, in the scene (a goal in an obstacle, say), in an option's value (--reach 3) or
+  1    bad input, in the scene (a goal in an obstacle, say), in an option's value (--reach 3),
+       an extra that an option needs and is not installed (--reach without matplotlib) or
        a --plan file that is not a plan for the scene (another start, goal, part, or through a
        wall): one line "plan: error: <field>: <problem>", nothing written
   2    not solved within the time limit, or the goal is certified unreachable (one line
@@ -137,8 +139,10 @@ def _parser() -> argparse.ArgumentParser:
                    help=f"what a switch of edge costs, in metres of the part's path, >= 0 (default: the scene's "
                         f"planner.switch_cost, else {DEFAULT_SWITCH_COST:g})")
     p.add_argument("--optimize", type=int, metavar="N",
-                   help=f"after the first plan, N more searches (0..{MAX_OPTIMIZE}, each with its own seed drawn "
-                        "from --seed), keeping the cheapest plan (default: the scene's planner.optimize, else 0)")
+                   help=f"after the first plan, N improvement rounds (0..{MAX_OPTIMIZE}) within --time-limit: odd "
+                        "rounds search again, each with its own seed drawn from --seed; even rounds move the plan's "
+                        "switch poses (or a via pose) on ever finer grids; the cheapest plan is kept (default: the "
+                        "scene's planner.optimize, else 0)")
     p.add_argument("--out", metavar="DIR", help="output folder (default: logs/<name>-<timestamp>/)")
     p.add_argument("--verify", type=int, metavar="N",
                    help="re-simulate the plan under N support distributions; exit 3 if a push slips")
@@ -217,6 +221,8 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     _check_simulation(args)
     if args.reach is not None and args.reach not in (1, 2):
         raise SceneError("--reach", f"must be 1 or 2 pushes, got {args.reach}")
+    if args.reach is not None and not have("matplotlib"):  # found before the work, not after it
+        raise SceneError("--reach", f"the map's PNG {needs('matplotlib')}")
     for flag, value in (("--engine", args.engine), ("--jobs", args.jobs), ("--address", args.address)):
         if value is not None and args.reach is None:
             raise SceneError(flag, "is for a batch (several scenes or --seeds) or a --reach map")
@@ -407,7 +413,7 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         return 2
     head = (f"loaded {inputs.plan_path}: {result.contents()}"
             if inputs.given is not None
-            else f"solved: {result.contents()}, cost {result.cost:.3f} m, length {result.length:.3f} m, "
+            else f"solved: {result.headline()}, "
                  f"planning time {result.planning_time_s:.2f} s{_first_found(result)}")
     extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{f', {scene.name}-reach.png' if reach else ''}"
     lines = [f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}"]

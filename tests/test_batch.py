@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from planner import load_scene
-from planner.batch import LocalExecutor, make_tasks, run_batch
+from planner.batch import BatchFailed, LocalExecutor, Outcome, make_tasks, run_batch
 from planner.batch.reach import reachable_set_on
 from planner.batch.results import COLUMNS, STATUSES
 from planner.cli import main
@@ -306,7 +306,7 @@ def test_a_results_file_that_is_a_pipe_is_one_line_before_any_task(tmp_path, cap
 
 
 def test_ctrl_c_while_the_workers_start_is_one_line(tmp_path):
-    """Ctrl-C reaches the whole process group, the batch's spawned workers too, which import the
+    """Ctrl-C reaches the whole process group, the batch's workers too, which import the
     planner for a second or so: they start with it ignored, so only the command speaks."""
     runs = [subprocess.Popen([str(PLAN), *SCENES, "--seeds", "1:20", "--jobs", "2", "--out", str(tmp_path / f"o{k}")],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
@@ -319,3 +319,59 @@ def test_ctrl_c_while_the_workers_start_is_one_line(tmp_path):
         _, stderr = run.communicate(timeout=60)
         assert run.returncode == 130 and "Traceback" not in stderr, stderr
         assert [line for line in stderr.splitlines() if not line.startswith("[")] == ["plan: interrupted"], stderr
+
+
+class _Failing:
+    """An executor whose every call fails, as when a worker cannot run the tasks at all."""
+
+    workers = 1
+
+    def run(self, fn, items, shared=None, **kwargs):
+        for index, _ in enumerate(items):
+            yield index, Outcome(error="OSError: no room left")
+
+    def close(self) -> None:
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        pass
+
+
+def test_a_batch_whose_every_task_fails_raises_and_the_command_exits_2(tmp_path, monkeypatch, capsys):
+    with pytest.raises(BatchFailed, match=r"every task of the batch failed \(2\); battery-s1: OSError: no room"):
+        run_batch(make_tasks([SCENES[0]], [1, 2]), tmp_path / "api", _Failing(), stream=open(os.devnull, "w"))
+    assert len((tmp_path / "api" / "results.jsonl").read_text().splitlines()) == 2  # recorded all the same
+    monkeypatch.setattr("planner.batch.command.executor", lambda *args: _Failing())
+    assert main([SCENES[0], "--seeds", "1:2", "--out", str(tmp_path / "cli")]) == 2
+    out, err = capsys.readouterr()
+    assert "2 tasks, 2 failed" in out
+    assert err.splitlines()[-1] == "plan: every task of the batch failed (2); battery-s1: OSError: no room left"
+
+
+_RUNS_ITSELF = '''
+import os
+from planner.batch import LocalExecutor
+
+def square(item, shared):
+    return item * item
+
+if __name__ == "__main__":
+    with LocalExecutor(2) as pool:
+        print(sorted(o.value for _, o in pool.run(square, [2, 3])))
+'''
+
+
+def test_a_function_of_a_module_run_with_dash_m_reaches_the_workers_and_one_of_a_script_is_one_line(tmp_path):
+    (tmp_path / "squares.py").write_text(_RUNS_ITSELF)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    module = subprocess.run([sys.executable, "-m", "squares"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                            timeout=120)
+    assert (module.returncode, module.stdout) == (0, "[4, 9]\n"), module.stderr
+    script = subprocess.run([sys.executable, "squares.py"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                            timeout=120)
+    assert script.returncode == 1 and script.stderr.splitlines()[-1] == (
+        f"TypeError: square is defined in the script being run ({tmp_path / 'squares.py'}), which batch workers "
+        "do not run: define it in a module they can import"), script.stderr

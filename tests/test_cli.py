@@ -618,3 +618,21 @@ def test_an_output_place_that_cannot_be_written_is_refused_before_planning(tmp_p
     assert main([str(SCENES / "battery.yaml"), *flags]) == 4
     assert capsys.readouterr().err == f"plan: error: cannot write {named!r}: Not a directory\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]
+
+
+def test_every_planner_setting_has_its_flag_and_the_flag_sets_it():
+    """A scene's planner: block and the command line name the same settings: each option of
+    PlannerOptions has a flag, and giving the flag changes that option alone."""
+    import dataclasses
+
+    from planner.cli import FLAGS, options_of, _parser
+    from planner.model.options import PlannerOptions
+
+    assert set(FLAGS) == {f.name for f in dataclasses.fields(PlannerOptions)}
+    given = {"name": "kpiece", "time_limit": 3.0, "seed": 7, "regions": "stable", "switch_cost": 0.5, "optimize": 2,
+             "transit": "lift"}
+    base = PlannerOptions()
+    for field, flag in FLAGS.items():
+        changed = options_of(_parser().parse_args(["s.yaml", flag, str(given[field])]), base)
+        assert getattr(changed, field) == given[field] != getattr(base, field)
+        assert {f.name for f in dataclasses.fields(base) if getattr(changed, f.name) != getattr(base, f.name)} == {field}

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -149,3 +150,13 @@ def test_plan_bad_reach_exits_1_with_one_line(n, tmp_path, monkeypatch, capsys):
     assert captured.out == "" and captured.err.count("\n") == 1
     assert captured.err.startswith("plan: error: --reach: ")
     assert not (tmp_path / "out").exists()
+
+
+def test_without_matplotlib_reach_is_one_line_naming_the_extra_before_any_work(monkeypatch, capsys, tmp_path):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # as after a plain pip install -e .
+    assert main([str(SCENES / "parking.yaml"), "--reach", "2", "--out", str(tmp_path / "out")]) == 1
+    assert capsys.readouterr().err == ("plan: error: --reach: the map's PNG needs matplotlib, which the figures "
+                                       "extra installs: pip install 'stablepush[figures]'\n")
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(ModuleNotFoundError, match=r"^needs matplotlib, which the figures extra installs"):
+        write_png(None, load_scene(SCENES / "parking.yaml"), str(tmp_path / "map.png"))

@@ -129,10 +129,16 @@ def _transit_place(transit, pose: np.ndarray) -> tuple[float, int, float]:
 
 
 @pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+def test_the_csv_numbers_the_segments_from_1_to_their_count_as_the_screen_does(runs, name):
+    _, result, rows = runs[name]
+    assert sorted(set(rows[:, 9].astype(int))) == list(range(1, len(result.segments) + 1))
+
+
+@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
 def test_every_sample_lies_on_the_planned_path(runs, name):
     scene, result, rows = runs[name]
     for row in rows[::5]:  # every fifth sample keeps it quick
-        segment = result.segments[int(row[9])]
+        segment = result.segments[int(row[9]) - 1]  # numbered from 1, as on screen
         if segment.kind == "push":
             error, s = _push_error(scene, segment, row[1:4])
         else:
@@ -169,7 +175,7 @@ def test_plan_time_places_each_sample_on_the_plans_own_clock(runs, name):
 @pytest.mark.parametrize("name", ["junction", "narrow_junction"])
 def test_rests_at_the_ends_and_at_every_change_of_segment(runs, name):
     scene, result, rows = runs[name]
-    t, segment = rows[:, 0], rows[:, 9].astype(int)
+    t, segment = rows[:, 0], rows[:, 9].astype(int) - 1  # the CSV numbers them from 1
     assert t[0] == 0.0 and np.allclose(np.diff(t)[:-1], 1 / RATE) and 0 < t[-1] - t[-2] <= 1 / RATE + 1e-12
     speed = np.linalg.norm(corner_velocities(scene, rows), axis=2).max(axis=1)
     assert speed[0] == 0.0 and speed[-1] <= 1e-12
@@ -193,7 +199,7 @@ def test_a_lift_rises_and_lands_straight_and_flies_at_full_height(runs):
     z = rows[:, 7]
     assert z.min() == 0.0 and z.max() == pytest.approx(0.05, abs=1e-12)
     for row in rows:
-        segment = result.segments[int(row[9])]
+        segment = result.segments[int(row[9]) - 1]  # numbered from 1, as on screen
         if segment.kind == "push" or segment.mode != "lift":
             assert row[7] == 0.0
             continue

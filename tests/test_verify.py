@@ -85,7 +85,8 @@ def test_every_shipped_plan_sticks_under_every_distribution(name):
     # One check per push, in order (the recording maps them onto the push segments); one line per
     # segment, each saying what it is.
     assert [c.segment for c in check.pushes] == [s for s in plan.segments if s.kind == "push"]
-    assert [line.split()[0] for line in check.lines()] == [s.kind for s in plan.segments]
+    assert [line.split()[:3] for line in check.lines()] == [
+        ["segment", f"{n}/{len(plan.segments)}:", s.kind] for n, s in enumerate(plan.segments, 1)]
     assert check.summary().startswith("verify: passed: ")
 
 
@@ -201,7 +202,7 @@ def test_a_switching_plan_verifies_with_a_line_for_its_transit(name, mode):
     assert transit.mode == mode and plan.segments[k - 1].edge == transit.from_edge != transit.to_edge
     check = verify(scene, plan, n=6)
     assert check.passed, "\n".join(check.lines())
-    assert check.lines()[k] == (f"transit 1/{plan.switches} (edge {transit.from_edge} -> {transit.to_edge}, {mode}, "
+    assert check.lines()[k] == (f"segment {k + 1}/{len(plan.segments)}: transit 1/{plan.switches} (edge {transit.from_edge} -> {transit.to_edge}, {mode}, "
                                 f"{transit.duration:.3f} s): part still, flush on both edges: ok")
 
 
@@ -328,7 +329,7 @@ def test_command_verifies_a_good_plan_file_and_exits_0(plan_files, tmp_path):
     assert run.stderr == ""
     head, push, overall = run.stdout.splitlines()
     assert head.startswith(f"loaded {good}: 1 push -> out/battery.json")
-    assert push.startswith("push 1/1 (edge 3,") and push.endswith(": ok") and "12/12 stick" in push
+    assert push.startswith("segment 1/1: push 1/1 (edge 3,") and push.endswith(": ok") and "12/12 stick" in push
     assert overall.startswith("verify: passed: 1 push x 12 distributions") and "worst deviation" in overall
     assert {p.name for p in (tmp_path / "out").iterdir()} == {"battery.json", "battery.rrd"}
     rrd_verify(tmp_path / "out" / "battery.rrd")
@@ -392,7 +393,7 @@ def test_command_verifies_a_switching_plan_file_and_refuses_a_tampered_transit(t
                          timeout=60)
     assert run.returncode == 0, run.stderr
     lines = run.stdout.splitlines()[1:-1]
-    assert [line.split()[0] for line in lines] == [s.kind for s in plan.segments] and lines[k].endswith(": ok")
+    assert [line.split()[2] for line in lines] == [s.kind for s in plan.segments] and lines[k].endswith(": ok")
     run = subprocess.run([*command, "bad", "--plan", str(bad)], capture_output=True, text=True, cwd=tmp_path,
                          timeout=60)
     assert run.returncode == 1 and run.stdout == ""

@@ -16,7 +16,7 @@ Allowed imports: every package below it (:mod:`planner.model` to :mod:`planner.o
 
 from .engines import ENGINES, executor
 from .executors import Executor, LocalExecutor, Outcome
-from .run import run_batch
+from .run import BatchFailed, run_batch
 from .tasks import Task, make_tasks, parse_seeds
 
-__all__ = ["ENGINES", "Executor", "LocalExecutor", "Outcome", "Task", "executor", "make_tasks", "parse_seeds", "run_batch"]
+__all__ = ["ENGINES", "BatchFailed", "Executor", "LocalExecutor", "Outcome", "Task", "executor", "make_tasks", "parse_seeds", "run_batch"]

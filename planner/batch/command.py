@@ -21,7 +21,7 @@ from ..model.options import check_seed
 from ..model.processes import cores
 from .engines import executor
 from .results import summary
-from .run import run_batch
+from .run import BatchFailed, run_batch
 from .tasks import make_tasks, parse_seeds
 
 __all__ = ["run_command"]
@@ -48,7 +48,11 @@ def run_command(args: argparse.Namespace) -> int:
     with executor(args.engine or "local", args.jobs, args.address) as engine:
         if (args.engine or "local") == "local" and args.jobs is not None:
             _note_workers(args.jobs, len(tasks))
-        records = run_batch(tasks, out, engine, resume=args.resume)
+        try:
+            records = run_batch(tasks, out, engine, resume=args.resume)
+        except BatchFailed as err:  # said at once, then the table and exit 2 as for any failure
+            print(f"plan: {err}", file=sys.stderr)
+            records = err.records
     failed = sum(r["status"] == "failed" for r in records)
     print(summary(records))
     print(f"{len(records)} tasks, {failed} failed -> {out}/results.jsonl", file=sys.stdout)

@@ -9,10 +9,14 @@ with the reason; a call that raises is answered failed at once (it would raise a
 item gives the same call); a call still running ``timeout`` seconds after it began has its worker
 killed and is answered failed. So a run always ends with every item answered.
 
-:class:`LocalExecutor` is a pool of this machine's processes. Its workers are spawned, not forked:
-a fork copies only the forking thread, so a lock held by another thread (a progress bar's, Ray's,
-a profiler's) would stay held in the child for ever (:mod:`planner.model.processes`); a spawned
-worker imports the planner once, then plans task after task. A worker dies with the run
+:class:`LocalExecutor` is a pool of this machine's processes. Its workers are new interpreters
+running :mod:`planner.batch.worker`, not forks: a fork copies only the forking thread, so a lock
+held by another thread (a progress bar's, Ray's, OMPL's, a profiler's) would stay held in the child
+for ever (:mod:`planner.model.processes`); nor multiprocessing's ``spawn`` or ``forkserver``
+children, which run the parent's ``__main__`` again (a user's script without its guard would start
+its batch again in every worker). A worker imports the planner once, then plans task after task;
+a call's function and item are pickled, so the function must be importable by its module's name
+(:func:`importable`: one of a module run as ``python -m`` is found by that name). A worker dies with the run
 (:func:`~planner.model.processes.die_with_parent`), ignores Ctrl-C (the run kills it) and is killed
 by pid when the run ends or is interrupted, so none is left behind. A dead worker breaks nothing
 but its own call, unlike :class:`multiprocessing.pool.Pool` (which hangs) or
@@ -26,23 +30,25 @@ but its own call, unlike :class:`multiprocessing.pool.Pool` (which hangs) or
 
 from __future__ import annotations
 
-import multiprocessing
+import functools
+import importlib
 import os
-import signal
 import socket
+import subprocess
+import sys
 import time
-import traceback
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass, replace
-from multiprocessing.connection import Connection, wait
+from multiprocessing import Pipe
+from multiprocessing.connection import wait
+from pathlib import Path
 from typing import Any, Protocol
 
-from ..model.processes import cores, die_with_parent
-from ..model.stop import quiet_child, signals_blocked
+from ..model.processes import cores
+from ..model.stop import signals_blocked
 
-__all__ = ["Executor", "Feed", "LocalExecutor", "Outcome", "describe"]
+__all__ = ["Executor", "Feed", "LocalExecutor", "Outcome", "describe", "importable"]
 
 
 @dataclass(frozen=True)
@@ -80,51 +86,49 @@ class Executor(Protocol):
 
 
 def describe(err: BaseException) -> str:
-    """One line for an exception: its type and message, as a results file records it."""
+    """One line for an exception: its type and message, as a results file records it.
+
+    >>> describe(ValueError("no\\nmore")), describe(KeyError())
+    ('ValueError: no', 'KeyError')
+    """
     return f"{type(err).__name__}: {err}".splitlines()[0] if str(err) else type(err).__name__
 
 
-def _serve(conn: Connection, parent: int) -> None:
-    """A worker's life: receive ``("shared", obj)`` and ``("call", index, fn, item)`` messages, answer
-    each call with ``(index, value, error, pid, seconds)``, until the pipe closes."""
-    die_with_parent(parent, signal.SIGKILL)  # it writes nothing: SIGKILL is the right end
-    quiet_child()  # Ctrl-C reaches the whole group: the run handles it
-    shared = None
-    while True:
-        try:
-            message = conn.recv()
-        except (EOFError, OSError):
-            return
-        if message[0] == "shared":
-            shared = message[1]
-            continue
-        _, index, fn, item = message
-        clock = time.perf_counter()
-        try:
-            value, error = fn(item, shared), None
-        except Exception as err:  # the call's own failure: reported, the worker goes on
-            value, error = None, describe(err)
-            traceback.print_exc()
-        conn.send((index, value, error, os.getpid(), time.perf_counter() - clock))
+def importable(fn: Callable) -> Callable:
+    """``fn`` as a worker can import it: itself, or, for a function of a module run as ``python -m
+    NAME`` (whose ``__module__`` is ``'__main__'``), the same function reached through ``NAME``.
+    A worker imports modules by name and never runs the parent's ``__main__`` (module docstring).
+
+    Raises
+    ------
+    TypeError
+        For a function of a script run by its path, which a worker cannot import: one line
+        saying to move it into a module.
+    """
+    if getattr(fn, "__module__", None) != "__main__":
+        return fn
+    main = sys.modules["__main__"]
+    name = getattr(getattr(main, "__spec__", None), "name", None)
+    if not name:
+        raise TypeError(f"{getattr(fn, '__qualname__', fn)!s} is defined in the script being run "
+                        f"({getattr(main, '__file__', '__main__')}), which batch workers do not run: "
+                        "define it in a module they can import")
+    return functools.reduce(getattr, fn.__qualname__.split("."), importlib.import_module(name))
+
+
+def _environment() -> dict[str, str]:
+    """The environment a worker starts with: this one, the planner importable first (its ``-P``
+    leaves the current folder out of its path, as the parent's may not hold it), and one BLAS
+    thread unless the user chose a number, as the ``plan`` command asks for itself (planner.cli):
+    a worker plans one task on one core, its matrices are tiny, and BLAS threads would only
+    compete with the other workers for the cores."""
+    root = str(Path(__file__).resolve().parents[2])
+    path = os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH")) if p)
+    return dict.fromkeys(_BLAS_THREADS, "1") | dict(os.environ) | {"PYTHONPATH": path}
 
 
 #: Thread counts of the BLAS libraries numpy may load, read when the library loads.
 _BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-
-
-@contextmanager
-def _one_blas_thread() -> Iterator[None]:
-    """Within the block, the environment a spawned process starts with asks for one BLAS thread
-    (unless the user chose a number), as the ``plan`` command does for itself (planner.cli): a
-    worker plans one task on one core, its matrices are tiny, and BLAS threads would only compete
-    with the other workers for the cores."""
-    added = [name for name in _BLAS_THREADS if name not in os.environ]
-    os.environ.update(dict.fromkeys(added, "1"))
-    try:
-        yield
-    finally:
-        for name in added:
-            os.environ.pop(name, None)
 
 
 class Feed:
@@ -174,16 +178,27 @@ class Feed:
         return self.attempts.pop(index)
 
 
-class _Worker:
-    """One spawned worker process and the pipe to it."""
+def _pidfd(pid: int) -> int | None:
+    """A file descriptor readable when process ``pid`` ends, whoever else holds its end of the
+    connection (Linux 5.3 and later); None elsewhere, where the connection's end alone tells."""
+    try:
+        return os.pidfd_open(pid)
+    except (AttributeError, OSError):
+        return None
 
-    def __init__(self, context: multiprocessing.context.BaseContext, shared: Any):
-        self.conn, child = context.Pipe()
-        self.process = context.Process(target=_serve, args=(child, os.getpid()), daemon=True,
-                                       name="stablepush-batch-worker")
-        with _one_blas_thread(), signals_blocked():  # until the worker has its own handlers (_serve)
-            self.process.start()
+
+class _Worker:
+    """One worker process (:mod:`planner.batch.worker`) and the connection to it."""
+
+    def __init__(self, shared: Any):
+        self.conn, child = Pipe()
+        with signals_blocked():  # until the worker has its own handlers (worker.serve)
+            self.process = subprocess.Popen(
+                [sys.executable, "-P", "-m", "planner.batch.worker", str(child.fileno()), str(os.getpid())],
+                pass_fds=[child.fileno()], env=_environment(), stdin=subprocess.DEVNULL)
         child.close()
+        self.sentinel = _pidfd(self.process.pid)
+        self.conn.send(("path", sys.path))
         self.conn.send(("shared", shared))
         self.index: int | None = None  # the call it runs
         self.item: Any = None  # and its item, to begin it again if the worker dies
@@ -193,12 +208,26 @@ class _Worker:
         self.conn.send(("call", index, fn, item))
         self.index, self.began = index, time.monotonic()
 
+    def waited_on(self) -> list:
+        """What :func:`~multiprocessing.connection.wait` watches for it: an answer, or its end."""
+        return [self.conn] if self.sentinel is None else [self.conn, self.sentinel]
+
+    def exit_code(self, timeout: float) -> int | None:
+        """Its exit code (minus the signal that ended it), waiting up to ``timeout`` s; None if it runs on."""
+        try:
+            return self.process.wait(timeout)
+        except subprocess.TimeoutExpired:
+            return None
+
     def kill(self) -> None:
         """Kill it by pid and reap it."""
-        if self.process.is_alive():
+        if self.process.poll() is None:
             self.process.kill()
-        self.process.join()
+        self.process.wait()
         self.conn.close()
+        if self.sentinel is not None:
+            os.close(self.sentinel)
+            self.sentinel = None
 
 
 class LocalExecutor:
@@ -207,7 +236,6 @@ class LocalExecutor:
 
     def __init__(self, workers: int | None = None):
         self.workers = max(1, cores() if workers is None else int(workers))
-        self._context = multiprocessing.get_context("spawn")
         self.host = socket.gethostname()
 
     def __enter__(self) -> LocalExecutor:
@@ -224,6 +252,7 @@ class LocalExecutor:
         """Call ``fn(item, shared)`` for each item, taken from ``items`` as a worker is free for it
         (a worker is started only for an item waiting, so never more than the items); yield
         ``(index, Outcome)`` as calls end, ``index`` counting the items from 0 (module docstring)."""
+        fn = importable(fn)
         feed = Feed(items)
         pool: list[_Worker] = []
         try:
@@ -232,7 +261,7 @@ class LocalExecutor:
                 while (call := feed.peek()) is not None:
                     worker = next((w for w in pool if w.index is None), None)
                     if worker is None and len(pool) < self.workers:
-                        worker = _Worker(self._context, shared)
+                        worker = _Worker(shared)
                         pool.append(worker)
                     if worker is None:
                         break
@@ -248,7 +277,7 @@ class LocalExecutor:
                 if not busy:
                     break  # nothing waits: every call is answered
                 soonest = min((w.began + timeout for w in busy), default=None) if timeout else None
-                ready = wait([w.conn for w in busy] + [w.process.sentinel for w in busy],
+                ready = wait([c for w in busy for c in w.waited_on()],
                              None if soonest is None else max(0.0, soonest - time.monotonic()))
                 for worker in busy:
                     index = worker.index
@@ -257,9 +286,8 @@ class LocalExecutor:
                         continue
                     if outcome == "died":
                         pool.remove(worker)
-                        worker.process.join(1.0)  # its own exit code, if it is exiting of itself
+                        code = worker.exit_code(1.0)  # its own, if it is exiting of itself
                         worker.kill()
-                        code = worker.process.exitcode
                         why = (f"its worker died (signal {-code})" if code is not None and code < 0
                                else f"its worker died (exit code {code})")
                         if feed.attempts[index] <= retries:
@@ -287,7 +315,7 @@ class LocalExecutor:
             except (EOFError, OSError):
                 return "died"
             return Outcome(value, error, self.host, pid, seconds=seconds)
-        if worker.process.sentinel in ready or not worker.process.is_alive():
+        if worker.sentinel in ready or worker.process.poll() is not None:
             return "died"
         if timeout and time.monotonic() - worker.began > timeout:
             return "late"

@@ -24,13 +24,24 @@ from .progress import Progress
 from .results import COLUMNS, ResultsFile
 from .tasks import Task, TaskList, run_task, shared_regions
 
-__all__ = ["GRACE", "RETRIES", "batch_records", "reusable", "run_batch", "stop_after"]
+__all__ = ["GRACE", "RETRIES", "BatchFailed", "batch_records", "reusable", "run_batch", "stop_after"]
 
 #: A worker that dies under a task is replaced and the task begun again this many times.
 RETRIES = 2
 #: Seconds a task may run past its time limit (the plan's shortening and the worker's start-up)
 #: before it is stopped.
 GRACE = 10.0
+
+
+class BatchFailed(RuntimeError):
+    """Every task of a batch failed (none was solved, certified unreachable or left unknown): most
+    likely the set-up, not the tasks, is wrong. ``records`` holds them all, as :func:`run_batch`
+    would have returned them; the message names the first failure."""
+
+    def __init__(self, records: list[dict[str, Any]]):
+        super().__init__(f"every task of the batch failed ({len(records)}); "
+                         f"{records[0]['id']}: {records[0]['error']}")
+        self.records = records
 
 
 def stop_after(time_limit: float) -> float:
@@ -65,6 +76,9 @@ def run_batch(tasks: Sequence[Task], out: str | Path, executor: Executor | None 
     ------
     SceneError
         For tasks with the same id, or an ``out`` holding another batch's results without ``resume``.
+    BatchFailed
+        When every task failed (a batch of tasks none of which could run says so, not only in
+        its records).
     """
     if not isinstance(tasks, TaskList):
         tasks = list(tasks)
@@ -118,7 +132,10 @@ def run_batch(tasks: Sequence[Task], out: str | Path, executor: Executor | None 
     finally:
         if own:
             executor.close()
-    return batch_records(find, done)
+    records = batch_records(find, done)
+    if records and all(r["status"] == "failed" for r in records):
+        raise BatchFailed(records)
+    return records
 
 
 def reusable(find: Callable[[str], Task | None], done: Mapping[str, Mapping[str, Any]], out: Path) -> set[str]:

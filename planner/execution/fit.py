@@ -36,7 +36,7 @@ from mechanics import point_velocity, wrap_angle
 
 from ..actions.transit import in_plane_moves
 from ..model.bodies import body_outline
-from ..model.fields import SceneError
+from ..model.fields import SceneError, pose_text
 from ..model.plan_file import Plan, Push, rechain
 from ..model.scene import Scene
 from ..world.validity import CollisionModel, advances, pose_along
@@ -54,10 +54,6 @@ MAX_CHECKS = 100_000
 
 class _TooMany(Exception):
     """The check of a plan has taken :data:`MAX_CHECKS` clearance computations."""
-
-
-def _pose(pose: np.ndarray) -> str:
-    return f"[{pose[0]:.4f} m, {pose[1]:.4f} m, {math.degrees(pose[2]):.2f} deg]"
 
 
 def _miss(scene: Scene, pose: np.ndarray, target: np.ndarray) -> str:
@@ -89,7 +85,7 @@ def fit_plan(scene: Scene, plan: Plan) -> Plan:
     >>> fit_plan(elsewhere, solved)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    planner.model.fields.SceneError: plan.start: is [0.0000 m, 0.0000 m, 0.00 deg], not the scene's start ...
+    planner.model.fields.SceneError: plan.start: is [0.0000 m, 0.0000 m, 0.0000 rad = 0.00 deg], not the scene's start ...
     """
     with np.errstate(all="ignore"):  # a file's huge numbers overflow to inf, refused below, not warned of
         return _fit(scene, plan)
@@ -104,7 +100,7 @@ def _fit(scene: Scene, plan: Plan) -> Plan:
                                     f"{np.round(scene.slider.cf, 6).tolist()}: a plan for another part")
     check_chain(scene, plan)
     if not scene.within_tolerance(plan.start, scene.start):
-        raise SceneError("plan.start", f"is {_pose(plan.start)}, not the scene's start {_pose(scene.start)}: "
+        raise SceneError("plan.start", f"is {pose_text(plan.start)}, not the scene's start {pose_text(scene.start)}: "
                                        f"{_miss(scene, plan.start, scene.start)}")
     for k, segment in enumerate(plan.segments):
         if segment.kind == "push":
@@ -113,8 +109,8 @@ def _fit(scene: Scene, plan: Plan) -> Plan:
                 raise SceneError(f"plan.segments[{k}]", f"carries the body {travel:.3g} m, more than {MAX_TRAVEL:g} m")
     moved = replace(plan, start=scene.start.copy(), goal=scene.goal.copy(), segments=rechain(plan.segments, scene.start))
     if not scene.within_tolerance(moved.final):
-        raise SceneError("plan.final", f"run from the scene's start, it ends at {_pose(moved.final)}, not at the "
-                                       f"scene's goal {_pose(scene.goal)}: {_miss(scene, moved.final, scene.goal)}")
+        raise SceneError("plan.final", f"run from the scene's start, it ends at {pose_text(moved.final)}, not at the "
+                                       f"scene's goal {pose_text(scene.goal)}: {_miss(scene, moved.final, scene.goal)}")
     _check_clear(scene, moved)
     return moved
 
@@ -160,4 +156,4 @@ def _check_clear(scene: Scene, plan: Plan) -> None:
         if not free:
             what = "the push" if segment.kind == "push" else "the pusher's transit"
             raise SceneError(f"plan.segments[{k}]", f"{what} meets an obstacle or a workspace wall of the scene "
-                                                    f"(from the part at {_pose(segment.start)})")
+                                                    f"(from the part at {pose_text(segment.start)})")

@@ -82,7 +82,8 @@ COLUMNS = ("t", "x", "y", "theta", "vx", "vy", "omega", "z", "contact", "segment
 class Trajectory:
     """Samples of the pusher frame's world pose and velocity, one row per sample (columns of
     :data:`COLUMNS`): time (s), pose (m, rad, theta in ``[-pi, pi)``), velocity of the frame's
-    origin and angular velocity, height above the table, 1 while pushing, the plan segment's index.
+    origin and angular velocity, height above the table, 1 while pushing, the plan segment's index
+    (from 0; the CSV numbers segments from 1, as every line on screen does).
     ``plan_time`` (not a CSV column; None where no plan made the samples) is where each sample is
     on the plan's own clock, the plan file's durations at 1 m/s and the recording's ``time``
     timeline: a push's path parameter, a transit's share of its duration (none for a lift's rise
@@ -90,7 +91,7 @@ class Trajectory:
 
     >>> one = Trajectory(*(np.zeros(1) for _ in COLUMNS))
     >>> one.to_csv().splitlines()
-    ['t,x,y,theta,vx,vy,omega,z,contact,segment', '0,0,0,0,0,0,0,0,0,0']
+    ['t,x,y,theta,vx,vy,omega,z,contact,segment', '0,0,0,0,0,0,0,0,0,1']
     """
 
     t: np.ndarray
@@ -110,9 +111,11 @@ class Trajectory:
         return float(self.t[-1]) if len(self.t) else 0.0
 
     def to_csv(self) -> str:
-        """The samples as CSV with a header row; floats round-trip (17 digits)."""
+        """The samples as CSV with a header row; floats round-trip (17 digits); the plan's segments
+        numbered from 1, as on screen (``simulate ...: slip ... (segment 7)``)."""
         text = io.StringIO()
-        table = np.column_stack([getattr(self, c) for c in COLUMNS]) if len(self.t) else np.zeros((0, len(COLUMNS)))
+        columns = [self.segment + 1 if c == "segment" else getattr(self, c) for c in COLUMNS]
+        table = np.column_stack(columns) if len(self.t) else np.zeros((0, len(COLUMNS)))
         table = table + 0.0  # -0.0 written as 0
         np.savetxt(text, table, fmt=["%.17g"] * 8 + ["%d"] * 2, delimiter=",", header=",".join(COLUMNS),
                    comments="")

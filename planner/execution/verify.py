@@ -55,7 +55,7 @@ from mechanics.quasistatic import (DEFAULT_STEPS, Contact, ContactMode, PushResu
                                    dipod_supports, edge_contacts, grid_support, random_support, simulate_push,
                                    tripod_supports)
 
-from ..model.fields import SceneError
+from ..model.fields import SceneError, pose_text
 from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene
 from ..actions.transit import edge_contact_pose
@@ -199,7 +199,8 @@ class Verification:
                          if t > 0 else s.start for t in np.asarray(times, dtype=float)])
 
     def lines(self) -> list[str]:
-        """A line per segment, in plan order (``plan --verify`` prints them, then :meth:`summary`).
+        """A line per segment, in plan order, numbered from 1 (``plan --verify`` prints them, then
+        :meth:`summary`).
 
         A transit has nothing to simulate and :func:`verify` refuses a plan whose transits do not
         join up, so every transit it reports on is ``ok``; its line shows where the edge changes.
@@ -207,11 +208,12 @@ class Verification:
         transits = [s for s in self.segments if s.kind == "transit"]
         numbered = {"push": iter(enumerate(self.pushes, 1)), "transit": iter(enumerate(transits, 1))}
         out = []
-        for s in self.segments:
+        for n, s in enumerate(self.segments, 1):  # the plan's own numbering, as --simulate and the CSV use
             k, item = next(numbered[s.kind])
-            out.append(self._push_line(k, item) if s.kind == "push" else
-                       f"transit {k}/{len(transits)} (edge {item.from_edge} -> {item.to_edge}, {item.mode}, "
-                       f"{item.duration:.3f} s): part still, flush on both edges: ok")
+            out.append(f"segment {n}/{len(self.segments)}: " + (
+                self._push_line(k, item) if s.kind == "push" else
+                f"transit {k}/{len(transits)} (edge {item.from_edge} -> {item.to_edge}, {item.mode}, "
+                f"{item.duration:.3f} s): part still, flush on both edges: ok"))
         return out
 
     def _push_line(self, k: int, p: PushCheck) -> str:
@@ -281,8 +283,8 @@ def _check_transit(scene: Scene, transit: Transit, edge: int | None, name: str) 
         _allowed_edge(scene, e, f"{name}.{field}")
         flush = edge_contact_pose(scene.slider, e, transit.pose)
         if _off(scene, pose, flush):
-            raise SceneError(f"{name}.pusher_path", f"{verb} at {np.round(pose, 6).tolist()}, not at the contact "
-                                                    f"pose on edge {e}: {np.round(flush, 6).tolist()}")
+            raise SceneError(f"{name}.pusher_path", f"{verb} at {pose_text(pose)}, not at the contact "
+                                                    f"pose on edge {e}: {pose_text(flush)}")
 
 
 def check_chain(scene: Scene, plan: Plan) -> list[tuple[Contact, ...]]:
@@ -296,8 +298,8 @@ def check_chain(scene: Scene, plan: Plan) -> list[tuple[Contact, ...]]:
         # memory can get it wrong; then the segment as a whole is at fault.
         if _off(scene, segment.start, pose):
             raise SceneError(name if segment.kind == "transit" else f"{name}.start",
-                             f"the part is at {np.round(segment.start, 6).tolist()}, not where {after} left it: "
-                             f"{np.round(pose, 6).tolist()}")
+                             f"the part is at {pose_text(segment.start)}, not where {after} left it: "
+                             f"{pose_text(pose)}")
         if segment.kind == "transit":
             _check_transit(scene, segment, edge, name)
         else:

@@ -21,7 +21,7 @@ import numpy as np
 
 from mechanics import wrap_angle
 
-__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "poses", "shown",
+__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "pose_text", "poses", "shown",
            "vector"]
 
 #: Most characters of a bad value a message quotes: enough to recognise it, never a flood.
@@ -77,6 +77,17 @@ def shown(value: Any) -> str:
 
 #: A key that names itself plainly in a dotted field name; any other is quoted (:func:`shown`).
 _PLAIN_KEY = re.compile(r"[A-Za-z0-9_-]{1,40}")
+
+
+def pose_text(pose: Any) -> str:
+    """A pose ``(x, y, theta)`` (m, m, rad) for a line on screen, every unit named: a heading is
+    radians in plan files and degrees in scene files, so both are shown.
+
+    >>> pose_text([0.1, -0.25, np.pi / 2])
+    '[0.1000 m, -0.2500 m, 1.5708 rad = 90.00 deg]'
+    """
+    x, y, theta = (float(v) for v in pose)
+    return f"[{x:.4f} m, {y:.4f} m, {theta:.4f} rad = {np.degrees(theta):.2f} deg]"
 
 
 def member(name: str, key: Any) -> str:

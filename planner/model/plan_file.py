@@ -288,6 +288,11 @@ class Plan:
         pushes = count(self.pushes, "push", "pushes")
         return f"{pushes}{joiner}{count(self.switches, 'switch', 'switches')}" if self.switches else pushes
 
+    def headline(self) -> str:
+        """What a solved plan is and costs, as the ``plan`` command's line says it after ``solved:``
+        (and the README quotes it): ``'6 pushes, 1 switch, cost 0.789 m, length 0.539 m'``."""
+        return f"{self.contents()}, cost {self.cost:.3f} m, length {self.length:.3f} m"
+
     def path_length(self, cf: np.ndarray) -> float:
         """Length of the path of the centre of friction ``cf`` (slider frame)."""
         return path_length(self.segments, cf)

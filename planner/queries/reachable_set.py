@@ -44,6 +44,7 @@ import shapely
 from mechanics import log_pose, wrap_angle
 
 from ..actions.push import connect
+from ..model.extras import pyplot
 from ..model.plan_file import Push
 from ..search.goal_region import GoalRegion
 from ..actions.controls import EdgeControls, clearance_margin, controls_or_reason
@@ -216,10 +217,7 @@ def reach_points(reach: ReachableSet) -> tuple[np.ndarray, np.ndarray]:
 def write_png(reach: ReachableSet, scene: Scene, path: str) -> None:
     """Write a PNG of the map to ``path``: the workspace, cells coloured by the fewest pushes, cells
     where the part collides in light grey, the obstacles, the start's outline and the scene's goal."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()  # first: without matplotlib, one line naming the extra
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
