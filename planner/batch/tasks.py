@@ -16,8 +16,6 @@ import json
 import math
 import re
 import socket
-import time
-from collections import OrderedDict
 from collections.abc import Iterable, Iterator, Mapping, Sequence
 from functools import cache
 from importlib import metadata
@@ -36,7 +34,8 @@ from ..model.options import (check_optimize, check_planner, check_regions, check
                              check_time_limit, check_transit)
 from ..model.plan_file import Plan
 from ..model.scene import Scene, load_scene
-from ..queries.session import Planner
+from ..queries.reachability import certify_unreachable
+from ..queries.session import plan
 
 __all__ = ["OVERRIDES", "Task", "TaskList", "make_tasks", "parse_seeds", "planner_version", "run_task", "shared_regions"]
 
@@ -321,27 +320,6 @@ def shared_regions(tasks: Iterable[Task] | TaskList) -> dict[str, Any]:
     return shared
 
 
-#: Planner sessions a worker keeps (the most recent), one per scene file and overrides: the tasks
-#: of a batch that differ only in seed and goal share one, set up once (regions, collision model,
-#: certificates), since a session takes both per query.
-KEPT_SESSIONS = 4
-_SESSIONS: OrderedDict[tuple[str, str], Planner] = OrderedDict()
-
-
-def _session_of(task: Task, scene: Scene) -> Planner:
-    """The session for ``task``'s scene file and overrides (``scene``: the task's planned scene);
-    a scene given as an object, with no file digest, gets a fresh one."""
-    if task.digest is None:
-        return Planner(scene)
-    key = (task.digest, json.dumps({k: task.overrides[k] for k in sorted(task.overrides)}, default=str))
-    if key not in _SESSIONS:
-        _SESSIONS[key] = Planner(scene)
-        while len(_SESSIONS) > KEPT_SESSIONS:
-            _SESSIONS.popitem(last=False)
-    _SESSIONS.move_to_end(key)
-    return _SESSIONS[key]
-
-
 def run_task(task: Task, shared: Mapping[str, Any] | None) -> dict[str, Any]:
     """Plan ``task`` in this (worker) process, with the ``shared`` regions (:func:`shared_regions`)
     put into its cache first: its status (``solved``, ``unreachable``: certified so at once,
@@ -356,16 +334,13 @@ def run_task(task: Task, shared: Mapping[str, Any] | None) -> dict[str, Any]:
     p = scene.pusher
     missing = sum(not is_cached(scene.slider, e, p.mu, p.width, scene.planner.regions, scene.cf_uncertainty)
                   for e in p.edges)
-    clock = time.perf_counter()
-    session = _session_of(task, scene)
-    unreachable = session.certificates(scene.goal)
+    unreachable = certify_unreachable(scene, regions=False)
     if unreachable:
-        result = Plan(scene=scene.path, solved=False, planner=scene.planner.name, seed=task.seed,
-                      planning_time_s=time.perf_counter() - clock, start=scene.start.copy(), goal=scene.goal.copy(),
+        result = Plan(scene=scene.path, solved=False, planner=scene.planner.name, seed=task.seed, planning_time_s=0.0,
+                      start=scene.start.copy(), goal=scene.goal.copy(),
                       reason=unreachable)
     else:
-        # A session's plan without reuse is the seed's alone: the same as a fresh session's.
-        result = session.plan(goal=scene.goal, seed=task.seed, reuse=False)
+        result = plan(scene, seed=task.seed)
     status = "solved" if result.solved else "unreachable" if unreachable else "unknown"
     return {"status": status, "cost": result.cost if result.solved else None,
             "length": result.length if result.solved else None,
