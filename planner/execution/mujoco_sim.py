@@ -69,7 +69,7 @@ from ..model.fields import SceneError
 from ..model.files import write_atomic
 from ..model.plan_file import Plan
 from ..model.scene import Scene
-from .trajectory import Trajectory, trajectory
+from .trajectory import Trajectory, planned_part, trajectory
 
 __all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Simulation", "feet", "mjcf", "needs_mujoco",
            "simulate", "support_centre", "write_mjcf"]
@@ -380,24 +380,6 @@ class Simulation:
                 f"{sum(r.seconds for r in self.runs):.1f} s")
 
 
-def _planned_part(scene: Scene, plan: Plan, motion: Trajectory) -> np.ndarray:
-    """The planned part pose at each trajectory sample (module docstring)."""
-    out = np.empty((len(motion.t), 3))
-    pusher = np.column_stack([motion.x, motion.y, motion.theta])
-    for k, segment in enumerate(plan.segments):
-        rows = motion.segment == k
-        if segment.kind == "transit":
-            out[rows] = segment.start
-            continue
-        local = edge_contact_pose(scene.slider, segment.edge, np.zeros(3))  # pusher frame in the slider frame
-        theta = pusher[rows, 2] - local[2]
-        c, s = np.cos(theta), np.sin(theta)
-        out[rows, 0] = pusher[rows, 0] - (c * local[0] - s * local[1])
-        out[rows, 1] = pusher[rows, 1] - (s * local[0] + c * local[1])
-        out[rows, 2] = wrap_angle(theta)
-    return out
-
-
 def _run(scene: Scene, plan: Plan, motion: Trajectory, planned: np.ndarray, support: Feet, mu: float | None) -> Run:
     import mujoco  # only when simulating: a plan run without --simulate never loads it
 
@@ -483,6 +465,6 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
     needs_mujoco()
     supports = feet(scene, n, seed, cf_offset)
     motion = trajectory(scene, plan)
-    planned = _planned_part(scene, plan, motion)
+    planned = planned_part(scene, plan, motion)
     return Simulation(tuple(_run(scene, plan, motion, planned, s, mu) for s in supports),
                       scene.pusher.mu if mu is None else mu, motion, np.asarray(plan.start, dtype=float), planned)
