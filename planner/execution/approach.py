@@ -83,13 +83,17 @@ def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | Non
     the ways tried is free. ``edges`` are those the pusher may be put on (for a walk round).
 
     The ways, quickest first: straight to the standoff pose and in; backed off, then so; backed
-    off to the standoff pose of the nearest edge of ``edges`` and round the part as a transit."""
+    off to the standoff pose of the nearest edge of ``edges`` and round the part as a transit.
+    The standoff in front of ``edge`` is tried at a half and a quarter of the transits' where a
+    wall is close behind the edge."""
     pusher, part = np.asarray(pusher, dtype=float), np.asarray(part, dtype=float)
     gap = standoff(scene)
     contact = edge_contact_pose(scene.slider, edge, part)
-    front = backed_off(contact, gap)
     retreat = backed_off(pusher, gap)
-    ways = [[pusher, front, contact], [pusher, retreat, front, contact]]
+    ways = []
+    for near in (gap, gap / 2, gap / 4):  # nearer the part where a wall leaves no room behind the edge
+        front = backed_off(contact, near)
+        ways += [[pusher, front, contact], [pusher, retreat, front, contact]]
     if transits is not None:
         fronts = {e: backed_off(edge_contact_pose(scene.slider, e, part), gap) for e in edges if e != edge}
         if fronts:

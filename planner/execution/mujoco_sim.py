@@ -503,7 +503,7 @@ def perturbations(scene: Scene, plan: Plan, model: CollisionModel, start_error: 
     Raises
     ------
     SceneError
-        Naming ``start_error``, ``bump`` or ``pose_noise``: a value not finite, negative noise, a
+        Naming ``start_error``, ``bump`` (and which, if several) or ``pose_noise``: a value not finite, negative noise, a
         bump time outside the run, a perturbed part outside the workspace, on an obstacle or (at
         the start) on the pusher.
     """
@@ -528,16 +528,16 @@ def perturbations(scene: Scene, plan: Plan, model: CollisionModel, start_error: 
     rows = np.asarray(bumps, dtype=float).reshape(-1, 4) if len(bumps) else np.zeros((0, 4))
     out = []
     for k, (t, dx, dy, dtheta) in enumerate(rows):
-        name = f"bump[{k}]"
+        name, which = "bump", f"bump {k + 1}: " if len(rows) > 1 else ""
         if not np.isfinite(rows[k]).all():
-            raise SceneError(name, f"must be four finite numbers (T, dx, dy, dtheta), got {rows[k].tolist()}")
+            raise SceneError(name, f"{which}must be four finite numbers (T, dx, dy, dtheta), got {rows[k].tolist()}")
         if not 0 <= t <= lead.duration + motion.duration:
-            raise SceneError(name, f"time {t:g} s is outside the run (0 to {lead.duration + motion.duration:.2f} s)")
+            raise SceneError(name, f"{which}time {t:g} s is outside the run (0 to {lead.duration + motion.duration:.2f} s)")
         at = planned[min(int(np.searchsorted(motion.t, t - lead.duration)), len(planned) - 1)] if t > lead.duration \
             else start
         moved = at + [dx, dy, dtheta]
         if (fault := placement_fault(scene.slider, scene.obstacles, scene.workspace, moved)) is not None:
-            raise SceneError(name, f"puts the part where it cannot be (where the plan has it at {t:g} s): {fault}")
+            raise SceneError(name, f"{which}puts the part where it cannot be (where the plan has it at {t:g} s): {fault}")
         out.append((float(t), float(dx), float(dy), float(dtheta)))
     return start, tuple(sorted(out)), lead, motion
 

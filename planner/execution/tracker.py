@@ -53,7 +53,7 @@ from ..queries.session import Planner
 from .approach import approach
 from .trajectory import Trajectory, planned_part, trajectory
 
-__all__ = ["BUDGET", "CONFIRM", "FRACTION", "SETTLE", "SIGMAS", "Command", "Replan", "Tracker", "mean_pose"]
+__all__ = ["BUDGET", "CONFIRM", "REPLAN_LIMIT", "FRACTION", "SETTLE", "SIGMAS", "Command", "Replan", "Tracker", "mean_pose"]
 
 #: Thresholds: this fraction of the goal tolerance, and at least this many noise deviations.
 FRACTION, SIGMAS = 0.5, 5.0
@@ -63,6 +63,9 @@ CONFIRM = 3
 SETTLE = 5
 #: Re-plans allowed in one run.
 BUDGET = 8
+#: Default time limit of a re-plan's search, s: a robot waits that long at most (a join to the
+#: remembered plan takes tens of milliseconds; a search on the shipped scenes well under a second).
+REPLAN_LIMIT = 2.0
 
 
 @dataclass(frozen=True)
@@ -132,6 +135,8 @@ class Tracker:
         :data:`CONFIRM`, :data:`SETTLE`, :data:`BUDGET`.
     seed : int, optional
         The re-plans' seed (default: the session's).
+    time_limit : float
+        Each re-plan's search time limit, s (:data:`REPLAN_LIMIT`).
 
     Raises
     ------
@@ -149,7 +154,7 @@ class Tracker:
 
     def __init__(self, session: Planner, plan: Plan, *, pusher: ArrayLike | None = None, time: float = 0.0,
                  noise: tuple[float, float] = (0.0, 0.0), confirm: int = CONFIRM, settle: int = SETTLE,
-                 budget: int = BUDGET, seed: int | None = None):
+                 budget: int = BUDGET, seed: int | None = None, time_limit: float = REPLAN_LIMIT):
         if not isinstance(session, Planner):
             raise SceneError("session", f"must be a Planner, got {type(session).__name__}")
         if not (isinstance(plan, Plan) and plan.solved and plan.segments):
@@ -164,7 +169,10 @@ class Tracker:
         #: Position (m) and heading (rad) thresholds.
         self.threshold = (max(FRACTION * scene.tolerance_position, SIGMAS * float(noise[0])),
                           max(FRACTION * scene.tolerance_angle, SIGMAS * float(noise[1])))
+        if not 0 < float(time_limit) < math.inf:
+            raise SceneError("time_limit", f"must be a positive number of seconds, got {time_limit}")
         self.confirm, self.settle, self.budget, self.seed = confirm, settle, budget, seed
+        self.time_limit = min(float(time_limit), session.options.time_limit)
         #: The re-plans so far.
         self.replans: list[Replan] = []
         self.reason = ""  # why the tracker gave up
@@ -197,7 +205,7 @@ class Tracker:
             if way is None:
                 return "no free approach from the pusher to the plan's first contact"
             segments.insert(0, way)
-        self.plan = plan
+        self.plan, self._segments = plan, segments
         led = replace(plan, segments=segments)
         self.motion: Trajectory = trajectory(self.scene, led)
         self.expected = planned_part(self.scene, led, self.motion)
@@ -224,6 +232,8 @@ class Tracker:
 
     def _stop(self, now: float) -> None:
         pose, height, _, _ = self.pusher_at(now)
+        k = min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
+        self._edge = self._segments[int(self.motion.segment[k])].edge
         self._held, self._window = (pose, height), []
 
     def error(self, now: float, pose: np.ndarray) -> tuple[float, float]:
@@ -274,7 +284,11 @@ class Tracker:
         if certificate:
             return self._give_up(now, error, f"the goal is unreachable from the observed pose: {certificate}")
         try:
-            found = self.session.plan(start=part, seed=self.seed)
+            # First a plan that begins on the edge the pusher is at, so that it only has to come
+            # back to the part; then any (the pusher may not fit round to the edge it needs).
+            found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge])
+            if not found.solved:
+                found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit)
         except SceneError as err:  # the pusher has no room at the observed pose
             return self._give_up(now, error, f"no plan from the observed pose: {err.problem}")
         if not found.solved or not found.segments:
