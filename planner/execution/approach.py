@@ -82,32 +82,36 @@ def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | Non
     the part at ``part`` (module docstring), as a transit (mode ``'plane'``), or None if none of
     the ways tried is free. ``edges`` are those the pusher may be put on (for a walk round).
 
-    The ways, quickest first: straight to the standoff pose and in; backed off, then so; backed
-    off to the standoff pose of the nearest edge of ``edges`` and round the part as a transit.
-    The standoff in front of ``edge`` is tried at a half and a quarter of the transits' where a
-    wall is close behind the edge."""
+    The ways, in order: straight to the standoff pose and in; backed off (by the transits'
+    standoff, three times it, or :data:`LEAD_IN`: a pusher stopped after a knock may be on the
+    part, and its backing off is not checked against the part), then so, or round the part from
+    the standoff pose of the edge of ``edges`` nearest the pusher as a transit goes. The standoff
+    in front of ``edge`` is tried at a half and a quarter of the transits' where a wall is close
+    behind the edge."""
     pusher, part = np.asarray(pusher, dtype=float), np.asarray(part, dtype=float)
     gap = standoff(scene)
     contact = edge_contact_pose(scene.slider, edge, part)
-    retreat = backed_off(pusher, gap)
-    ways = []
-    for near in (gap, gap / 2, gap / 4):  # nearer the part where a wall leaves no room behind the edge
-        front = backed_off(contact, near)
-        ways += [[pusher, front, contact], [pusher, retreat, front, contact]]
+    fronts = [backed_off(contact, near) for near in (gap, gap / 2, gap / 4)]
+    ways = [[pusher, front, contact] for front in fronts]
+    walks = []
     if transits is not None:
-        fronts = {e: backed_off(edge_contact_pose(scene.slider, e, part), gap) for e in edges if e != edge}
-        if fronts:
-            near = min(fronts, key=lambda e: np.linalg.norm(fronts[e][:2] - retreat[:2]))
+        others = {e: backed_off(edge_contact_pose(scene.slider, e, part), gap) for e in edges if e != edge}
+        if others:
+            near = min(others, key=lambda e: np.linalg.norm(others[e][:2] - pusher[:2]))
             walk = transits.find(part, near, edge)
-            if walk is not None:
-                ways.append([pusher, retreat, *walk.pusher_path[1:]])
+            walks = [] if walk is None else [list(walk.pusher_path[1:])]
+    # Backing off farther where the pusher, stopped after a knock, is still on the part.
+    for back in (gap, 3 * gap, LEAD_IN):
+        retreat = backed_off(pusher, back)
+        ways += [[pusher, retreat, front, contact] for front in fronts] + [[pusher, retreat, *w] for w in walks]
     body = slider_at(scene.slider.polygon, part)
     reach = float(np.linalg.norm(pusher_frame_body(scene.pusher.width, scene.pusher.depth), axis=1).max())
     for way in ways:
         way = [p for k, p in enumerate(way) if k == 0 or np.abs(p - way[k - 1]).max() > 1e-12]
         moves = list(zip(way, way[1:]))
+        backing = len(way) > 3  # the first move backs straight off, away from the face: not checked on the part
         if all(model.pusher_move_is_free(a, b, 0.0) for a, b in moves) and all(
-                _off_part(scene, body, a, b) for a, b in moves[:-1]):
+                _off_part(scene, body, a, b) for a, b in moves[int(backing):-1]):
             path = np.array(way)
             return Transit(edge, edge, "plane", path, path_duration(path, reach), part.copy())
     return None

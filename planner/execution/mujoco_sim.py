@@ -92,6 +92,8 @@ PUSHER_MASS = 1000.0
 SETTLE = 0.1
 #: Feet of a grid distribution (about).
 GRID_FEET = 9
+#: Step by which a knocked part is moved off the pusher, m.
+BUMP_STEP = 0.0002
 
 
 @dataclass(frozen=True)
@@ -402,6 +404,8 @@ class World:
         self.qpos = self.model.joint("pusher_x").qposadr[0] + np.arange(4)
         self.qvel = self.model.joint("pusher_x").dofadr[0] + np.arange(4)
         self.bumps = sorted(bumps)
+        self.outline = scene.slider.polygon
+        self.pusher = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
 
     def step_to(self, t: float, pusher) -> None:
         """Step to ``t`` (MuJoCo's clock), the pusher set before every step to ``pusher(u)``:
@@ -413,10 +417,22 @@ class World:
             data.qpos[self.qpos] = pose
             data.qvel[self.qvel] = rate if u >= 0 else 0.0
             while self.bumps and self.bumps[0][0] <= u:
-                # A knock: the part is where it was moved to, at rest.
-                data.qpos[self.part] += self.bumps.pop(0)[1:]
+                # A knock: the part is where it was moved to, at rest, and not into the pusher,
+                # which is rigid: a knock towards it leaves the part against its face.
+                data.qpos[self.part] = self._off_pusher(data.qpos[self.part] + self.bumps.pop(0)[1:], pose)
                 data.qvel[self.part_speed] = 0.0
             self.mujoco.mj_step(self.model, data)
+
+    def _off_pusher(self, part: np.ndarray, pusher: ArrayLike) -> np.ndarray:
+        """``part`` moved along the pusher's +x, by :data:`BUMP_STEP` steps, until it is off the
+        pusher's body at ``pusher`` (``x, y, z, theta``); as it is if the pusher is lifted."""
+        x, y, z, theta = pusher
+        body = slider_at(self.pusher, [x, y, theta])
+        along = np.array([math.cos(theta), math.sin(theta), 0.0])
+        moved = part.copy()
+        while z < THICKNESS and slider_at(self.outline, moved).intersects(body) and np.linalg.norm(moved - part) < 0.1:
+            moved = moved + BUMP_STEP * along
+        return moved
 
     def pose(self) -> np.ndarray:
         return self.data.qpos[self.part].copy()
