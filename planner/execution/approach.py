@@ -27,7 +27,7 @@ from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
-__all__ = ["GRAZE", "LEAD_IN", "PART_STEP", "approach", "backed_off", "first_edge", "lead_in_pose"]
+__all__ = ["CLEARANCE", "GRAZE", "LEAD_IN", "PART_STEP", "approach", "backed_off", "first_edge", "lead_in_pose"]
 
 #: How far behind the first contact a run begins, m: more than the start errors a perception
 #: system makes (a centimetre or two), so the part is met, not overlapped.
@@ -36,6 +36,9 @@ LEAD_IN = 0.03
 PART_STEP = 0.001
 #: How much a move may graze the part, m.
 GRAZE = 0.001
+#: Least distance of the pusher's moves from obstacles and walls, m: conservative advancement
+#: needs one above zero to end (it steps by the clearance, which a grazing move runs down to 0).
+CLEARANCE = 0.0005
 
 
 def backed_off(pose: ArrayLike, distance: float) -> np.ndarray:
@@ -59,7 +62,7 @@ def lead_in_pose(scene: Scene, model: CollisionModel, plan: Plan) -> np.ndarray:
     (halving down to the transits' standoff) where a wall or obstacle is in the way."""
     contact = edge_contact_pose(scene.slider, first_edge(plan), plan.start)
     distance = LEAD_IN
-    while distance > standoff(scene) and not model.pusher_move_is_free(backed_off(contact, distance), contact, 0.0):
+    while distance > standoff(scene) and not model.pusher_move_is_free(backed_off(contact, distance), contact, CLEARANCE):
         distance /= 2
     return backed_off(contact, max(distance, standoff(scene)))
 
@@ -110,7 +113,7 @@ def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | Non
         way = [p for k, p in enumerate(way) if k == 0 or np.abs(p - way[k - 1]).max() > 1e-12]
         moves = list(zip(way, way[1:]))
         backing = len(way) > 3  # the first move backs straight off, away from the face: not checked on the part
-        if all(model.pusher_move_is_free(a, b, 0.0) for a, b in moves) and all(
+        if all(model.pusher_move_is_free(a, b, CLEARANCE) for a, b in moves) and all(
                 _off_part(scene, body, a, b) for a, b in moves[int(backing):-1]):
             path = np.array(way)
             return Transit(edge, edge, "plane", path, path_duration(path, reach), part.copy())

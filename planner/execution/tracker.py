@@ -11,10 +11,10 @@ any time; :meth:`Tracker.observe` takes an observed part pose and says what to d
 the distance of the slider frame's origins and the wrapped heading difference. A lost contact
 shows the same way (the part stays behind while the plan moves on). The thresholds are
 
-* half the goal tolerance (position and angle): a stable push funnels smaller errors away (in
-  MuJoCo a junction part started 12 mm / 5 degrees off its start ends inside the 1 cm
-  tolerance), and a plan joined from the observed pose is only as good as that observation, so
-  re-planning for less would chase the perception's noise;
+* half the goal tolerance (position and angle): a stable push funnels smaller errors away (open
+  loop in MuJoCo, parts started up to a centimetre off mostly end inside the 1 cm tolerance,
+  ``python -m planner.bench.closed_loop``), and a plan joined from the observed pose is only as
+  good as that observation, so re-planning for less would chase the perception's noise;
 * at least :data:`SIGMAS` standard deviations of the observation noise: the chance that noise
   alone exceeds 5 sigma is about 4e-6 per observation for the position (Rayleigh) and 6e-7 for
   the heading (Gaussian);
@@ -27,9 +27,12 @@ session, which joins that pose to the plan it remembers for the goal in millisec
 (:meth:`planner.Planner.plan`). At the plan's end the same mean decides: in the goal tolerance,
 ``'done'``; else a re-plan.
 
+**Re-planning** asks first for a plan whose first push is on the edge the pusher is at (if it
+can come back to it), then for one beginning on an edge it has a free approach to.
+
 **Giving up.** When the goal is certified unreachable from the observed pose
-(:meth:`planner.Planner.certify_unreachable`), when the planner finds no plan from it, when no
-free approach to the new plan's first contact is found, or when the re-plans exceed the budget,
+(:meth:`planner.Planner.certify_unreachable`), when the planner finds no plan from it, when the
+pusher has no free approach to any edge, or when the re-plans exceed the budget,
 the tracker gives up with the reason and holds the pusher where it is.
 
 Times are the caller's clock (seconds, increasing); poses ``(x, y, theta)`` in metres and radians.
@@ -48,9 +51,9 @@ from numpy.typing import ArrayLike
 from mechanics import wrap_angle
 
 from ..model.fields import SceneError, poses
-from ..model.plan_file import Plan
+from ..model.plan_file import Plan, Transit
 from ..queries.session import Planner
-from .approach import approach
+from .approach import approach, first_edge
 from .trajectory import Trajectory, planned_part, trajectory
 
 __all__ = ["BUDGET", "CONFIRM", "REPLAN_LIMIT", "FRACTION", "SETTLE", "SIGMAS", "Command", "Replan", "Tracker", "mean_pose"]
@@ -198,10 +201,7 @@ class Tracker:
         ``pusher`` (if given); the reason if there is no free approach."""
         segments = list(plan.segments)
         if pusher is not None:
-            world = self.session.world
-            edges = [c.edge for c in world.controls] if world is not None else []
-            way = approach(self.scene, self.session.model, world.transits if world is not None else None, pusher,
-                           part, segments[0].edge if segments[0].kind == "push" else segments[0].from_edge, edges)
+            way = self._approach(pusher, part, first_edge(plan))
             if way is None:
                 return "no free approach from the pusher to the plan's first contact"
             segments.insert(0, way)
@@ -213,6 +213,12 @@ class Tracker:
         self._since = now
         self._strikes, self._held = 0, None
         return ""
+
+    def _approach(self, pusher: np.ndarray, part: np.ndarray, edge: int) -> Transit | None:
+        world = self.session.world
+        edges = [c.edge for c in world.controls] if world is not None else []
+        return approach(self.scene, self.session.model, world.transits if world is not None else None, pusher, part,
+                        edge, edges)
 
     def pusher_at(self, now: float) -> tuple[np.ndarray, float, np.ndarray, bool]:
         """Where the pusher frame should be at ``now``: pose ``(x, y, theta)`` (theta unwrapped along
@@ -283,17 +289,25 @@ class Tracker:
         certificate = self.session.certify_unreachable(start=part)
         if certificate:
             return self._give_up(now, error, f"the goal is unreachable from the observed pose: {certificate}")
+        pusher = self._held[0]
         try:
             # First a plan that begins on the edge the pusher is at, so that it only has to come
-            # back to the part; then any (the pusher may not fit round to the edge it needs).
-            found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge])
-            if not found.solved:
-                found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit)
+            # back to the part; then one that begins on an edge the pusher can get to from there.
+            found = None
+            if self._approach(pusher, part, self._edge) is not None:
+                found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge])
+            if found is None or not found.solved:
+                world = self.session.world
+                others = [c.edge for c in world.controls if c.edge != self._edge] if world is not None else []
+                reached = [e for e in others if self._approach(pusher, part, e) is not None]
+                if not reached and found is None:
+                    return self._give_up(now, error, "no free approach from the pusher to any edge of the part")
+                if reached:
+                    found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=reached)
         except SceneError as err:  # the pusher has no room at the observed pose
             return self._give_up(now, error, f"no plan from the observed pose: {err.problem}")
         if not found.solved or not found.segments:
             return self._give_up(now, error, f"no plan from the observed pose: {found.reason or 'no segments'}")
-        pusher = self._held[0]
         problem = self._begin(found, pusher, part, now)
         if problem:
             self._held = (pusher, 0.0)
