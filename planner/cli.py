@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import math
 import os
 import signal
 import sys
@@ -72,7 +73,7 @@ from .outputs.recorder import RecordingFailed, recorder
 from .actions.region_cache import cache_folder
 from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEFAULT_TRANSIT, MAX_OPTIMIZE,
                             MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS, TRANSITS, PlannerOptions)
-from .model.scene import Scene, load_scene, write_scene
+from .model.scene import Scene, load_scene, placement_fault, write_scene
 from .queries.session import plan
 
 for _signal, _handler in _LOADING.items():  # loaded: main() handles them from here on
@@ -80,6 +81,7 @@ for _signal, _handler in _LOADING.items():  # loaded: main() handles them from h
 
 if TYPE_CHECKING:
     from .execution.trajectory import Trajectory
+    from .execution.closed_loop import ClosedLoop
     from .execution.mujoco_sim import Simulation
     from .execution.verify import Verification
 
@@ -166,6 +168,18 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--sim-cf-offset", type=float, nargs=2, metavar=("DX", "DY"),
                    help="with --simulate: move the supports' centre of pressure by this offset from the CF "
                         "(slider frame, m)")
+    p.add_argument("--sim-start-error", type=float, nargs=3, metavar=("DX", "DY", "DTHETA"),
+                   help="with --simulate: the part starts this far from the plan's start (world frame; m, m, "
+                        "degrees); every run begins with the pusher behind the first contact, moving in")
+    p.add_argument("--sim-bump", type=float, nargs=4, action="append", metavar=("T", "DX", "DY", "DTHETA"),
+                   help="with --simulate: T seconds after the pusher starts moving, the part is knocked this far "
+                        "(world frame; m, m, degrees); may be given several times")
+    p.add_argument("--sim-pose-noise", type=float, nargs=2, metavar=("SIGMA_M", "SIGMA_DEG"),
+                   help="with --simulate: Gaussian noise on the part pose the closed loop observes (m per axis, degrees; "
+                        "an open loop observes nothing)")
+    p.add_argument("--closed-loop", action="store_true",
+                   help="with --simulate: observe the part at 20 Hz and re-plan from where it is when it strays from "
+                        "the plan (planner.execution.tracker); the summary counts the re-plans")
     p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")
     p.add_argument("--export-scene", metavar="FILE",
                    help="also write the scene as planned to FILE (YAML, the plain schema: CAD files and boxes "
@@ -200,6 +214,10 @@ class Inputs:
     sim_cf_offset: tuple[float, float] = (0.0, 0.0)  # --sim-cf-offset
     mjcf: Path | None = None  # --mjcf FILE
     export_scene: Path | None = None  # --export-scene FILE
+    start_error: tuple[float, float, float] = (0.0, 0.0, 0.0)  # --sim-start-error, theta in radians
+    bumps: tuple[tuple[float, float, float, float], ...] = ()  # --sim-bump, theta in radians
+    pose_noise: tuple[float, float] = (0.0, 0.0)  # --sim-pose-noise, theta in radians
+    closed_loop: bool = False  # --closed-loop
 
 
 def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
@@ -234,6 +252,10 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         from .execution.mujoco_sim import support_centre
 
         support_centre(scene, args.sim_cf_offset)
+    if args.sim_start_error is not None:  # found now; the rest (the pusher's lead-in, the bumps) once planned
+        moved = scene.start + _radians(args.sim_start_error)
+        if (fault := placement_fault(scene.slider, scene.obstacles, scene.workspace, moved)) is not None:
+            raise SceneError("--sim-start-error", f"puts the part where it cannot be: {fault}")
     # The search, the one-step check, the recording and verify's check of lifts all read the
     # options from the scene as planned.
     scene = scene.with_options(options_of(args, scene.planner))
@@ -260,7 +282,19 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
                   None if args.engine is None and args.jobs is None else (args.engine or "local", args.jobs, args.address),
                   args.trajectory, args.simulate,
                   args.sim_mu, tuple(args.sim_cf_offset or (0.0, 0.0)), None if args.mjcf is None else Path(args.mjcf),
-                  None if args.export_scene is None else Path(args.export_scene))
+                  None if args.export_scene is None else Path(args.export_scene),
+                  _radians(args.sim_start_error or (0.0, 0.0, 0.0)),
+                  tuple(_radians(b) for b in args.sim_bump or ()), _radians(args.sim_pose_noise or (0.0, 0.0)),
+                  args.closed_loop)
+
+
+def _radians(values: Sequence[float]) -> tuple[float, ...]:
+    """The flag's values with the last, in degrees, in radians.
+
+    >>> _radians([0.02, 0.0, 90.0])
+    (0.02, 0.0, 1.5707963267948966)
+    """
+    return (*map(float, values[:-1]), math.radians(values[-1]))
 
 
 #: The flag of each planner option (:class:`~planner.model.options.PlannerOptions`' fields).
@@ -270,10 +304,11 @@ FLAGS = {"name": "--planner", "time_limit": "--time-limit", "seed": "--seed", "r
 
 #: The arguments the library names as fields (its errors never name a flag), with their flags
 #: (the options' are :data:`FLAGS`, turned by :func:`options_of`: ``name`` is also a scene's field).
-ARGUMENTS = {"seed": "--seed", "cf_offset": "--sim-cf-offset",
+ARGUMENTS = {"seed": "--seed", "cf_offset": "--sim-cf-offset", "start_error": "--sim-start-error",
+             "bump": "--sim-bump", "pose_noise": "--sim-pose-noise",
              **{name: f"--{name.replace('_', '-')}" for name in
                 ("engine", "jobs", "address", "out", "seeds", "resume", "simulate", "verify", "reach",
-                 "trajectory", "sim_mu", "sim_cf_offset", "mjcf")}}
+                 "trajectory", "sim_mu", "sim_cf_offset", "mjcf", "closed_loop")}}
 
 
 def flag_of(field: str) -> str:
@@ -297,11 +332,21 @@ def options_of(args: argparse.Namespace, options: PlannerOptions) -> PlannerOpti
 
 def _check_simulation(args: argparse.Namespace) -> None:
     """Refuse the simulation flags without ``--simulate``, bad values, and ``--simulate`` without MuJoCo."""
-    for flag, value in (("--sim-mu", args.sim_mu), ("--sim-cf-offset", args.sim_cf_offset), ("--mjcf", args.mjcf)):
+    for flag, value in (("--sim-mu", args.sim_mu), ("--sim-cf-offset", args.sim_cf_offset), ("--mjcf", args.mjcf),
+                        ("--sim-start-error", args.sim_start_error), ("--sim-bump", args.sim_bump),
+                        ("--sim-pose-noise", args.sim_pose_noise), ("--closed-loop", args.closed_loop or None)):
         if value is not None and args.simulate is None:
             raise SceneError(flag, "needs --simulate N")
     if args.simulate is None:
         return
+    for flag, values in (("--sim-start-error", args.sim_start_error), ("--sim-pose-noise", args.sim_pose_noise),
+                         *(("--sim-bump", b) for b in args.sim_bump or ())):
+        if values is not None and not all(abs(v) < float("inf") for v in values):
+            raise SceneError(flag, f"must be finite, got {' '.join(map(str, values))}")
+    if args.sim_pose_noise is not None and min(args.sim_pose_noise) < 0:
+        raise SceneError("--sim-pose-noise", f"standard deviations must be >= 0, got {' '.join(map(str, args.sim_pose_noise))}")
+    if any(b[0] < 0 for b in args.sim_bump or ()):
+        raise SceneError("--sim-bump", "a bump's time must be >= 0")
     if args.simulate < 1:
         raise SceneError("--simulate", f"must be at least 1 distribution, got {args.simulate}")
     if args.sim_mu is not None and not 0 < args.sim_mu < float("inf"):
@@ -391,7 +436,17 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
     if inputs.simulate and result.solved:
         from .execution.mujoco_sim import simulate  # MuJoCo is loaded only for --simulate
 
-        simulation = simulate(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset)
+        if inputs.closed_loop:
+            from .execution.closed_loop import closed_loop
+            from .queries.session import Planner
+
+            session = Planner(scene)
+            session.plan(start=result.start, seed=seed)  # a plan for the goal that re-plans are joined to
+            simulation = closed_loop(session, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset,
+                                     inputs.start_error, inputs.bumps, inputs.pose_noise)
+        else:
+            simulation = simulate(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset,
+                                  inputs.start_error, inputs.bumps)
     reach = None
     if inputs.reach:  # after planning: the map is about the start, whatever the plan
         if inputs.engine is None:
@@ -404,7 +459,8 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
             reach = reachable_set_on(scene, inputs.reach, *inputs.engine)
     if inputs.export_scene is not None:
         _export_scene(scene, inputs)
-    _write_outputs(out, scene, result, check, reach, motion, write_recording, simulation, inputs.mjcf)
+    _write_outputs(out, scene, result, check, reach, motion, write_recording, simulation, inputs.mjcf,
+                   inputs.closed_loop)
     if unreachable:
         print(f"plan: unreachable: {unreachable} (outputs in {out})", file=sys.stderr)
         return 2
@@ -415,7 +471,8 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
             if inputs.given is not None
             else f"solved: {result.headline()}, "
                  f"planning time {result.planning_time_s:.2f} s{_first_found(result)}")
-    extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{f', {scene.name}-reach.png' if reach else ''}"
+    executed = motion is not None and inputs.closed_loop and simulation is not None
+    extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{f', {scene.name}.executed.csv' if executed else ''}{f', {scene.name}-reach.png' if reach else ''}"
     lines = [f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}"]
     if check is not None:
         lines += [*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]
@@ -466,16 +523,21 @@ def _fresh_folder(base: Path) -> Path:
 
 def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | None, reach,
                    motion: Trajectory | None, write_recording: Callable[..., None],
-                   simulation: Simulation | None = None, mjcf: Path | None = None) -> None:
+                   simulation: Simulation | ClosedLoop | None = None, mjcf: Path | None = None,
+                   closed: bool = False) -> None:
     """Write the recording (with ``check``'s ghost, ``reach``'s map and ``simulation``'s worst run,
     by ``write_recording``), ``reach``'s PNG and the trajectory ``motion``'s CSV if given, the MJCF
     of ``simulation``'s first run to ``mjcf`` if both are given, and the plan JSON into ``out``,
     creating it if need be. The plan file comes last: where it is, the run wrote everything. A new
-    ``out`` appears with all of them at once (:func:`~planner.model.files.staged_folder`)."""
+    ``out`` appears with all of them at once (:func:`~planner.model.files.staged_folder`). A closed
+    loop's runs (``closed``) are not in the recording (their plans change as they go); with
+    ``motion``, its first run's executed pusher path is written beside it, ``<name>.executed.csv``."""
     stage = out
     try:
         with staged_folder(out) as stage:
-            write_recording(stage / f"{scene.name}.rrd", scene, result, check, reach, simulation)
+            # The recording shows an open-loop run against its plan; a closed loop's plans change.
+            shown_run = None if closed else simulation
+            write_recording(stage / f"{scene.name}.rrd", scene, result, check, reach, shown_run)
             if reach is not None:
                 from .queries.reachable_set import write_png
 
@@ -483,6 +545,8 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
                     write_png(reach, scene, str(tmp))
             if motion is not None:
                 motion.write_csv(stage / f"{scene.name}.trajectory.csv")
+                if closed and simulation is not None:
+                    simulation.write_executed(stage / f"{scene.name}.executed.csv")
             if simulation is not None and mjcf is not None:
                 simulation.write_mjcf(_within(mjcf, out, stage), scene)
             write_atomic(stage / f"{scene.name}.json", result.to_json())

@@ -64,15 +64,17 @@ from mechanics import relative_pose, transform_points, wrap_angle
 from mechanics.quasistatic import grid_support, tripod_supports
 
 from ..actions.transit import edge_contact_pose
-from ..model.bodies import convex_pieces, pusher_frame_body
+from ..model.bodies import convex_pieces, pusher_frame_body, slider_at
 from ..model.fields import SceneError
 from ..model.files import write_atomic
-from ..model.plan_file import Plan
-from ..model.scene import Scene
-from .trajectory import Trajectory, trajectory
+from ..model.plan_file import Plan, Transit
+from ..model.scene import Scene, placement_fault
+from ..world.validity import CollisionModel
+from .approach import first_edge, lead_in_pose
+from .trajectory import Trajectory, planned_part, trajectory
 
 __all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Simulation", "feet", "mjcf", "needs_mujoco",
-           "simulate", "support_centre", "write_mjcf"]
+           "World", "perturbations", "simulate", "support_centre", "write_mjcf"]
 
 #: The one line ``plan --simulate`` prints (after ``plan: error: --simulate: ``) without MuJoCo.
 MISSING = "needs MuJoCo: pip install 'stablepush[mujoco]'"
@@ -90,6 +92,8 @@ PUSHER_MASS = 1000.0
 SETTLE = 0.1
 #: Feet of a grid distribution (about).
 GRID_FEET = 9
+#: Step by which a knocked part is moved off the pusher, m.
+BUMP_STEP = 0.0002
 
 
 @dataclass(frozen=True)
@@ -345,7 +349,7 @@ class Simulation:
     runs: tuple[Run, ...]
     mu: float
     motion: Trajectory
-    start: np.ndarray  # the plan's start, where the part is placed
+    start: np.ndarray  # where the part is placed: the plan's start, moved by any start error
     planned: np.ndarray  # the planned part pose at each of motion's samples
 
     #: Seconds between the keyframes :meth:`write_mjcf` writes along the run.
@@ -380,82 +384,184 @@ class Simulation:
                 f"{sum(r.seconds for r in self.runs):.1f} s")
 
 
-def _planned_part(scene: Scene, plan: Plan, motion: Trajectory) -> np.ndarray:
-    """The planned part pose at each trajectory sample (module docstring)."""
-    out = np.empty((len(motion.t), 3))
-    pusher = np.column_stack([motion.x, motion.y, motion.theta])
-    for k, segment in enumerate(plan.segments):
-        rows = motion.segment == k
-        if segment.kind == "transit":
-            out[rows] = segment.start
-            continue
-        local = edge_contact_pose(scene.slider, segment.edge, np.zeros(3))  # pusher frame in the slider frame
-        theta = pusher[rows, 2] - local[2]
-        c, s = np.cos(theta), np.sin(theta)
-        out[rows, 0] = pusher[rows, 0] - (c * local[0] - s * local[1])
-        out[rows, 1] = pusher[rows, 1] - (s * local[0] + c * local[1])
-        out[rows, 2] = wrap_angle(theta)
-    return out
+class World:
+    """One run's MuJoCo model and data: the part placed at ``start``, the pusher driven by a
+    function of the run's clock ``u`` (seconds since the pusher began to move, after
+    :data:`SETTLE`), and the bumps ``(T, dx, dy, dtheta)`` applied when ``u`` passes ``T``."""
+
+    def __init__(self, scene: Scene, support: Feet, mu: float | None, start: np.ndarray, bumps: tuple = ()):
+        import mujoco  # only when simulating: a plan run without --simulate never loads it
+
+        self.mujoco = mujoco
+        self.model = mujoco.MjModel.from_xml_string(mjcf(scene, support, mu, start))
+        self.data = mujoco.MjData(self.model)
+        mujoco.mj_resetDataKeyframe(self.model, self.data, self.model.key("start").id)
+        self.own = {self.model.geom(f"part{j}").id for j in range(len(convex_pieces(scene.slider.polygon)))}
+        self.part = self.model.joint("part_x").qposadr[0] + np.arange(3)
+        self.part_speed = self.model.joint("part_x").dofadr[0] + np.arange(3)
+        self.blocks = {self.model.geom(i).id for i in range(self.model.ngeom)
+                       if self.model.geom(i).name.startswith(("wall", "obstacle"))}
+        self.qpos = self.model.joint("pusher_x").qposadr[0] + np.arange(4)
+        self.qvel = self.model.joint("pusher_x").dofadr[0] + np.arange(4)
+        self.bumps = sorted(bumps)
+        self.outline = scene.slider.polygon
+        self.pusher = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
+
+    def step_to(self, t: float, pusher) -> None:
+        """Step to ``t`` (MuJoCo's clock), the pusher set before every step to ``pusher(u)``:
+        ``(x, y, z, theta)`` and their rates; at rest before ``u = 0``."""
+        data = self.data
+        while data.time < t - TIMESTEP / 2:
+            u = data.time - SETTLE
+            pose, rate = pusher(max(u, 0.0))
+            data.qpos[self.qpos] = pose
+            data.qvel[self.qvel] = rate if u >= 0 else 0.0
+            while self.bumps and self.bumps[0][0] <= u:
+                # A knock: the part is where it was moved to, at rest, and not into the pusher,
+                # which is rigid: a knock towards it leaves the part against its face.
+                data.qpos[self.part] = self._off_pusher(data.qpos[self.part] + self.bumps.pop(0)[1:], pose)
+                data.qvel[self.part_speed] = 0.0
+            self.mujoco.mj_step(self.model, data)
+
+    def _off_pusher(self, part: np.ndarray, pusher: ArrayLike) -> np.ndarray:
+        """``part`` moved along the pusher's +x, by :data:`BUMP_STEP` steps, until it is off the
+        pusher's body at ``pusher`` (``x, y, z, theta``); as it is if the pusher is lifted."""
+        x, y, z, theta = pusher
+        body = slider_at(self.pusher, [x, y, theta])
+        along = np.array([math.cos(theta), math.sin(theta), 0.0])
+        moved = part.copy()
+        while z < THICKNESS and slider_at(self.outline, moved).intersects(body) and np.linalg.norm(moved - part) < 0.1:
+            moved = moved + BUMP_STEP * along
+        return moved
+
+    def pose(self) -> np.ndarray:
+        return self.data.qpos[self.part].copy()
+
+    def colliding(self) -> bool:
+        """The part touches a wall or an obstacle."""
+        return any(c.dist < 0 and ({c.geom1, c.geom2} & self.blocks) and ({c.geom1, c.geom2} & self.own)
+                   for c in self.data.contact[:self.data.ncon])
 
 
-def _run(scene: Scene, plan: Plan, motion: Trajectory, planned: np.ndarray, support: Feet, mu: float | None) -> Run:
-    import mujoco  # only when simulating: a plan run without --simulate never loads it
-
-    clock = time.perf_counter()
-    model = mujoco.MjModel.from_xml_string(mjcf(scene, support, mu, plan.start))
-    data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, model.key("start").id)
-    own = {model.geom(f"part{j}").id for j in range(len(convex_pieces(scene.slider.polygon)))}
-    part = model.joint("part_x").qposadr[0] + np.arange(3)
-    blocks = {model.geom(i).id for i in range(model.ngeom) if model.geom(i).name.startswith(("wall", "obstacle"))}
-    theta = np.unwrap(motion.theta)
-    # The pusher's joints are set to the trajectory before every step, position and velocity:
-    # its velocity is what the contact's friction sees (a mocap body's would be zero).
-    path = np.column_stack([motion.x, motion.y, motion.z, theta])
+def _follower(motion: Trajectory):
+    """``u -> (pusher qpos, qvel)`` along ``motion`` (linear interpolation between its samples)."""
+    path = np.column_stack([motion.x, motion.y, motion.z, np.unwrap(motion.theta)])
     speed = np.column_stack([motion.vx, motion.vy, np.gradient(motion.z, motion.t) if len(motion.t) > 1
                              else np.zeros(1), motion.omega])
-    qpos = model.joint("pusher_x").qposadr[0] + np.arange(4)
-    qvel = model.joint("pusher_x").dofadr[0] + np.arange(4)
-    times = motion.t + SETTLE
+
+    def at(u: float) -> tuple[list[float], list[float]]:
+        return ([np.interp(u, motion.t, column) for column in path.T],
+                [np.interp(u, motion.t, column) for column in speed.T])
+
+    return at
+
+
+def _run(scene: Scene, plan: Plan, motion: Trajectory, planned: np.ndarray, support: Feet, mu: float | None,
+         start: np.ndarray, lead: Trajectory, bumps: tuple) -> Run:
+    clock = time.perf_counter()
+    world = World(scene, support, mu, start, bumps)
+    led, follow = _follower(lead), _follower(motion)
+
+    def pusher(u: float):
+        return led(u) if u < lead.duration else follow(u - lead.duration)
+
+    times = motion.t + SETTLE + lead.duration
     poses = np.empty((len(times), 3))
     collisions = 0
     slips, starts = np.zeros(len(plan.segments)), {}
-    for i, t in enumerate(np.concatenate([[0.0], times])):
-        while data.time < t - TIMESTEP / 2:
-            u = data.time - SETTLE
-            data.qpos[qpos] = [np.interp(u, motion.t, column) for column in path.T]
-            data.qvel[qvel] = [np.interp(u, motion.t, column) for column in speed.T] if u >= 0 else 0.0
-            mujoco.mj_step(model, data)
-        if i == 0:
-            continue
-        row = i - 1
-        poses[row] = data.qpos[part]
-        contacts = data.contact[:data.ncon]
-        collisions += any(c.dist < 0 and ({c.geom1, c.geom2} & blocks) and ({c.geom1, c.geom2} & own)
-                          for c in contacts)
+    world.step_to(SETTLE + lead.duration, pusher)
+    for row, t in enumerate(times):
+        world.step_to(t, pusher)
+        poses[row] = world.pose()
+        collisions += world.colliding()
         if motion.contact[row]:
             # The face midpoint in the part frame, against where it was when this push began.
             face = relative_pose(poses[row], [motion.x[row], motion.y[row], motion.theta[row]])[:2]
             k = int(motion.segment[row])
-            start = starts.setdefault(k, face)
-            slips[k] = max(slips[k], float(np.linalg.norm(face - start)))
+            first = starts.setdefault(k, face)
+            slips[k] = max(slips[k], float(np.linalg.norm(face - first)))
     cf = scene.slider.cf[None]
     gap = np.linalg.norm(np.array([transform_points(cf, p)[0] for p in poses])
                          - np.array([transform_points(cf, p)[0] for p in planned]), axis=1)
     by_segment = [motion.segment == k for k in range(len(plan.segments))]
     end = poses[-1]
-
-    def error(target: np.ndarray) -> tuple[float, float]:
-        return math.hypot(end[0] - target[0], end[1] - target[1]), abs(float(wrap_angle(end[2] - target[2])))
-
     deviations = tuple(float(gap[rows].max(initial=0.0)) for rows in by_segment)
-    return Run(support, error(scene.goal), error(plan.final), float(gap.max()), float(slips.max(initial=0.0)),
-               collisions, scene.within_tolerance(end), time.perf_counter() - clock, float(motion.duration), poses,
-               deviations, tuple(float(v) for v in slips))
+    return Run(support, _error(end, scene.goal), _error(end, plan.final), float(gap.max()),
+               float(slips.max(initial=0.0)), collisions, scene.within_tolerance(end), time.perf_counter() - clock,
+               float(motion.duration + lead.duration), poses, deviations, tuple(float(v) for v in slips))
+
+
+def _error(end: np.ndarray, target: np.ndarray) -> tuple[float, float]:
+    return math.hypot(end[0] - target[0], end[1] - target[1]), abs(float(wrap_angle(end[2] - target[2])))
+
+
+def _lead_in(scene: Scene, plan: Plan, model: CollisionModel) -> Trajectory:
+    """The pusher's move from :func:`.approach.lead_in_pose` to the plan's first contact."""
+    edge = first_edge(plan)
+    contact = edge_contact_pose(scene.slider, edge, plan.start)
+    path = np.array([lead_in_pose(scene, model, plan), contact])
+    step = float(np.linalg.norm(path[1, :2] - path[0, :2]))
+    return trajectory(scene, Plan(scene=None, solved=True, planner=plan.planner, seed=plan.seed, planning_time_s=0.0,
+                                  start=plan.start, goal=plan.start,
+                                  segments=[Transit(edge, edge, "plane", path, step, np.asarray(plan.start, dtype=float))]))
+
+
+def perturbations(scene: Scene, plan: Plan, model: CollisionModel, start_error: ArrayLike = (0.0, 0.0, 0.0),
+                  bumps: ArrayLike = (), noise: ArrayLike = (0.0, 0.0)) -> tuple[np.ndarray, tuple, Trajectory,
+                                                                                 Trajectory]:
+    """Check a run's perturbations against ``plan`` and return the part's actual start, the bumps
+    as ``(T, dx, dy, dtheta)`` tuples in time order, the lead-in and the plan's trajectory.
+
+    ``start_error`` ``(dx, dy, dtheta)`` (m, m, rad, world frame) moves the part off the plan's
+    start; each bump ``(T, dx, dy, dtheta)`` displaces it at ``T`` seconds after the pusher
+    begins to move (its lead-in included) by that much; ``noise`` ``(sigma_m, sigma_rad)`` is on
+    what a closed loop observes.
+
+    Raises
+    ------
+    SceneError
+        Naming ``start_error``, ``bump`` (and which, if several) or ``pose_noise``: a value not finite, negative noise, a
+        bump time outside the run, a perturbed part outside the workspace, on an obstacle or (at
+        the start) on the pusher.
+    """
+    error = np.asarray(start_error, dtype=float)
+    if error.shape != (3,) or not np.isfinite(error).all():
+        raise SceneError("start_error", f"must be three finite numbers (dx, dy, dtheta), got {np.ravel(error).tolist()}")
+    sigma = np.asarray(noise, dtype=float)
+    if sigma.shape != (2,) or not np.isfinite(sigma).all() or (sigma < 0).any():
+        raise SceneError("pose_noise", f"must be two finite standard deviations >= 0, got {np.ravel(sigma).tolist()}")
+    start = np.asarray(plan.start, dtype=float) + error
+    start[2] = wrap_angle(start[2])
+    fault = placement_fault(scene.slider, scene.obstacles, scene.workspace, start)
+    lead = _lead_in(scene, plan, model)
+    pusher = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
+    if fault is None and slider_at(pusher, [lead.x[0], lead.y[0], lead.theta[0]]).intersects(
+            slider_at(scene.slider.polygon, start)):
+        fault = "the part is on the pusher where it starts"
+    if fault:
+        raise SceneError("start_error", f"puts the part where it cannot be: {fault}")
+    motion = trajectory(scene, plan)
+    planned = planned_part(scene, plan, motion)
+    rows = np.asarray(bumps, dtype=float).reshape(-1, 4) if len(bumps) else np.zeros((0, 4))
+    out = []
+    for k, (t, dx, dy, dtheta) in enumerate(rows):
+        name, which = "bump", f"bump {k + 1}: " if len(rows) > 1 else ""
+        if not np.isfinite(rows[k]).all():
+            raise SceneError(name, f"{which}must be four finite numbers (T, dx, dy, dtheta), got {rows[k].tolist()}")
+        if not 0 <= t <= lead.duration + motion.duration:
+            raise SceneError(name, f"{which}time {t:g} s is outside the run (0 to {lead.duration + motion.duration:.2f} s)")
+        at = planned[min(int(np.searchsorted(motion.t, t - lead.duration)), len(planned) - 1)] if t > lead.duration \
+            else start
+        moved = at + [dx, dy, dtheta]
+        if (fault := placement_fault(scene.slider, scene.obstacles, scene.workspace, moved)) is not None:
+            raise SceneError(name, f"{which}puts the part where it cannot be (where the plan has it at {t:g} s): {fault}")
+        out.append((float(t), float(dx), float(dy), float(dtheta)))
+    return start, tuple(sorted(out)), lead, motion
 
 
 def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
-             cf_offset: ArrayLike = (0.0, 0.0)) -> Simulation:
+             cf_offset: ArrayLike = (0.0, 0.0), start_error: ArrayLike = (0.0, 0.0, 0.0),
+             bumps: ArrayLike = ()) -> Simulation:
     """Run ``plan`` open-loop in MuJoCo once per foot set of :func:`feet` (module docstring).
 
     Parameters
@@ -470,6 +576,10 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
         Pusher-part friction to simulate with; default the planned ``scene.pusher.mu``.
     cf_offset : (2,) array_like
         Moves the support's centre of pressure from the CF, slider frame (m).
+    start_error, bumps : array_like
+        The part's start off the plan's, and knocks during the run (:func:`perturbations`).
+
+    Every run begins with the pusher behind the first contact, moving in (:func:`.approach.lead_in_pose`).
 
     Returns
     -------
@@ -478,11 +588,13 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
     Raises
     ------
     SceneError
-        If MuJoCo is missing (:data:`MISSING`) or the offset centre is off the part.
+        If MuJoCo is missing (:data:`MISSING`), the offset centre is off the part, or a
+        perturbation is bad (:func:`perturbations`).
     """
     needs_mujoco()
     supports = feet(scene, n, seed, cf_offset)
-    motion = trajectory(scene, plan)
-    planned = _planned_part(scene, plan, motion)
-    return Simulation(tuple(_run(scene, plan, motion, planned, s, mu) for s in supports),
-                      scene.pusher.mu if mu is None else mu, motion, np.asarray(plan.start, dtype=float), planned)
+    start, knocks, lead, motion = perturbations(scene, plan, CollisionModel(scene, scene.pusher.edges), start_error,
+                                                bumps)
+    planned = planned_part(scene, plan, motion)
+    return Simulation(tuple(_run(scene, plan, motion, planned, s, mu, start, lead, knocks) for s in supports),
+                      scene.pusher.mu if mu is None else mu, motion, start, planned)

@@ -66,7 +66,7 @@ from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene
 
 __all__ = ["COLUMNS", "LIFT_HEIGHT", "MAX_ACCEL", "MAX_JERK", "MAX_SPEED", "RATE", "Trajectory", "path_limits",
-           "trajectory"]
+           "planned_part", "trajectory"]
 
 #: Default limits for every point of the pusher body: m/s, m/s^2, m/s^3 (quasi-static, above).
 MAX_SPEED, MAX_ACCEL, MAX_JERK = 0.05, 0.5, 5.0
@@ -291,3 +291,22 @@ def trajectory(scene: Scene, plan: Plan, max_speed: float = MAX_SPEED, max_accel
         out[rows, 9] = piece.segment
         progress[rows] = piece.clock + piece.pace * s
     return Trajectory(*out[:, :8].T, out[:, 8].astype(int), out[:, 9].astype(int), progress)
+
+
+def planned_part(scene: Scene, plan: Plan, motion: Trajectory) -> np.ndarray:
+    """The part's planned pose at each sample of ``motion`` (``plan``'s trajectory): during a push,
+    the pusher frame's pose times the inverse of the contact pose; in a transit, where the part was left."""
+    out = np.empty((len(motion.t), 3))
+    pusher = np.column_stack([motion.x, motion.y, motion.theta])
+    for k, segment in enumerate(plan.segments):
+        rows = motion.segment == k
+        if segment.kind == "transit":
+            out[rows] = segment.start
+            continue
+        local = edge_contact_pose(scene.slider, segment.edge, np.zeros(3))  # pusher frame in the slider frame
+        theta = pusher[rows, 2] - local[2]
+        c, s = np.cos(theta), np.sin(theta)
+        out[rows, 0] = pusher[rows, 0] - (c * local[0] - s * local[1])
+        out[rows, 1] = pusher[rows, 1] - (s * local[0] + c * local[1])
+        out[rows, 2] = wrap_angle(theta)
+    return out

@@ -26,7 +26,7 @@ from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vec
 from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
 from .yaml_file import read_yaml
 
-__all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene", "plain_scene",
+__all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene", "placement_fault", "plain_scene",
            "write_scene"]
 
 #: The keys of a scene's ``planner:`` block: the options but ``transit``, which is ``pusher.transit``.
@@ -331,13 +331,21 @@ def _pose(value: Any, name: str, slider: Slider, obstacles: tuple[shapely.Polygo
     LENGTH.check(x, f"{name}[0]")
     LENGTH.check(y, f"{name}[1]")
     pose = np.array([x, y, float(wrap_angle(math.radians(ANGLE.check(theta, f"{name}[2]"))))])
+    if (fault := placement_fault(slider, obstacles, workspace, pose)) is not None:
+        raise SceneError(name, fault)
+    return pose
+
+
+def placement_fault(slider: Slider, obstacles: tuple[shapely.Polygon, ...],
+                    workspace: tuple[float, float, float, float], pose: ArrayLike) -> str | None:
+    """Why the part cannot be at ``pose`` (outside the workspace, or on an obstacle), or None."""
     body = slider_at(slider.polygon, pose)
     if not shapely.box(*workspace).contains(body):
-        raise SceneError(name, "the part is not inside the workspace")
+        return "the part is not inside the workspace"
     for k, obstacle in enumerate(obstacles):
         if body.intersects(obstacle):
-            raise SceneError(name, f"the part collides with obstacle {k}")
-    return pose
+            return f"the part collides with obstacle {k}"
+    return None
 
 
 def parse_scene(data: Any, default_name: str = "scene", path: str | None = None) -> Scene:

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import time
 from collections import OrderedDict
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -147,7 +147,7 @@ class Planner:
 
     def plan(self, start: ArrayLike | None = None, goal: ArrayLike | None = None, *, seed: int | None = None,
              time_limit: float | None = None, optimize: int | None = None, planner: str | None = None,
-             reuse: bool = True) -> Plan:
+             reuse: bool = True, edges: Sequence[int] | None = None) -> Plan:
         """A plan of guaranteed-stable pushes from ``start`` to ``goal`` (``(x, y, theta)``,
         radians; default: the scene's).
 
@@ -155,7 +155,9 @@ class Planner:
         ``planner`` (``'rrt'``, ``'kpiece'`` or ``'est'``) default to the session's options. With
         ``reuse``, a plan this session found before for the same goal is tried first: the start
         joined to it by one or two pushes (module docstring). A plan is always solved or says why
-        not (``Plan.reason``); a start where the pusher has no room is bad input.
+        not (``Plan.reason``); a start where the pusher has no room is bad input. ``edges``, if
+        given, are the only edges the first push may be on (a robot re-planning with its pusher on
+        the part keeps it there; the plan may still switch, by a checked transit).
 
         Raises
         ------
@@ -166,15 +168,22 @@ class Planner:
         request = self._request(seed, time_limit, optimize, planner)
         start = self._pose(start, "start", self.scene.start)
         goal = self._pose(goal, "goal", self.scene.goal)
-        return self._plan(start, goal, request, time.perf_counter(), reuse)
+        if edges is not None and not all(isinstance(e, int) and e in self.scene.pusher.edges for e in edges):
+            raise SceneError("edges", f"must be allowed edges of the pusher {list(self.scene.pusher.edges)}, got {edges}")
+        return self._plan(start, goal, request, time.perf_counter(), reuse, edges)
 
     def _plan(self, start: np.ndarray, goal: np.ndarray, request: PlanRequest, clock: float,
-              reuse: bool = False) -> Plan:
+              reuse: bool = False, edges: Sequence[int] | None = None) -> Plan:
         if self._no_push is not None:
             raise self._no_push
         if self.world is None:
             return plan_result(self.scene, request, clock, start, goal, [], self._timeout)
         context = PlanningContext(self.world, request, start, clock)
+        if edges is not None:
+            context.starts = [k for k in context.starts if self.world.controls[k].edge in edges]
+            if not context.starts:
+                return plan_result(self.scene, request, clock, start, goal, [],
+                                   f"no stable push with room for the pusher at the start on edges {list(edges)}")
         key = tuple(goal.tolist())
         joined = self._joined(context, goal, self._plans.get(key, [])) if reuse else None
         found = joined or solve(context, goal)

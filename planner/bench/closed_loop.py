@@ -1,0 +1,130 @@
+"""Benchmark: perturbed runs in MuJoCo, open loop against closed loop (``plan --simulate
+--closed-loop``), with success rates and re-plan latencies.
+
+``python -m planner.bench.closed_loop scenes/*.yaml --cases 5`` plans each scene with seed 1 (one
+:class:`~planner.Planner` session per scene) and draws ``--cases`` perturbations per scene from
+``--seed``, cycling through the kinds:
+
+* ``start``: the part starts up to 15 mm and 8 degrees off the plan's start;
+* ``knock``: at a random time of the run the part is displaced by up to 25 mm and 10 degrees;
+* ``noisy``: a start error with 1 mm / 0.5 degree noise on the observed pose;
+* ``cf``: a start error with the centre of pressure 5 mm off the CF (the ``--sim-cf-offset`` runs);
+* ``slippery``: a start error with half the planned pusher friction (``--sim-mu``).
+
+A draw that puts the part on an obstacle or on the pusher is drawn again. Each case runs once
+open loop and once closed loop on the grid foot set; a row per case, then the totals: runs in the
+goal without touching a wall or obstacle (open loop: slip is not counted, a part met off its
+planned contact slides along the face by design), re-plans and their latency (median, max).
+Needs the mujoco extra.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+
+import numpy as np
+
+from ..execution.closed_loop import closed_loop
+from ..execution.mujoco_sim import simulate
+from ..model.fields import SceneError
+from ..model.scene import load_scene
+from ..queries.session import Planner
+
+__all__ = ["KINDS", "draw", "main"]
+
+KINDS = ("start", "knock", "noisy", "cf", "slippery")
+HEADER = ("| scene | case | open loop | closed loop | re-plans | latency (median, max) |\n"
+          "|---|---|---|---|---|---|")
+
+
+def draw(kind: str, rng: np.random.Generator, duration: float, mu: float) -> dict:
+    """The keyword arguments of one case of ``kind`` (module docstring) for a run of ``duration`` s."""
+    def offset(largest: float, degrees: float) -> list[float]:
+        angle, size = rng.uniform(0, 2 * math.pi), largest * math.sqrt(rng.uniform(0.25, 1.0))
+        return [size * math.cos(angle), size * math.sin(angle), math.radians(rng.uniform(-degrees, degrees))]
+
+    case = {"start_error": offset(0.015, 8.0)} if kind != "knock" else {
+        "bumps": [[rng.uniform(0.2, 0.8) * duration, *offset(0.025, 10.0)]]}
+    if kind == "noisy":
+        case["noise"] = (0.001, math.radians(0.5))
+    if kind == "cf":
+        case["cf_offset"] = offset(0.005, 0.0)[:2]
+    if kind == "slippery":
+        case["mu"] = mu / 2
+    return case
+
+
+def _shown(case: dict) -> str:
+    parts = []
+    if "start_error" in case:
+        dx, dy, dt = case["start_error"]
+        parts.append(f"start ({dx * 1e3:.0f}, {dy * 1e3:.0f}) mm {math.degrees(dt):.0f} deg")
+    for t, dx, dy, dt in case.get("bumps", []):
+        parts.append(f"knock at {t:.1f} s ({dx * 1e3:.0f}, {dy * 1e3:.0f}) mm {math.degrees(dt):.0f} deg")
+    if "noise" in case:
+        parts.append("noise 1 mm, 0.5 deg")
+    if "cf_offset" in case:
+        parts.append("CF off by 5 mm")
+    if "mu" in case:
+        parts.append(f"pusher mu {case['mu']:g}")
+    return ", ".join(parts)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m planner.bench.closed_loop", description=__doc__.splitlines()[0])
+    p.add_argument("scenes", nargs="+", help="scene files (YAML)")
+    p.add_argument("--cases", type=int, default=5, help="perturbations per scene (default 5, one of each kind)")
+    p.add_argument("--seed", type=int, default=1, help="seed of the draws (default 1)")
+    args = p.parse_args(argv)
+    rng = np.random.default_rng(args.seed)
+    print(HEADER, flush=True)
+    opened = closed = total = 0
+    latencies: list[float] = []
+    for path in args.scenes:
+        session = Planner(load_scene(path))
+        scene = session.scene
+        result = session.plan(seed=1)
+        if not result.solved:
+            print(f"| {scene.name} | not solved ({result.reason}) | | | | |", flush=True)
+            continue
+        duration = simulate(scene, result, 1).runs[0].simulated  # with its lead-in
+        for k in range(args.cases):
+            kind = KINDS[k % len(KINDS)]
+            for _ in range(50):
+                case = draw(kind, rng, duration, scene.pusher.mu)
+                noise = case.pop("noise", (0.0, 0.0))
+                try:
+                    open_run = simulate(scene, result, 1, **case).runs[0]
+                    closed_run = closed_loop(session, result, 1, noise=noise, **case).runs[0]
+                    break
+                except SceneError:  # the part on an obstacle or on the pusher: draw again
+                    continue
+            else:
+                print(f"| {scene.name} | {kind}: no free draw in 50 | | | | |", flush=True)
+                continue
+            case["noise"] = noise if noise != (0.0, 0.0) else None
+            total += 1
+            open_ok = open_run.in_goal and not open_run.collisions
+            opened += open_ok
+            closed += closed_run.passed
+            latencies += closed_run.latencies
+            timing = (f"{np.median(closed_run.latencies) * 1e3:.0f} ms, {max(closed_run.latencies) * 1e3:.0f} ms"
+                      if closed_run.latencies else "")
+            print(f"| {scene.name} | {kind}: {_shown({k: v for k, v in case.items() if v is not None})} "
+                  f"| {'ok' if open_ok else 'FAIL'} ({open_run.goal_error[0] * 1e3:.1f} mm"
+                  f"{', collides' if open_run.collisions else ''}) "
+                  f"| {'ok' if closed_run.passed else 'FAIL'} ({closed_run.goal_error[0] * 1e3:.1f} mm"
+                  f"{'; ' + closed_run.reason if closed_run.reason else ''}) | {len(closed_run.replans)} | {timing} |",
+                  flush=True)
+    if total:
+        timing = (f"re-plans {len(latencies)}, latency median {np.median(latencies) * 1e3:.0f} ms, "
+                  f"max {max(latencies) * 1e3:.0f} ms" if latencies else "no re-plans")
+        print(f"\nopen loop {opened}/{total} ({100 * opened / total:.0f} %), closed loop {closed}/{total} "
+              f"({100 * closed / total:.0f} %); {timing}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,321 @@
+"""Closing the loop: a plan followed against timed observations of the part, re-planned when the
+part is not where the plan expects it.
+
+A :class:`Tracker` is what a robot program runs beside its perception: it holds the plan being
+executed as a trajectory of the pusher (:func:`.trajectory.trajectory`, with the approach to the
+first contact in front, :func:`.approach.approach`) and the part's planned pose along it
+(:func:`.trajectory.planned_part`). :meth:`Tracker.pusher_at` says where the pusher should be at
+any time; :meth:`Tracker.observe` takes an observed part pose and says what to do.
+
+**When to re-plan.** The part's observed pose is compared with the planned one at the same time:
+the distance of the slider frame's origins and the wrapped heading difference. A lost contact
+shows the same way (the part stays behind while the plan moves on). The thresholds are
+
+* half the goal tolerance (position and angle): a stable push funnels smaller errors away (open
+  loop in MuJoCo, parts started up to a centimetre off mostly end inside the 1 cm tolerance,
+  ``python -m planner.bench.closed_loop``), and a plan joined from the observed pose is only as
+  good as that observation, so re-planning for less would chase the perception's noise;
+* at least :data:`SIGMAS` standard deviations of the observation noise: the chance that noise
+  alone exceeds 5 sigma is about 4e-6 per observation for the position (Rayleigh) and 6e-7 for
+  the heading (Gaussian);
+
+and an observation beyond them counts only when :data:`CONFIRM` consecutive ones are (a debounce:
+one outlier of the perception does not stop the robot). Then the pusher stops where it is
+(``'stop'`` commands) and the tracker takes :data:`SETTLE` more observations of the part at rest;
+their mean (the noise down by ``sqrt(SETTLE)``) is where it re-plans from, with the planner
+session, which joins that pose to the plan it remembers for the goal in milliseconds
+(:meth:`planner.Planner.plan`). At the plan's end the same mean decides: in the goal tolerance,
+``'done'``; else a re-plan.
+
+**Re-planning** asks first for a plan whose first push is on the edge the pusher is at (if it
+can come back to it), then for one beginning on an edge it has a free approach to.
+
+**Giving up.** When the goal is certified unreachable from the observed pose
+(:meth:`planner.Planner.certify_unreachable`), when the planner finds no plan from it, when the
+pusher has no free approach to any edge, or when the re-plans exceed the budget,
+the tracker gives up with the reason and holds the pusher where it is.
+
+Times are the caller's clock (seconds, increasing); poses ``(x, y, theta)`` in metres and radians.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from mechanics import wrap_angle
+
+from ..model.fields import SceneError, poses
+from ..model.plan_file import Plan, Transit
+from ..queries.session import Planner
+from .approach import approach, first_edge
+from .trajectory import Trajectory, planned_part, trajectory
+
+__all__ = ["BUDGET", "CONFIRM", "REPLAN_LIMIT", "FRACTION", "SETTLE", "SIGMAS", "Command", "Replan", "Tracker", "mean_pose"]
+
+#: Thresholds: this fraction of the goal tolerance, and at least this many noise deviations.
+FRACTION, SIGMAS = 0.5, 5.0
+#: Consecutive observations beyond the thresholds that make a deviation (the debounce).
+CONFIRM = 3
+#: Observations of the part at rest averaged before a re-plan or the final check.
+SETTLE = 5
+#: Re-plans allowed in one run.
+BUDGET = 8
+#: Default time limit of a re-plan's search, s: a robot waits that long at most (a join to the
+#: remembered plan takes tens of milliseconds; a search on the shipped scenes well under a second).
+REPLAN_LIMIT = 2.0
+
+
+@dataclass(frozen=True)
+class Command:
+    """What the pusher should do after an observation.
+
+    ``kind``: ``'follow'`` (go on along the plan), ``'stop'`` (hold still while the part is
+    observed at rest), ``'replan'`` (``plan`` is the new plan, the pusher now approaches its first
+    contact), ``'done'`` (the part is in the goal) or ``'give_up'`` (``reason`` says why).
+    ``pusher`` is where the pusher frame should be now ``(x, y, theta)``, ``height`` its height
+    above the table (a lift's flight), ``contact`` whether it should be pushing, ``error`` the
+    observed part's distance (m) and heading difference (rad) from its planned pose."""
+
+    kind: Literal["follow", "stop", "replan", "done", "give_up"]
+    pusher: np.ndarray
+    height: float
+    contact: bool
+    error: tuple[float, float]
+    plan: Plan | None = None
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class Replan:
+    """One re-plan: when (the caller's clock), from which observed pose (the mean of the settled
+    observations), what triggered it (``trigger``: the observation that confirmed the deviation,
+    and its error), how long the planning took (s) and what it gave."""
+
+    time: float
+    start: np.ndarray
+    trigger: np.ndarray
+    error: tuple[float, float]
+    why: str
+    latency: float
+    plan: Plan
+
+
+def mean_pose(rows: ArrayLike) -> np.ndarray:
+    """The mean of poses ``(x, y, theta)``: positions averaged, headings by their unit vectors.
+
+    >>> mean_pose([[0.0, 0.0, math.pi - 0.1], [1.0, 2.0, -math.pi + 0.1]]).round(12).tolist()
+    [0.5, 1.0, -3.14159265359]
+    """
+    rows = np.asarray(rows, dtype=float)
+    heading = math.atan2(float(np.sin(rows[:, 2]).mean()), float(np.cos(rows[:, 2]).mean()))
+    return np.array([*rows[:, :2].mean(axis=0), float(wrap_angle(heading))])
+
+
+class Tracker:
+    """Follows ``plan`` (solved, for ``session``'s scene) against observations of the part
+    (module docstring).
+
+    Parameters
+    ----------
+    session : Planner
+        The planning session of the scene: re-plans and certificates come from it.
+    plan : Plan
+        The plan to execute, from where the part is believed to be.
+    pusher : (3,) array_like
+        Where the pusher frame is when the run begins (the tracker approaches the first contact
+        from there); default: on the first contact.
+    time : float
+        The caller's clock when the run begins.
+    noise : (float, float)
+        Standard deviations of the observations: position (m, per axis) and heading (rad).
+    confirm, settle, budget : int
+        :data:`CONFIRM`, :data:`SETTLE`, :data:`BUDGET`.
+    seed : int, optional
+        The re-plans' seed (default: the session's).
+    time_limit : float
+        Each re-plan's search time limit, s (:data:`REPLAN_LIMIT`).
+
+    Raises
+    ------
+    SceneError
+        Naming the argument at fault.
+
+    Examples
+    --------
+    >>> from planner import load_scene
+    >>> session = Planner(load_scene("scenes/battery.yaml"))
+    >>> tracker = Tracker(session, session.plan(seed=1))
+    >>> tracker.observe(0.0, session.scene.start).kind, tracker.replans
+    ('follow', [])
+    """
+
+    def __init__(self, session: Planner, plan: Plan, *, pusher: ArrayLike | None = None, time: float = 0.0,
+                 noise: tuple[float, float] = (0.0, 0.0), confirm: int = CONFIRM, settle: int = SETTLE,
+                 budget: int = BUDGET, seed: int | None = None, time_limit: float = REPLAN_LIMIT):
+        if not isinstance(session, Planner):
+            raise SceneError("session", f"must be a Planner, got {type(session).__name__}")
+        if not (isinstance(plan, Plan) and plan.solved and plan.segments):
+            raise SceneError("plan", "must be a solved plan with at least one segment")
+        if not (len(noise) == 2 and all(0 <= float(v) < math.inf for v in noise)):
+            raise SceneError("noise", f"must be two finite standard deviations >= 0, got {noise}")
+        for name, value in (("confirm", confirm), ("settle", settle), ("budget", budget)):
+            if not (isinstance(value, int) and value >= (0 if name == "budget" else 1)):
+                raise SceneError(name, f"must be an integer >= {0 if name == 'budget' else 1}, got {value!r}")
+        self.session, self.scene = session, session.scene
+        scene = self.scene
+        #: Position (m) and heading (rad) thresholds.
+        self.threshold = (max(FRACTION * scene.tolerance_position, SIGMAS * float(noise[0])),
+                          max(FRACTION * scene.tolerance_angle, SIGMAS * float(noise[1])))
+        if not 0 < float(time_limit) < math.inf:
+            raise SceneError("time_limit", f"must be a positive number of seconds, got {time_limit}")
+        self.confirm, self.settle, self.budget, self.seed = confirm, settle, budget, seed
+        self.time_limit = min(float(time_limit), session.options.time_limit)
+        #: The re-plans so far.
+        self.replans: list[Replan] = []
+        self.reason = ""  # why the tracker gave up
+        self.done = False
+        self._strikes = 0
+        self._trigger: tuple[np.ndarray, tuple[float, float], str] | None = None
+        self._window: list[np.ndarray] = []
+        self._held: tuple[np.ndarray, float] | None = None
+        start = self._pose(plan.start, "plan.start")
+        first = self._begin(plan, self._pose(pusher, "pusher") if pusher is not None else None, start, float(time))
+        if first:
+            raise SceneError("pusher", first)
+
+    @staticmethod
+    def _pose(value: ArrayLike, name: str) -> np.ndarray:
+        rows = poses(value, name)
+        if len(rows) != 1:
+            raise SceneError(name, f"must be one pose (x, y, theta), got {len(rows)}")
+        return rows[0]
+
+    def _begin(self, plan: Plan, pusher: np.ndarray | None, part: np.ndarray, now: float) -> str:
+        """Follow ``plan`` from ``now``, the pusher first approaching its first contact from
+        ``pusher`` (if given); the reason if there is no free approach."""
+        segments = list(plan.segments)
+        if pusher is not None:
+            way = self._approach(pusher, part, first_edge(plan))
+            if way is None:
+                return "no free approach from the pusher to the plan's first contact"
+            segments.insert(0, way)
+        self.plan, self._segments = plan, segments
+        led = replace(plan, segments=segments)
+        self.motion: Trajectory = trajectory(self.scene, led)
+        self.expected = planned_part(self.scene, led, self.motion)
+        self._theta = np.unwrap(self.motion.theta)
+        self._since = now
+        self._strikes, self._held = 0, None
+        return ""
+
+    def _approach(self, pusher: np.ndarray, part: np.ndarray, edge: int) -> Transit | None:
+        world = self.session.world
+        edges = [c.edge for c in world.controls] if world is not None else []
+        return approach(self.scene, self.session.model, world.transits if world is not None else None, pusher, part,
+                        edge, edges)
+
+    def pusher_at(self, now: float) -> tuple[np.ndarray, float, np.ndarray, bool]:
+        """Where the pusher frame should be at ``now``: pose ``(x, y, theta)`` (theta unwrapped along
+        the plan), height, velocity ``(vx, vy, omega, vz)`` and whether it should be pushing."""
+        if self._held is not None:
+            pose, height = self._held
+            return pose.copy(), height, np.zeros(4), False
+        m, u = self.motion, now - self._since
+        column = [np.interp(u, m.t, c) for c in (m.x, m.y, self._theta, m.z, m.vx, m.vy, m.omega)]
+        k = min(int(np.searchsorted(m.t, u)), len(m.t) - 1)
+        rise = np.interp(u, m.t, np.gradient(m.z, m.t)) if len(m.t) > 1 else 0.0
+        return np.array(column[:3]), float(column[3]), np.array([*column[4:], rise]), bool(m.contact[k])
+
+    def _command(self, kind: str, now: float, error: tuple[float, float], plan: Plan | None = None) -> Command:
+        pose, height, _, contact = self.pusher_at(now)
+        return Command(kind, pose, height, contact, error, plan, self.reason)
+
+    def _stop(self, now: float) -> None:
+        pose, height, _, _ = self.pusher_at(now)
+        k = min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
+        self._edge = self._segments[int(self.motion.segment[k])].edge
+        self._held, self._window = (pose, height), []
+
+    def error(self, now: float, pose: np.ndarray) -> tuple[float, float]:
+        """The distance (m) and heading difference (rad) of ``pose`` from the part's planned pose at ``now``."""
+        u = now - self._since
+        k = min(int(np.searchsorted(self.motion.t, u)), len(self.motion.t) - 1)
+        planned = self.expected[k]
+        return math.hypot(*(pose[:2] - planned[:2])), abs(float(wrap_angle(pose[2] - planned[2])))
+
+    def observe(self, now: float, pose: ArrayLike) -> Command:
+        """Take the part's observed pose at ``now`` and say what the pusher does (module docstring).
+
+        Raises
+        ------
+        SceneError
+            If ``pose`` is not one finite pose.
+        """
+        pose = self._pose(pose, "pose")
+        now = float(now)
+        error = self.error(now, pose)
+        if self.done or self.reason:
+            return self._command("done" if self.done else "give_up", now, error)
+        if self._held is not None:
+            self._window.append(pose)
+            if len(self._window) < self.settle:
+                return self._command("stop", now, error)
+            return self._settled(now, mean_pose(self._window), error)
+        beyond = error[0] > self.threshold[0] or error[1] > self.threshold[1]
+        self._strikes = self._strikes + 1 if beyond else 0
+        ended = now - self._since >= self.motion.duration
+        if self._strikes >= self.confirm or ended:
+            why = "the plan ended" if ended and self._strikes < self.confirm else (
+                f"off the plan by {error[0] * 1000:.1f} mm, {math.degrees(error[1]):.1f} deg")
+            self._trigger = (pose, error, why)
+            self._stop(now)
+            return self._command("stop", now, error)
+        return self._command("follow", now, error)
+
+    def _settled(self, now: float, part: np.ndarray, error: tuple[float, float]) -> Command:
+        """The part observed at rest at ``part`` (the mean): done, re-planned, or given up."""
+        if self.scene.within_tolerance(part):
+            self.done = True
+            return self._command("done", now, error)
+        if len(self.replans) >= self.budget:
+            return self._give_up(now, error, f"the re-plan budget ({self.budget}) is spent")
+        clock = time.perf_counter()
+        certificate = self.session.certify_unreachable(start=part)
+        if certificate:
+            return self._give_up(now, error, f"the goal is unreachable from the observed pose: {certificate}")
+        pusher = self._held[0]
+        try:
+            # First a plan that begins on the edge the pusher is at, so that it only has to come
+            # back to the part; then one that begins on an edge the pusher can get to from there.
+            found = None
+            if self._approach(pusher, part, self._edge) is not None:
+                found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge])
+            if found is None or not found.solved:
+                world = self.session.world
+                others = [c.edge for c in world.controls if c.edge != self._edge] if world is not None else []
+                reached = [e for e in others if self._approach(pusher, part, e) is not None]
+                if not reached and found is None:
+                    return self._give_up(now, error, "no free approach from the pusher to any edge of the part")
+                if reached:
+                    found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=reached)
+        except SceneError as err:  # the pusher has no room at the observed pose
+            return self._give_up(now, error, f"no plan from the observed pose: {err.problem}")
+        if not found.solved or not found.segments:
+            return self._give_up(now, error, f"no plan from the observed pose: {found.reason or 'no segments'}")
+        problem = self._begin(found, pusher, part, now)
+        if problem:
+            self._held = (pusher, 0.0)
+            return self._give_up(now, error, problem)
+        trigger, trigger_error, why = self._trigger
+        self.replans.append(Replan(now, part, trigger, trigger_error, why, time.perf_counter() - clock, found))
+        return self._command("replan", now, error, found)
+
+    def _give_up(self, now: float, error: tuple[float, float], reason: str) -> Command:
+        self.reason = reason
+        return self._command("give_up", now, error)

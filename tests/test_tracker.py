@@ -1,0 +1,126 @@
+"""The closed loop's tracker, without MuJoCo (planner.execution.tracker): synthetic streams of
+timed pose observations.
+
+A part observed a known offset from the plan's start makes the tracker stop, settle and re-plan
+from exactly that pose (the mean of the settled observations), and the new plan ends in the goal;
+a part observed inside a walled pocket the goal is outside of gives up with the certificate's
+reason; observations along the plan with 1 mm / 0.5 degree noise finish without a re-plan; a
+spent budget is a reason too.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from planner import Planner, load_scene
+from planner.execution.approach import lead_in_pose
+from planner.execution.tracker import CONFIRM, SETTLE, Tracker, mean_pose
+from planner.model.fields import SceneError
+from planner.model.scene import parse_scene
+
+ROOT = Path(__file__).resolve().parents[1]
+RATE = 10.0  # observations per second
+
+
+@pytest.fixture(scope="module")
+def junction():
+    session = Planner(load_scene(ROOT / "scenes" / "junction.yaml"))
+    return session, session.plan(seed=1)
+
+
+def on_plan(tracker: Tracker, now: float) -> np.ndarray:
+    """Where the tracker's current plan has the part at ``now`` (its own record, as a perfect perception would see it)."""
+    k = min(int(np.searchsorted(tracker.motion.t, now - tracker._since)), len(tracker.motion.t) - 1)
+    return tracker.expected[k]
+
+
+def test_a_known_start_offset_is_re_planned_from_the_observed_pose(junction):
+    session, plan = junction
+    scene = session.scene
+    tracker = Tracker(session, plan, pusher=lead_in_pose(scene, session.model, plan))
+    offset = np.array([0.02, -0.015, math.radians(8)])
+    observed = scene.start + offset
+    kinds = [tracker.observe(k / RATE, observed).kind for k in range(CONFIRM + SETTLE)]
+    # Two observations beyond the threshold are not yet a deviation; the third is, and the pusher
+    # stops; SETTLE observations at rest later it re-plans.
+    assert kinds == ["follow"] * (CONFIRM - 1) + ["stop"] * SETTLE + ["replan"]
+    (replan,) = tracker.replans
+    assert np.allclose(replan.start, observed) and np.allclose(replan.trigger, observed)
+    assert replan.error[0] == pytest.approx(math.hypot(0.02, 0.015)) and replan.error[1] == pytest.approx(offset[2])
+    assert np.allclose(replan.plan.start, observed) and scene.within_tolerance(replan.plan.final)
+    assert tracker.plan is replan.plan
+    # The pusher stopped on its way in, short of the old first contact, and approaches the new
+    # plan's first contact from there.
+    stopped = (CONFIRM - 1) / RATE
+    held, _, _, _ = tracker.pusher_at(stopped)
+    pose, height, _, contact = tracker.pusher_at(len(kinds) / RATE - 1 / RATE)
+    assert height == 0.0 and not contact and np.allclose(pose, held)
+    assert 0 < np.linalg.norm(held[:2] - lead_in_pose(scene, session.model, plan)[:2]) < 0.03
+    # Followed with the part where the new plan has it, the run ends in the goal with no more re-plans.
+    now, last = len(kinds) / RATE, None
+    while last not in ("done", "give_up") and now < 100:
+        last = tracker.observe(now, on_plan(tracker, now)).kind
+        now += 1 / RATE
+    assert last == "done" and len(tracker.replans) == 1
+
+
+def test_noise_alone_does_not_re_plan(junction):
+    """1 mm (per axis) and 0.5 degree of noise: the thresholds are 5 sigma (5 mm, 2.5 degrees)
+    and three observations in a row must exceed them, so nothing triggers."""
+    session, plan = junction
+    noise = (0.001, math.radians(0.5))
+    tracker = Tracker(session, plan, noise=noise)
+    assert tracker.threshold == pytest.approx((0.005, math.radians(2.5)))
+    rng = np.random.default_rng(7)
+    now, kinds = 0.0, []
+    while not kinds or kinds[-1] not in ("done", "give_up"):
+        kinds.append(tracker.observe(now, on_plan(tracker, now) + rng.normal(0.0, [noise[0], noise[0], noise[1]])).kind)
+        now += 1 / RATE
+    assert kinds[-1] == "done" and tracker.replans == []
+    assert kinds.count("stop") == SETTLE  # only the final check at rest
+    assert len(kinds) > 200  # the whole plan was observed
+
+
+def test_a_spent_budget_is_the_reason_to_give_up(junction):
+    session, plan = junction
+    tracker = Tracker(session, plan, budget=0)
+    kinds = [tracker.observe(k / RATE, session.scene.start + [0.0, 0.01, 0.0]).kind for k in range(CONFIRM + SETTLE)]
+    assert kinds[-1] == "give_up" and tracker.reason == "the re-plan budget (0) is spent"
+    assert tracker.observe(5.0, session.scene.start).kind == "give_up"  # and stays so
+
+
+def test_a_part_knocked_into_a_sealed_pocket_gives_up_with_the_certificate():
+    scene = parse_scene({
+        "name": "pocket",
+        "slider": {"vertices": [[-0.04, -0.03], [0.04, -0.03], [0.04, 0.03], [-0.04, 0.03]]},
+        "pusher": {"width": 0.05, "depth": 0.015, "mu": 0.5, "transit": "none", "edges": [3]},
+        "obstacles": [{"box": {"center": c, "size": s}} for c, s in (([0.16, 0.25], [0.02, 0.2]), ([0.34, 0.25], [0.02, 0.2]),
+                                                                    ([0.25, 0.16], [0.2, 0.02]), ([0.25, 0.34], [0.2, 0.02]))],
+        "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]},
+        "start": [-0.35, -0.35, 0.0], "goal": [-0.2, -0.35, 0.0]})
+    session = Planner(scene)
+    tracker = Tracker(session, session.plan(seed=1))
+    inside = [0.25, 0.25, 0.0]
+    kinds = [tracker.observe(k / RATE, inside).kind for k in range(CONFIRM + SETTLE)]
+    assert kinds[-1] == "give_up" and tracker.replans == []
+    assert tracker.reason.startswith("the goal is unreachable from the observed pose: component")
+
+
+def test_bad_arguments_name_their_field(junction):
+    session, plan = junction
+    for kwargs, field in (({"noise": (-0.001, 0.0)}, "noise"), ({"noise": (math.nan, 0.0)}, "noise"),
+                          ({"confirm": 0}, "confirm")):
+        with pytest.raises(SceneError) as err:
+            Tracker(session, plan, **kwargs)
+        assert err.value.field == field
+    with pytest.raises(SceneError) as err:
+        Tracker(session, plan).observe(0.0, [0.0, math.inf, 0.0])
+    assert err.value.field.startswith("pose")
+
+
+def test_the_mean_of_headings_across_the_cut_is_near_pi():
+    assert abs(abs(mean_pose([[0, 0, math.pi - 0.2], [0, 0, -math.pi + 0.1]])[2]) - (math.pi - 0.05)) < 1e-12
