@@ -62,4 +62,4 @@ def test_a_start_error_the_open_loop_carries_to_the_end_is_recovered_closed_loop
     executed = np.loadtxt(tmp_path / "closed" / "junction.executed.csv", delimiter=",", skiprows=1)
     planned = np.loadtxt(tmp_path / "closed" / "junction.trajectory.csv", delimiter=",", skiprows=1)
     assert executed[0, 1] < planned[0, 1] - 0.02 and executed[0, 2] == pytest.approx(planned[0, 2])
-    assert set(executed[:, 9].astype(int)) == {0, 1}  # the first plan, then the re-plan
+    assert set(executed[:, 9].astype(int)) == {1, 2}  # the first plan, then the re-plan (numbered from 1)
