@@ -35,11 +35,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import exp_twist
+from mechanics import exp_twist, transform_points
 
 from ..actions.controls import NoStablePush, RegionTimeout
 from ..actions.region_cache import RegionCache
-from ..model.bodies import cf_poses
 from ..model.fields import SceneError, integer, poses
 from ..model.options import PlannerOptions
 from ..model.plan_file import Plan, Push, Transit, rechain
@@ -50,7 +49,7 @@ from ..world.validity import CollisionModel
 from .reachability import Certificates, Reach, answers
 from .reachable_set import ReachableSet, reachable_set
 
-__all__ = ["JOINED_PLANS", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
+__all__ = ["JOINED_PLANS", "JOIN_SLACK", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
            "reachability"]
 
 #: Without a time limit, :meth:`Planner.reachability` grows its search for this long plus this
@@ -61,6 +60,9 @@ REACH_BASE_S, REACH_PER_GOAL_S = 0.5, 0.01
 #: Plans a session keeps for re-planning (the most recent), and how many of the latest for a goal
 #: a new start is joined to.
 REMEMBERED_PLANS, JOINED_PLANS = 16, 2
+#: A join is taken once no pose left could make one cheaper by more than this share: the lower
+#: bound (the straight line) is loose, and each pose tried costs collision checks.
+JOIN_SLACK = 0.05
 #: Goals reached by reachability queries whose plans a session keeps (the most recent), for the
 #: queries after them.
 REMEMBERED_GOALS = 20_000
@@ -203,20 +205,19 @@ class Planner:
         ``goal``, the rest of that plan after it: the cheapest found, or None.
 
         Poses are tried cheapest first by a lower bound (the straight line from the start's CF to
-        theirs, plus the rest of their plan), until no pose left can beat the best join."""
+        theirs, plus the rest of their plan), until no pose left can beat the best join by more
+        than :data:`JOIN_SLACK`."""
         world, scene = self.world, self.scene
         anchors = [a for p in known[:JOINED_PLANS] for a in _anchors(p.segments)]
         if not anchors:
             return None
         region = world.goal_region([pose for pose, _, _ in anchors], aim=False)
         cf = scene.slider.cf
-        here = cf_poses(cf, context.start[None, :2], context.start[None, 2])[0]
-        rests = [cost(scene, rest) for _, _, rest in anchors]
-        there = cf_poses(cf, np.array([pose[:2] for pose, _, _ in anchors]), np.array([pose[2] for pose, _, _ in anchors]))
-        bounds = np.linalg.norm(there - here, axis=1) + rests
+        here, there = transform_points(cf, context.start), transform_points(cf, np.array([a[0] for a in anchors]))
+        bounds = np.linalg.norm(there - here, axis=1) + [cost(scene, rest) for _, _, rest in anchors]
         best, best_cost = None, np.inf
         for a in np.argsort(bounds, kind="stable").tolist():
-            if bounds[a] >= best_cost:
+            if bounds[a] * (1.0 + JOIN_SLACK) >= best_cost:
                 break
             pose, edge, rest = anchors[a]
             for k in context.starts:
@@ -265,7 +266,7 @@ class Planner:
         if time_limit is not None:
             self._request(seed, time_limit)  # checked before any work
         clock = time.perf_counter()
-        reasons = [self.certify_unreachable(g, start=start) for g in rows]
+        reasons = [self._reason(g, start) for g in rows]
         self.timings = {"certificates": time.perf_counter() - clock, "connections": 0.0, "growth": 0.0}
         if time_limit is None:
             time_limit = min(self.options.time_limit, REACH_BASE_S + REACH_PER_GOAL_S * reasons.count(None))
@@ -293,8 +294,10 @@ class Planner:
     def certify_unreachable(self, goal: ArrayLike | None = None, *, start: ArrayLike | None = None) -> str | None:
         """Why ``goal`` (default: the scene's) is certainly unreachable from ``start`` (default:
         the scene's), or None if no certificate shows it (:mod:`planner.queries.reachability`)."""
-        start = self._pose(start, "start", self.scene.start)
-        goal = self._pose(goal, "goal", self.scene.goal)
+        return self._reason(self._pose(goal, "goal", self.scene.goal), self._pose(start, "start", self.scene.start))
+
+    def _reason(self, goal: np.ndarray, start: np.ndarray) -> str | None:
+        """:meth:`certify_unreachable` of poses checked already."""
         reason = self.certificates(goal, start)
         if reason is None and self._no_push is not None and not self.scene.within_tolerance(start, goal):
             reason = f"no stable push: {self._no_push.problem}"
