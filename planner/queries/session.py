@@ -29,7 +29,7 @@ from __future__ import annotations
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import replace
+from dataclasses import asdict, replace
 from typing import Any
 
 import numpy as np
@@ -103,8 +103,8 @@ class Planner:
         if not isinstance(scene, Scene):
             raise SceneError("scene", f"must be a Scene (planner.load_scene), got {type(scene).__name__}")
         if isinstance(options, PlannerOptions):
-            self.options = PlannerOptions().merged({k: getattr(options, k) for k in _FIELDS
-                                                    if getattr(options, k) is not None})
+            # Checked as any options are: a PlannerOptions may be made without its checks.
+            self.options = PlannerOptions().merged({k: v for k, v in asdict(options).items() if v is not None})
         elif options is None or isinstance(options, Mapping):
             self.options = scene.planner.merged(options)
         else:
@@ -310,9 +310,6 @@ class Planner:
         regions and collision model."""
         return reachable_set(self.scene, pushes, heading, resolution,
                              controls=None if self.world is None else self.world.controls, **kwargs)
-
-
-_FIELDS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize", "transit")
 
 
 def _anchors(segments: list[Push | Transit]) -> list[tuple[np.ndarray, int, list[Push | Transit]]]:
