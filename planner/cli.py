@@ -73,7 +73,9 @@ from .outputs.recorder import RecordingFailed, recorder
 from .actions.region_cache import cache_folder
 from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEFAULT_TRANSIT, MAX_OPTIMIZE,
                             MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS, TRANSITS, PlannerOptions)
-from .model.scene import Scene, load_scene, placement_fault, write_scene
+from .model.parts import PartsScene
+from .model.scene import Scene, placement_fault, write_scene
+from .model.scene_file import load_scene
 from .queries.session import plan
 
 for _signal, _handler in _LOADING.items():  # loaded: main() handles them from here on
@@ -198,7 +200,7 @@ def _parser() -> argparse.ArgumentParser:
 class Inputs:
     """A command line, checked: the scene with the flags applied, and what to do with it."""
 
-    scene: Scene  # with --regions and --transit applied
+    scene: Scene | PartsScene  # with --regions and --transit applied
     planner: str
     time_limit: float
     seed: int
@@ -248,6 +250,8 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--resume" if args.resume else "scene", "several scenes, --seeds or --resume make a batch, "
                                                                "which the plan command runs itself (planner.batch)")
     scene = load_scene(args.scene[0])
+    if isinstance(scene, PartsScene):
+        _check_parts(args)
     if args.sim_cf_offset is not None:
         from .execution.mujoco_sim import support_centre
 
@@ -358,6 +362,17 @@ def _check_simulation(args: argparse.Namespace) -> None:
     needs_mujoco()
 
 
+#: What a multi-part scene does not take (yet): each flag with why.
+_ONE_PART = ("--plan", "--reach", "--export-scene", "--verify", "--trajectory", "--simulate")
+
+
+def _check_parts(args: argparse.Namespace) -> None:
+    """Refuse the flags a multi-part scene does not take."""
+    for flag in _ONE_PART:
+        if getattr(args, flag[2:].replace("-", "_")) not in (None, False):
+            raise SceneError(flag, "is for one-part scenes (slider, start, goal), not a scene with parts")
+
+
 def main(argv: list[str] | None = None) -> int:
     atexit.register(_silence_nanobind_leak_report)
     try:
@@ -396,6 +411,8 @@ class _NotWritten(Exception):
 def _run(inputs: Inputs) -> int:
     for note in inputs.scene.notes:
         print(f"plan: note: {note}", file=sys.stderr)
+    if isinstance(inputs.scene, PartsScene):
+        return _plan_parts(inputs)
     with recorder(inputs.scene) as write:  # rerun is imported beside the search, where it can be
         return _plan_and_write(inputs, write)
 
@@ -482,6 +499,34 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         lines[-1] += f" (outputs in {out})"
     print("\n".join(lines))
     return 0 if (check is None or check.passed) and (simulation is None or simulation.passed) else 3
+
+
+def _plan_parts(inputs: Inputs) -> int:
+    """Plan a multi-part scene and write its plan (``stablepush.plan/2``) and recording."""
+    from .queries.session import PartsPlanner
+
+    scene, out = inputs.scene, inputs.out
+    tty = sys.stderr.isatty()
+    if tty:
+        print(f"planning {scene.name}: {len(scene.parts)} parts with {inputs.planner} (seed {inputs.seed}, limit "
+              f"{inputs.time_limit:g} s) ...", file=sys.stderr, flush=True)
+    result = PartsPlanner(scene, progress=_progress if tty else None).plan()
+    if tty:
+        print("\r\033[K", end="", file=sys.stderr, flush=True)
+    try:
+        with staged_folder(out) as stage:
+            from .outputs.parts_recording import write_parts_recording  # rerun: only now
+
+            write_parts_recording(stage / f"{scene.name}.rrd", scene, result)
+            write_atomic(stage / f"{scene.name}.json", result.to_json())
+    except OSError as err:
+        raise _NotWritten(f"cannot write {shown(str(err.filename or out))}: {err.strerror or err}") from None
+    if not result.solved:
+        print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
+        return 2
+    print(f"solved: {result.headline()}, planning time {result.planning_time_s:.2f} s -> {out}/{scene.name}.json, "
+          f"{scene.name}.rrd")
+    return 0
 
 
 def _export_scene(scene: Scene, inputs: Inputs) -> None:

@@ -218,3 +218,86 @@ def replay_transit(spec: dict, seg: dict, part_pose: np.ndarray, blocked: shapel
             else:
                 assert gap > 0, f"pusher touches the part at {q_s} in transit {seg}"
     assert abs(duration - seg["duration"]) <= 1e-9, f"transit {seg} takes {duration} s at 1 m/s"
+
+
+def replay_parts_plan(spec: dict, plan: dict) -> None:
+    """Assert that ``plan`` (a ``stablepush.plan/2`` JSON) is a valid plan of the multi-part scene
+    ``spec`` (its YAML form): each move, the part's run of segments between transfers, replays as a
+    one-part plan (:func:`replay_plan`) with the other parts as obstacles where they stand then;
+    each transfer passes :func:`replay_transfer`; every part ends within tolerance of its goal."""
+    parts = {p["name"]: p for p in spec["parts"]}
+    poses = {n: degrees_pose(p["start"]) for n, p in parts.items()}
+    edge_on = None  # (part, edge) the pusher is on
+    segments = plan["segments"]
+    k = 0
+    while k < len(segments):
+        seg = segments[k]
+        if seg["kind"] == "transfer":
+            assert edge_on is not None and seg["from_part"] == edge_on[0], f"transfer {k} leaves another part"
+            replay_transfer(spec, seg, poses, edge_on[1])
+            edge_on = (seg["to_part"], seg["to_edge"])
+            k += 1
+            continue
+        name = seg["part"]
+        assert edge_on is None or edge_on[0] == name, f"segment {k} pushes {name}, the pusher is on {edge_on[0]}"
+        run = []
+        while k < len(segments) and segments[k]["kind"] != "transfer":
+            assert segments[k]["part"] == name, "a move pushes one part"
+            run.append({key: v for key, v in segments[k].items() if key != "part"})
+            k += 1
+        first = run[0]["edge"] if run[0]["kind"] == "push" else run[0]["from_edge"]
+        assert edge_on is None or edge_on[1] == first, f"the move of {name} starts on another edge than the transfer's"
+        others = [place(parts[m]["vertices"], poses[m]) for m in parts if m != name]
+        one = {"slider": {key: parts[name][key] for key in ("vertices", "cf") if key in parts[name]},
+               "pusher": spec["pusher"], "workspace": spec["workspace"], "tolerance": spec.get("tolerance", {}),
+               "obstacles": [*(spec.get("obstacles") or []),
+                             *({"polygon": np.asarray(o.exterior.coords)[:-1].tolist()} for o in others)],
+               "start": [*poses[name][:2], math.degrees(poses[name][2])]}
+        end = np.asarray(run[-1]["end"], float)
+        replay_plan(one, {"start": list(poses[name]), "segments": run, "final": list(end)}, goal=end)
+        poses[name] = end
+        edge_on = (name, run[-1]["edge"] if run[-1]["kind"] == "push" else run[-1]["to_edge"])
+    tol = spec.get("tolerance", {})
+    for n, p in parts.items():
+        goal = degrees_pose(p["goal"])
+        assert math.dist(poses[n][:2], goal[:2]) <= tol.get("position", 0.01), f"part {n} misses its goal"
+        assert angle_diff(poses[n][2], goal[2]) <= math.radians(tol.get("angle", 2.0)), f"part {n} misses its heading"
+        np.testing.assert_allclose(plan["parts"][n]["final"][:2], poses[n][:2], atol=1e-9)
+
+
+def replay_transfer(spec: dict, seg: dict, poses: dict, from_edge: int) -> None:
+    """Check a transfer with every part standing at ``poses``: flush on ``from_edge`` of the part it
+    leaves at its first pose and on ``to_edge`` of the part it reaches at its last, every in-plane
+    piece clear of obstacles, walls and every part (touching only those two, at the two ends), and
+    the duration at 1 m/s."""
+    parts = {p["name"]: p for p in spec["parts"]}
+    pusher = spec["pusher"]
+    path = np.asarray(seg["pusher_path"], float)
+    assert seg["mode"] in ("plane", "lift") and len(path) >= 2
+    if seg["mode"] == "lift":
+        assert pusher.get("transit", "plane") == "lift" and len(path) == 4
+    for at, part, edge in ((path[0], seg["from_part"], from_edge), (path[-1], seg["to_part"], seg["to_edge"])):
+        flush = flush_pose(parts[part]["vertices"], edge, poses[part])
+        np.testing.assert_allclose(at[:2], flush[:2], atol=1e-9, err_msg=f"transfer not flush on {part}'s edge {edge}")
+        assert angle_diff(at[2], flush[2]) < 1e-9
+    blocked = blocked_region(spec)
+    bodies = {n: place(p["vertices"], poses[n]) for n, p in parts.items()}
+    rectangle = pusher_rectangle(pusher["width"], pusher["depth"])
+    reach = math.hypot(pusher["depth"], pusher["width"] / 2)
+    last = len(path) - 2
+    duration = 0.0
+    for k, (p, q) in enumerate(zip(path, path[1:])):
+        shift, turn = math.dist(p[:2], q[:2]), angle_diff(p[2], q[2])
+        duration += shift + reach * turn
+        if seg["mode"] == "lift" and k == 1:
+            continue
+        n = max(1, math.ceil((shift + reach * turn) / SAMPLE), math.ceil(turn / TURN)) + 1
+        for s in np.linspace(0.0, 1.0, n):
+            q_s = interpolate(p, q, s)
+            body = place(rectangle, q_s)
+            assert body.distance(blocked) > SAMPLE / 2, f"pusher collides at {q_s} in transfer {seg['to_part']}"
+            for name, part in bodies.items():
+                touching = (k, s) == (0, 0.0) and name == seg["from_part"] or (k, s) == (last, 1.0) and name == seg["to_part"]
+                gap = body.distance(part)
+                assert gap < 1e-9 if touching else gap > 0, f"pusher and part {name} at {q_s} in a transfer"
+    assert abs(duration - seg["duration"]) <= 1e-9

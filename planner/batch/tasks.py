@@ -33,7 +33,8 @@ from ..model.fields import SceneError, number, shown
 from ..model.options import (check_optimize, check_planner, check_regions, check_seed, check_switch_cost,
                              check_time_limit, check_transit)
 from ..model.plan_file import Plan
-from ..model.scene import Scene, load_scene
+from ..model.scene import Scene
+from ..model.scene_file import load_scene
 from ..queries.reachability import certify_unreachable
 from ..queries.session import plan
 

@@ -26,11 +26,12 @@ from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vec
 from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
 from .yaml_file import read_yaml
 
-__all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "Pusher", "Scene", "load_scene", "parse_scene", "placement_fault", "plain_scene",
-           "write_scene"]
+__all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "PLANNER_KEYS", "Pusher", "Scene", "Table", "load_scene", "parse_scene",
+           "placement_fault", "plain_scene", "read_cf_uncertainty", "read_edges", "read_name", "read_pose", "read_pusher",
+           "read_slider", "read_table", "write_scene"]
 
 #: The keys of a scene's ``planner:`` block: the options but ``transit``, which is ``pusher.transit``.
-_PLANNER_KEYS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize")
+PLANNER_KEYS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize")
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
 _MAX_NAME_BYTES = 200
 #: The pusher's width and depth and a box's sides, in metres (a micron): thinner is no body.
@@ -152,7 +153,7 @@ def plain_scene(scene: Scene) -> dict[str, Any]:
         "start": [*scene.start[:2].tolist(), _degrees(scene.start[2])],
         "goal": [*scene.goal[:2].tolist(), _degrees(scene.goal[2])],
         "tolerance": {"position": scene.tolerance_position, "angle": _degrees(scene.tolerance_angle)},
-        "planner": {key: getattr(scene.planner, key) for key in _PLANNER_KEYS},
+        "planner": {key: getattr(scene.planner, key) for key in PLANNER_KEYS},
     }
 
 
@@ -224,34 +225,38 @@ def _obstacles(value: Any, name: str, folder: Path, notes: list[str]) -> list[sh
     return [shapely.Polygon(corners @ rot.T + [cx, cy])]
 
 
-def _slider(value: Any, folder: Path, notes: list[str]) -> Slider:
+def read_slider(value: Any, folder: Path, notes: list[str], name: str = "slider",
+                more: tuple[str, ...] = ()) -> Slider:
+    """The part ``value`` describes (its vertices or a CAD file, and its CF), checked; errors
+    name the fields under ``name``, and ``more`` are further keys ``value`` may hold (read by
+    the caller: a multi-part scene's name, start and goal)."""
     if isinstance(value, dict) and "file" in value:
-        return _slider_from_file(value, folder, notes)
-    spec = keys(value, "slider", ("vertices",), ("cf", "cf_uncertainty"))
-    vertices = _points(spec["vertices"], "slider.vertices")
-    return _checked_slider(vertices, spec, "slider.vertices")
+        return _slider_from_file(value, folder, notes, name, more)
+    spec = keys(value, name, ("vertices",), ("cf", "cf_uncertainty") + more)
+    vertices = _points(spec["vertices"], f"{name}.vertices")
+    return _checked_slider(vertices, spec, f"{name}.vertices", name)
 
 
-def _slider_from_file(value: dict, folder: Path, notes: list[str]) -> Slider:
+def _slider_from_file(value: dict, folder: Path, notes: list[str], name: str, more: tuple[str, ...]) -> Slider:
     """The part a file draws: its outline is what the pusher touches, and its default CF the
     centroid of its footprint, holes left out (a hole carries no weight)."""
     from .cad import FILE_KEYS, FILE_OPTIONS, read_shapes
 
-    spec = keys(value, "slider", FILE_KEYS, FILE_OPTIONS + ("cf", "cf_uncertainty"))
-    shapes = read_shapes(spec, "slider", folder, notes)
+    spec = keys(value, name, FILE_KEYS, FILE_OPTIONS + ("cf", "cf_uncertainty") + more)
+    shapes = read_shapes({k: v for k, v in spec.items() if k not in more}, name, folder, notes)
     if len(shapes) > 1:
-        raise SceneError("slider.file", f"holds {len(shapes)} parts: pick one with layer or name")
+        raise SceneError(f"{name}.file", f"holds {len(shapes)} parts: pick one with layer or name")
     (shape,) = shapes
     if shape.footprint.area <= 0:
-        raise SceneError("slider.file", "the part has no footprint on the table")
+        raise SceneError(f"{name}.file", "the part has no footprint on the table")
     vertices = np.asarray(shape.region.exterior.coords)[:-1]
     cf = np.asarray(shape.footprint.centroid.coords[0])
-    return _checked_slider(vertices, {"cf": cf.tolist(), **spec}, "slider.file")
+    return _checked_slider(vertices, {"cf": cf.tolist(), **spec}, f"{name}.file", name)
 
 
-def _checked_slider(vertices: np.ndarray, spec: dict, field: str) -> Slider:
+def _checked_slider(vertices: np.ndarray, spec: dict, field: str, name: str) -> Slider:
     """The part of ``vertices`` and ``spec``'s ``cf`` (default: the area centroid), checked;
-    ``field`` is where the vertices came from."""
+    ``field`` is where the vertices came from, ``name`` the part's field."""
     _simple_polygon(vertices, field)
     # A repeated vertex makes an edge of no length, with no normal to push along; shapely accepts it.
     # Nearly repeated is as bad: the edge's direction is rounding noise, or its square underflows to 0.
@@ -270,35 +275,42 @@ def _checked_slider(vertices: np.ndarray, spec: dict, field: str) -> Slider:
                                 "any (each edge has a vertex beyond its line)")
     if "cf" not in spec:
         return part
-    cf = vector(spec["cf"], "slider.cf", 2, LENGTH)  # outside the try: a SceneError is a ValueError too
+    cf = vector(spec["cf"], f"{name}.cf", 2, LENGTH)  # outside the try: a SceneError is a ValueError too
     try:
         return Slider(vertices, cf)
     except ValueError as err:
-        raise SceneError("slider.cf", str(err)) from None
+        raise SceneError(f"{name}.cf", str(err)) from None
 
 
-def _pusher(value: Any, slider: Slider) -> Pusher:
-    spec = keys(value, "pusher", ("width", "depth", "mu"), ("edges", "transit"))
+def read_pusher(value: Any, slider: Slider | None) -> Pusher:
+    """The pusher ``value`` describes, with the edges it may push of ``slider`` (default: all
+    pushable); a multi-part scene (``slider`` None) gives edges per part (:func:`read_edges`)."""
+    spec = keys(value, "pusher", ("width", "depth", "mu"), ("edges", "transit") if slider is not None else ("transit",))
     width, depth = (_at_least_min_size(number(spec[key], f"pusher.{key}", positive=True, limit=LENGTH),
                                        f"pusher.{key}", spec[key]) for key in ("width", "depth"))
     mu, mu_high = _friction(spec["mu"])
     transit = check_transit(spec.get("transit", DEFAULT_TRANSIT), "pusher.transit")
-    if "edges" not in spec:
-        return Pusher(width, depth, mu, slider.pushable_edges, mu_high, transit)
-    listed = spec["edges"]
+    edges = () if slider is None else read_edges(spec.get("edges"), slider, "pusher.edges")
+    return Pusher(width, depth, mu, edges, mu_high, transit)
+
+
+def read_edges(listed: Any, slider: Slider, name: str) -> tuple[int, ...]:
+    """The edges of ``slider`` listed at ``name`` (None: every pushable edge), checked."""
+    if listed is None:
+        return slider.pushable_edges
     if not isinstance(listed, (list, tuple)) or not listed:
-        raise SceneError("pusher.edges", "must be a non-empty list of edge indices")
+        raise SceneError(name, "must be a non-empty list of edge indices")
     edges = []
     for i, e in enumerate(listed):
-        e = integer(e, f"pusher.edges[{i}]")
+        e = integer(e, f"{name}[{i}]")
         if not 0 <= e < slider.n:
-            raise SceneError("pusher.edges", f"edge {e} does not exist (the part has edges 0..{slider.n - 1})")
+            raise SceneError(name, f"edge {e} does not exist (the part has edges 0..{slider.n - 1})")
         if not slider.is_pushable(e):
-            raise SceneError("pusher.edges", f"edge {e} is not on the convex hull, so a flat pusher cannot push it")
+            raise SceneError(name, f"edge {e} is not on the convex hull, so a flat pusher cannot push it")
         if e in edges:
-            raise SceneError("pusher.edges", f"edge {e} is listed twice")
+            raise SceneError(name, f"edge {e} is listed twice")
         edges.append(e)
-    return Pusher(width, depth, mu, tuple(edges), mu_high, transit)
+    return tuple(edges)
 
 
 def _friction(value: Any) -> tuple[float, float | None]:
@@ -323,8 +335,8 @@ def _at_least_min_size(size: float, name: str, given: Any) -> float:
     return size
 
 
-def _pose(value: Any, name: str, slider: Slider, obstacles: tuple[shapely.Polygon, ...],
-          workspace: tuple[float, float, float, float]) -> np.ndarray:
+def read_pose(value: Any, name: str, slider: Slider, obstacles: tuple[shapely.Polygon, ...],
+              workspace: tuple[float, float, float, float]) -> np.ndarray:
     """A pose ``[x, y, degrees]`` as ``(x, y, radians)`` with the angle in ``[-pi, pi)``, as the
     plan's segments have theirs; the part there must be in the workspace and clear of obstacles."""
     x, y, theta = vector(value, name, 3)
@@ -349,15 +361,37 @@ def placement_fault(slider: Slider, obstacles: tuple[shapely.Polygon, ...],
 
 
 def parse_scene(data: Any, default_name: str = "scene", path: str | None = None) -> Scene:
-    """Validate a scene given as the parsed YAML mapping (see :func:`load_scene`); the files it
-    names are relative to the folder of ``path`` (the working folder if None)."""
+    """Validate a one-part scene given as the parsed YAML mapping (see :func:`load_scene`); the
+    files it names are relative to the folder of ``path`` (the working folder if None). Any scene,
+    multi-part ones too, is read by :mod:`.scene_file`."""
     spec = keys(data, "scene", ("slider", "pusher", "workspace", "start", "goal"),
                  ("name", "obstacles", "tolerance", "planner"))
-    name = _name(spec.get("name", default_name))
+    name = read_name(spec.get("name", default_name))
     folder, notes = Path(path).parent if path else Path(), []
-    slider = _slider(spec["slider"], folder, notes)
-    cf_uncertainty = _cf_uncertainty(spec["slider"], slider)
-    pusher = _pusher(spec["pusher"], slider)
+    slider = read_slider(spec["slider"], folder, notes)
+    cf_uncertainty = read_cf_uncertainty(spec["slider"], slider, "slider")
+    pusher = read_pusher(spec["pusher"], slider)
+    table = read_table(spec, folder, notes)
+    start = read_pose(spec["start"], "start", slider, table.obstacles, table.workspace)
+    goal = read_pose(spec["goal"], "goal", slider, table.obstacles, table.workspace)
+    return Scene(name, slider, pusher, table.obstacles, table.workspace, start, goal, table.tolerance_position,
+                 table.tolerance_angle, table.planner, path, cf_uncertainty, tuple(notes))
+
+
+@dataclass(frozen=True)
+class Table:
+    """What every scene has besides its parts and pusher: obstacles, workspace, goal tolerance
+    and planner options."""
+
+    obstacles: tuple[shapely.Polygon, ...]
+    workspace: tuple[float, float, float, float]
+    tolerance_position: float
+    tolerance_angle: float
+    planner: PlannerOptions
+
+
+def read_table(spec: dict, folder: Path, notes: list[str]) -> Table:
+    """The :class:`Table` of a scene's mapping ``spec``, checked; CAD files are relative to ``folder``."""
     obstacles_spec = [] if spec.get("obstacles") is None else spec["obstacles"]  # None: a bare "obstacles:"
     if not isinstance(obstacles_spec, list):
         raise SceneError("obstacles", "must be a list")
@@ -367,8 +401,6 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     if not np.all(hi > lo):
         raise SceneError("workspace", f"is empty or inverted: max {hi.tolist()} must exceed min {lo.tolist()}")
     workspace = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
-    start = _pose(spec["start"], "start", slider, obstacles, workspace)
-    goal = _pose(spec["goal"], "goal", slider, obstacles, workspace)
     tol = keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
     tol_pos = number(tol.get("position", 0.01), "tolerance.position", positive=True, limit=LENGTH)
     tol_ang = math.radians(number(tol.get("angle", 2.0), "tolerance.angle", positive=True, limit=ANGLE))
@@ -382,23 +414,21 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     if tol_ang < MIN_TOLERANCE:
         raise SceneError("tolerance.angle", f"must be at least {math.degrees(MIN_TOLERANCE):g} degrees (the rounding "
                                             f"of a plan's headings is about 1e-11 rad), got {math.degrees(tol_ang):g}")
-    opts = keys(spec.get("planner", {}), "planner", (), _PLANNER_KEYS)
-    planner = PlannerOptions().merged(opts, prefix="planner.")
-    return Scene(name, slider, pusher, obstacles, workspace, start, goal, tol_pos, tol_ang, planner, path,
-                 cf_uncertainty, tuple(notes))
+    opts = keys(spec.get("planner", {}), "planner", (), PLANNER_KEYS)
+    return Table(obstacles, workspace, tol_pos, tol_ang, PlannerOptions().merged(opts, prefix="planner."))
 
 
-def _cf_uncertainty(spec: dict, slider: Slider) -> float:
-    """``slider.cf_uncertainty``: the radius (>= 0, less than the part's radius) of the disk about
+def read_cf_uncertainty(spec: dict, slider: Slider, name: str) -> float:
+    """``<name>.cf_uncertainty``: the radius (>= 0, less than the part's radius) of the disk about
     the CF that holds the true CF."""
-    radius = number(spec.get("cf_uncertainty", 0.0), "slider.cf_uncertainty")
+    radius = number(spec.get("cf_uncertainty", 0.0), f"{name}.cf_uncertainty")
     if not 0 <= radius < slider.radius:
-        raise SceneError("slider.cf_uncertainty", f"must be >= 0 and less than the part's radius "
+        raise SceneError(f"{name}.cf_uncertainty", f"must be >= 0 and less than the part's radius "
                                                   f"{slider.radius:.4g}, got {shown(radius)}")
     return radius
 
 
-def _name(value: Any) -> str:
+def read_name(value: Any) -> str:
     # The name names the output files, so it must make a plain file name.
     if not isinstance(value, str) or not value or not value.isprintable() or any(c in value for c in "/\\"):
         raise SceneError("name", f"must be a plain non-empty string, got {shown(value)}")

@@ -37,19 +37,23 @@ from numpy.typing import ArrayLike
 
 from mechanics import exp_twist, transform_points
 
-from ..actions.controls import NoStablePush, RegionTimeout
+from ..actions.controls import NoStablePush, RegionTimeout, clearance_margin
 from ..actions.region_cache import RegionCache
 from ..model.fields import SceneError, integer, poses
-from ..model.options import PlannerOptions
+from ..model.options import PlannerOptions, check_planner
+from ..model.parts import PartsScene
+from ..model.parts_plan import PartsPlan
 from ..model.plan_file import Plan, Push, Transit, rechain
 from ..model.scene import Scene
 from ..search import PlanningContext, PlanRequest, SearchWorld, solve
 from ..search.context import cost, plan_result
+from ..search.transfer import TransferPaths
 from ..world.validity import CollisionModel
+from .multi_part import plan_parts
 from .reachability import Certificates, Reach, answers
 from .reachable_set import ReachableSet, reachable_set
 
-__all__ = ["JOINED_PLANS", "JOIN_SLACK", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
+__all__ = ["JOINED_PLANS", "JOIN_SLACK", "PartsPlanner", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
            "reachability"]
 
 #: Without a time limit, :meth:`Planner.reachability` grows its search for this long plus this
@@ -88,6 +92,10 @@ class Planner:
     progress : callable, optional
         ``progress(k, n)`` before computing the ``k``-th of the ``n`` regions not cached.
 
+    A multi-part scene (:class:`~planner.model.parts.PartsScene`) gets a
+    :class:`~planner.queries.multi_part.PartsPlanner` instead, whose :meth:`plan` plans the whole
+    transfer.
+
     Setting up computes the regions within half the options' time limit; edges not done by then
     are left out (``note`` says which), and a session with none plans nothing (each plan says why).
 
@@ -96,6 +104,12 @@ class Planner:
     SceneError
         If an option is invalid, or the pusher has no room at the scene's start.
     """
+
+    def __new__(cls, scene: Scene | PartsScene, *args: Any, **kwargs: Any):
+        # A multi-part scene is planned by its own kind of session, with the same arguments.
+        if cls is Planner and isinstance(scene, PartsScene):
+            return PartsPlanner(scene, *args, **kwargs)
+        return super().__new__(cls)
 
     def __init__(self, scene: Scene, options: PlannerOptions | Mapping[str, Any] | None = None, *,
                  cache: RegionCache | None = None, progress: Callable[[int, int], None] | None = None):
@@ -312,6 +326,54 @@ class Planner:
                              controls=None if self.world is None else self.world.controls, **kwargs)
 
 
+class PartsPlanner:
+    """A planning session on a multi-part ``scene`` (what :class:`Planner` gives for a
+    :class:`~planner.model.parts.PartsScene`), with ``options``, ``cache`` and ``progress`` as
+    :class:`Planner`'s. Its :meth:`plan` searches the order of moves
+    (:mod:`planner.queries.multi_part`); the one-part session of each part among the others where
+    they stand is made once and kept, so that the buffer poses tried from one place, and later
+    plans, share it.
+
+    >>> from planner import load_scene
+    >>> result = Planner(load_scene("scenes/parts/channel.yaml")).plan()
+    >>> result.solved, [m.part for m in result.moves]     # the far end of the dead end first
+    (True, ['far', 'near'])
+    """
+
+    def __init__(self, scene: PartsScene, options: PlannerOptions | Mapping[str, Any] | None = None, *,
+                 cache: RegionCache | None = None, progress: Callable[[int, int], None] | None = None):
+        if isinstance(options, PlannerOptions):
+            self.options = PlannerOptions().merged({k: v for k, v in asdict(options).items() if v is not None})
+        elif options is None or isinstance(options, Mapping):
+            self.options = scene.planner.merged(options)
+        else:
+            raise SceneError("options", f"must be PlannerOptions or a mapping, got {type(options).__name__}")
+        self.scene = scene.with_options(self.options)
+        self._cache, self._progress = cache, progress
+        self._sessions: OrderedDict[tuple, Planner] = OrderedDict()
+        margin = min(clearance_margin(self.scene.move_scene(n, self.scene.starts)) for n in self.scene.names)
+        self.paths = TransferPaths(self.scene, margin)
+
+    def plan(self, *, seed: int | None = None, time_limit: float | None = None) -> PartsPlan:
+        """Every part from its start to its goal, or as far as the search got (``solved`` False,
+        ``delivered`` naming the parts at their goals). ``seed`` and ``time_limit`` (seconds, the
+        whole transfer's) default to the options'."""
+        request = PlanRequest.of(self.options, seed=seed, time_limit=time_limit)
+        return plan_parts(self.scene, self.session, self.paths, request.seed, request.time_limit)
+
+    def session(self, part: str, poses: Mapping[str, np.ndarray]) -> Planner:
+        """The one-part session of moving ``part`` with the others at ``poses`` (kept: the
+        :data:`REMEMBERED_PLANS` latest)."""
+        key = (part, *(tuple(np.round(poses[n], 9).tolist()) for n in self.scene.names if n != part))
+        if key not in self._sessions:
+            self._sessions[key] = Planner(self.scene.move_scene(part, poses), cache=self._cache,
+                                          progress=self._progress)
+            while len(self._sessions) > REMEMBERED_PLANS:
+                self._sessions.popitem(last=False)
+        self._sessions.move_to_end(key)
+        return self._sessions[key]
+
+
 def _anchors(segments: list[Push | Transit]) -> list[tuple[np.ndarray, int, list[Push | Transit]]]:
     """Poses along a plan that a new start may join: per push, its start and points along it
     (:data:`_ALONG`), each with the push's edge and the plan's segments from there on."""
@@ -329,9 +391,10 @@ def _anchors(segments: list[Push | Transit]) -> list[tuple[np.ndarray, int, list
     return out
 
 
-def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = None, planner: str | None = None,
-         regions: str | None = None, transit: str | None = None, switch_cost: float | None = None,
-         optimize: int | None = None, progress: Callable[[int, int], None] | None = None) -> Plan:
+def plan(scene: Scene | PartsScene, *, seed: int | None = None, time_limit: float | None = None,
+         planner: str | None = None, regions: str | None = None, transit: str | None = None,
+         switch_cost: float | None = None, optimize: int | None = None,
+         progress: Callable[[int, int], None] | None = None) -> Plan | PartsPlan:
     """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``: a fresh
     :class:`Planner` session asked once.
 
@@ -339,7 +402,8 @@ def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = No
     ``regions`` is ``'stable'`` (procedure STABLE) or ``'exact'`` (the default); ``transit``
     ``'plane'``, ``'lift'`` or ``'none'``; ``switch_cost`` in metres; ``optimize`` a number of
     improvement rounds. With a given seed, a run that solves within the time limit returns the
-    same plan every time. The time limit bounds the stable regions (which may take half of it;
+    same plan every time; a multi-part scene gets a :class:`~planner.model.parts_plan.PartsPlan`
+    (:class:`~planner.queries.multi_part.PartsPlanner`). The time limit bounds the stable regions (which may take half of it;
     edges not done are left out, as ``Plan.note`` says) and the search together.
 
     Raises
@@ -348,9 +412,14 @@ def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = No
         Naming the argument at fault, or if no allowed edge can start pushing.
     """
     clock = time.perf_counter()
-    session = Planner(scene, {k: v for k, v in (("time_limit", time_limit), ("seed", seed), ("regions", regions),
-                                                ("switch_cost", switch_cost), ("optimize", optimize),
-                                                ("transit", transit)) if v is not None}, progress=progress)
+    options = {k: v for k, v in (("time_limit", time_limit), ("seed", seed), ("regions", regions),
+                                 ("switch_cost", switch_cost), ("optimize", optimize), ("transit", transit))
+               if v is not None}
+    if isinstance(scene, PartsScene):
+        if planner is not None:
+            options["name"] = check_planner(planner, "planner")
+        return PartsPlanner(scene, options, progress=progress).plan()
+    session = Planner(scene, options, progress=progress)
     return session._plan(session.scene.start, session.scene.goal, session._request(None, None, None, planner), clock)
 
 
