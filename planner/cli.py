@@ -363,7 +363,7 @@ def _check_simulation(args: argparse.Namespace) -> None:
 
 
 #: What a multi-part scene does not take (yet): each flag with why.
-_ONE_PART = ("--plan", "--reach", "--export-scene", "--verify", "--trajectory", "--simulate")
+_ONE_PART = ("--plan", "--reach", "--export-scene", "--verify", "--simulate")
 
 
 def _check_parts(args: argparse.Namespace) -> None:
@@ -513,19 +513,27 @@ def _plan_parts(inputs: Inputs) -> int:
     result = PartsPlanner(scene, progress=_progress if tty else None).plan()
     if tty:
         print("\r\033[K", end="", file=sys.stderr, flush=True)
+    motion = None
+    if inputs.trajectory and result.solved:
+        from .execution.trajectory import parts_trajectory  # loads ruckig, only for --trajectory
+
+        motion = parts_trajectory(scene, result)
     try:
         with staged_folder(out) as stage:
             from .outputs.parts_recording import write_parts_recording  # rerun: only now
 
             write_parts_recording(stage / f"{scene.name}.rrd", scene, result)
+            if motion is not None:
+                motion.write_csv(stage / f"{scene.name}.trajectory.csv")
             write_atomic(stage / f"{scene.name}.json", result.to_json())
     except OSError as err:
         raise _NotWritten(f"cannot write {shown(str(err.filename or out))}: {err.strerror or err}") from None
     if not result.solved:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
         return 2
+    extra = f", {scene.name}.trajectory.csv" if motion is not None else ""
     print(f"solved: {result.headline()}, planning time {result.planning_time_s:.2f} s -> {out}/{scene.name}.json, "
-          f"{scene.name}.rrd")
+          f"{scene.name}.rrd{extra}")
     return 0
 
 

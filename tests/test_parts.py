@@ -141,10 +141,12 @@ def run_plan(*args, cwd=None):
 
 
 def test_cli_plans_a_multi_part_scene(tmp_path):
-    done = run_plan("scenes/parts/swap.yaml", "--out", tmp_path / "out")
+    done = run_plan("scenes/parts/swap.yaml", "--out", tmp_path / "out", "--trajectory")
     assert done.returncode == 0, done.stderr
     line = done.stdout.strip()
-    assert line.startswith("solved: 2 parts, 3 moves (1 buffer), ") and "transfers" in line
+    assert line.startswith("solved: 2 parts, 3 moves (1 buffer), ") and line.endswith("swap.rrd, swap.trajectory.csv")
+    csv = (tmp_path / "out" / "swap.trajectory.csv").read_text().splitlines()
+    assert csv[0].endswith(",segment,part") and {row.rsplit(",", 1)[1] for row in csv[1:]} == {"red", "blue"}
     data = json.loads((tmp_path / "out" / "swap.json").read_text())
     assert data["format"] == "stablepush.plan/2" and set(data["parts"]) == {"red", "blue"}
     assert (tmp_path / "out" / "swap.rrd").stat().st_size > 0

@@ -11,6 +11,7 @@ from __future__ import annotations
 import io
 import math
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import pytest
@@ -19,7 +20,8 @@ from mechanics import exp_twist, relative_pose, wrap_angle
 from planner import load_scene, plan
 from planner.actions.transit import AIRBORNE, edge_contact_pose, transit_poses
 from planner.cli import main
-from planner.execution.trajectory import trajectory
+from planner.execution.trajectory import parts_trajectory, trajectory
+from planner.model.parts import PartsScene
 from planner.model.bodies import pusher_frame_body
 from planner.model.plan_file import Plan, Push
 
@@ -30,17 +32,47 @@ SPEED, ACCEL, JERK, RATE = 0.05, 0.5, 5.0, 100.0
 SLACK = 1.02  # finite differences of samples 10 ms apart
 
 
+class Run(NamedTuple):
+    """A plan's trajectory, as read from its CSV: the scene (its pusher), the plan's segments in
+    order with the part each moves (transfers of a multi-part plan included), the samples."""
+
+    scene: object
+    segments: list
+    sliders: list
+    rows: np.ndarray
+    motion: object
+    parts: list  # the CSV's part column (multi-part plans), else []
+    owners: list  # the part each segment moves, from the plan (multi-part plans), else []
+
+
+#: A walk round, a lift, and several parts with a switch and transfers between them.
+CASES = ["junction", "narrow_junction", "parts/tray"]
+
+
 @pytest.fixture(scope="module")
 def runs() -> dict:
-    """Each shipped switching scene with its plan and its trajectory's samples, read from the CSV."""
+    """Each case's plan and its trajectory's samples, read from the CSV."""
     out = {}
-    for name in ("junction", "narrow_junction"):  # a walk round; a lift
+    for name in CASES:
         scene = load_scene(SCENES / f"{name}.yaml")
         result = plan(scene, seed=1)
-        assert result.solved and result.switches
-        text = trajectory(scene, result, SPEED, ACCEL, JERK, RATE).to_csv()
-        assert text.splitlines()[0] == HEADER
-        out[name] = scene, result, np.loadtxt(io.StringIO(text), delimiter=",", skiprows=1)
+        assert result.solved
+        if isinstance(scene, PartsScene):
+            motion = parts_trajectory(scene, result, SPEED, ACCEL, JERK, RATE)
+            segments = [s for _, s in result.segments]
+            sliders = [scene.part(n).slider for n, _ in result.segments]
+            assert any(s.kind == "transfer" for s in segments) and any(s.kind == "transit" for s in segments)
+        else:
+            motion = trajectory(scene, result, SPEED, ACCEL, JERK, RATE)
+            segments, sliders = result.segments, [scene.slider] * len(result.segments)
+            assert result.switches
+        text = motion.to_csv()
+        header = text.splitlines()[0]
+        assert header == HEADER + (",part" if isinstance(scene, PartsScene) else "")
+        parts = [line.rsplit(",", 1)[1] for line in text.splitlines()[1:]] if "part" in header else []
+        owners = [n for n, _ in result.segments] if isinstance(scene, PartsScene) else []
+        out[name] = Run(scene, segments, sliders, np.loadtxt(io.StringIO(text), delimiter=",", skiprows=1,
+                                                             usecols=range(10)), motion, parts, owners)
     return out
 
 
@@ -63,9 +95,9 @@ def corner_velocities(scene, rows: np.ndarray) -> np.ndarray:
     return np.stack([vx, vy], axis=-1)
 
 
-@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+@pytest.mark.parametrize("name", CASES)
 def test_corners_respect_the_speed_and_acceleration_limits(runs, name):
-    scene, _, rows = runs[name]
+    scene, rows = runs[name].scene, runs[name].rows
     p, dt = corner_positions(scene, rows), np.diff(rows[:, 0])
     v = np.diff(p, axis=0) / dt[:, None, None]
     assert np.linalg.norm(v, axis=2).max() <= SPEED * SLACK
@@ -75,9 +107,9 @@ def test_corners_respect_the_speed_and_acceleration_limits(runs, name):
     assert np.linalg.norm(a, axis=2).max() <= ACCEL * SLACK
 
 
-@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+@pytest.mark.parametrize("name", CASES)
 def test_velocity_is_continuous_and_matches_the_poses(runs, name):
-    scene, _, rows = runs[name]
+    scene, rows = runs[name].scene, runs[name].rows
     v, dt = corner_velocities(scene, rows), np.diff(rows[:, 0])
     assert (np.linalg.norm(np.diff(v, axis=0), axis=2).max(axis=1) <= ACCEL * dt * SLACK + 1e-12).all()
     moved = np.diff(corner_positions(scene, rows)[:, :, :2], axis=0)
@@ -85,10 +117,10 @@ def test_velocity_is_continuous_and_matches_the_poses(runs, name):
     assert np.abs(moved - mean).max() <= JERK * dt.max() ** 3
 
 
-def _push_error(scene, push, pose: np.ndarray) -> tuple[float, float]:
+def _push_error(slider, push, pose: np.ndarray) -> tuple[float, float]:
     """How far the pusher pose ``pose`` is from the push's planned pusher path, and its parameter s
     there: s found from the part pose the pusher pose implies."""
-    local = edge_contact_pose(scene.slider, push.edge, np.zeros(3))
+    local = edge_contact_pose(slider, push.edge, np.zeros(3))
     theta = pose[2] - local[2]
     c, s = math.cos(theta), math.sin(theta)
     part = np.array([pose[0] - c * local[0] + s * local[1], pose[1] - s * local[0] - c * local[1], theta])
@@ -102,7 +134,7 @@ def _push_error(scene, push, pose: np.ndarray) -> tuple[float, float]:
     best = (math.inf, 0.0)
     for s_ in candidates:
         if -1e-9 <= s_ <= push.duration + 1e-9:
-            on = edge_contact_pose(scene.slider, push.edge, exp_twist(push.start, push.twist, s_))
+            on = edge_contact_pose(slider, push.edge, exp_twist(push.start, push.twist, s_))
             best = min(best, (max(math.dist(on[:2], pose[:2]), abs(float(wrap_angle(on[2] - pose[2])))), s_))
     return best
 
@@ -128,42 +160,49 @@ def _transit_place(transit, pose: np.ndarray) -> tuple[float, int, float]:
     return best
 
 
-@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+@pytest.mark.parametrize("name", CASES)
 def test_the_csv_numbers_the_segments_from_1_to_their_count_as_the_screen_does(runs, name):
-    _, result, rows = runs[name]
-    assert sorted(set(rows[:, 9].astype(int))) == list(range(1, len(result.segments) + 1))
+    run = runs[name]
+    assert sorted(set(run.rows[:, 9].astype(int))) == list(range(1, len(run.segments) + 1))
 
 
-@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+def test_the_part_column_names_the_part_each_sample_moves(runs):
+    run = runs["parts/tray"]
+    assert run.parts == [run.owners[int(k) - 1] for k in run.rows[:, 9]]
+    assert set(run.parts) == set(run.scene.names)
+
+
+@pytest.mark.parametrize("name", CASES)
 def test_every_sample_lies_on_the_planned_path(runs, name):
-    scene, result, rows = runs[name]
-    for row in rows[::5]:  # every fifth sample keeps it quick
-        segment = result.segments[int(row[9]) - 1]  # numbered from 1, as on screen
+    run = runs[name]
+    for row in run.rows[::5]:  # every fifth sample keeps it quick
+        k = int(row[9]) - 1  # numbered from 1, as on screen
+        segment = run.segments[k]
         if segment.kind == "push":
-            error, s = _push_error(scene, segment, row[1:4])
+            error, s = _push_error(run.sliders[k], segment, row[1:4])
         else:
             error = _transit_place(segment, row[1:4])[0]
         assert error <= 1e-9, (row, segment.kind)
 
 
-@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+@pytest.mark.parametrize("name", CASES)
 def test_plan_time_places_each_sample_on_the_plans_own_clock(runs, name):
     """The plan time of a sample is where the plan (and the recording's ``time`` timeline) has the
     pusher there: a push's path parameter, recovered from the pose alone, or the transit time at
     which :func:`transit_poses` (the recording's placing) puts the pusher at the sample's pose."""
-    scene, result, _ = runs[name]
-    motion = trajectory(scene, result, SPEED, ACCEL, JERK, RATE)
-    clocks = np.concatenate([[0.0], np.cumsum([s.duration for s in result.segments])])
+    run = runs[name]
+    scene, motion = run.scene, run.motion
+    clocks = np.concatenate([[0.0], np.cumsum([s.duration for s in run.segments])])
     assert (np.diff(motion.plan_time) >= -1e-12).all()
     assert motion.plan_time[0] == 0.0 and motion.plan_time[-1] == pytest.approx(clocks[-1], abs=1e-9)
     body = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
-    for k, segment in enumerate(result.segments):
+    for k, segment in enumerate(run.segments):
         rows = np.flatnonzero(motion.segment == k)
         into = motion.plan_time[rows] - clocks[k]
         assert (into >= -1e-12).all() and (into <= segment.duration + 1e-9).all()
         poses = np.column_stack([motion.x, motion.y, motion.theta])[rows]
         if segment.kind == "push":
-            found = np.array([_push_error(scene, segment, pose)[1] for pose in poses])
+            found = np.array([_push_error(run.sliders[k], segment, pose)[1] for pose in poses])
             assert np.abs(found - into).max() <= 1e-9
         else:
             placed, _ = transit_poses(segment, body, into)
@@ -172,34 +211,35 @@ def test_plan_time_places_each_sample_on_the_plans_own_clock(runs, name):
             assert np.abs(gap).max() <= 1e-9
 
 
-@pytest.mark.parametrize("name", ["junction", "narrow_junction"])
+@pytest.mark.parametrize("name", CASES)
 def test_rests_at_the_ends_and_at_every_change_of_segment(runs, name):
-    scene, result, rows = runs[name]
+    run = runs[name]
+    scene, segments, rows = run.scene, run.segments, run.rows
     t, segment = rows[:, 0], rows[:, 9].astype(int) - 1  # the CSV numbers them from 1
     assert t[0] == 0.0 and np.allclose(np.diff(t)[:-1], 1 / RATE) and 0 < t[-1] - t[-2] <= 1 / RATE + 1e-12
     speed = np.linalg.norm(corner_velocities(scene, rows), axis=2).max(axis=1)
     assert speed[0] == 0.0 and speed[-1] <= 1e-12
     change = np.flatnonzero(np.diff(segment)) + 1
-    assert len(change) == len(result.segments) - 1  # every segment of these plans has samples
+    assert len(change) == len(segments) - 1  # every segment of these plans has samples
     # At rest at the change, somewhere between the two samples: neither can be faster than that allows.
     assert (speed[change] <= ACCEL / RATE * SLACK).all() and (speed[change - 1] <= ACCEL / RATE * SLACK).all()
-    assert (np.diff(segment) >= 0).all() and segment[0] == 0 and segment[-1] == len(result.segments) - 1
-    kinds = np.array([s.kind == "push" for s in result.segments])
+    assert (np.diff(segment) >= 0).all() and segment[0] == 0 and segment[-1] == len(segments) - 1
+    kinds = np.array([s.kind == "push" for s in segments])
     assert (rows[:, 8] == kinds[segment]).all()
-    first = result.segments[0]
-    assert np.allclose(rows[0, 1:4], edge_contact_pose(scene.slider, first.edge, first.start), atol=1e-12)
-    last = result.segments[-1]
-    assert _push_error(scene, last, rows[-1, 1:4]) == pytest.approx((0.0, last.duration), abs=1e-9)
+    first = segments[0]
+    assert np.allclose(rows[0, 1:4], edge_contact_pose(run.sliders[0], first.edge, first.start), atol=1e-12)
+    last = segments[-1]
+    assert _push_error(run.sliders[-1], last, rows[-1, 1:4]) == pytest.approx((0.0, last.duration), abs=1e-9)
 
 
 def test_a_lift_rises_and_lands_straight_and_flies_at_full_height(runs):
     """Off the table only over the flight's two standoff poses or between them, and moving
     across the table only at full height: the face never swings low over the part it left."""
-    scene, result, rows = runs["narrow_junction"]
+    segments, rows = runs["narrow_junction"].segments, runs["narrow_junction"].rows
     z = rows[:, 7]
     assert z.min() == 0.0 and z.max() == pytest.approx(0.05, abs=1e-12)
     for row in rows:
-        segment = result.segments[int(row[9]) - 1]  # numbered from 1, as on screen
+        segment = segments[int(row[9]) - 1]  # numbered from 1, as on screen
         if segment.kind == "push" or segment.mode != "lift":
             assert row[7] == 0.0
             continue

@@ -47,26 +47,29 @@ part's inertial force ``m a`` must be negligible against the support friction ``
 
 from __future__ import annotations
 
+import csv
 import io
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 import ruckig
 
-from mechanics import exp_twist, point_velocity, transform_points, wrap_angle
+from mechanics import Slider, exp_twist, point_velocity, transform_points, wrap_angle
 
 from ..actions.transit import AIRBORNE, edge_contact_pose, piece_times
 from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
+from ..model.parts import PartsScene
+from ..model.parts_plan import PartsPlan, Transfer
 from ..model.plan_file import Plan, Push, Transit
-from ..model.scene import Scene
+from ..model.scene import Pusher, Scene
 
 __all__ = ["COLUMNS", "LIFT_HEIGHT", "MAX_ACCEL", "MAX_JERK", "MAX_SPEED", "RATE", "Trajectory", "path_limits",
-           "planned_part", "trajectory"]
+           "parts_trajectory", "planned_part", "trajectory"]
 
 #: Default limits for every point of the pusher body: m/s, m/s^2, m/s^3 (quasi-static, above).
 MAX_SPEED, MAX_ACCEL, MAX_JERK = 0.05, 0.5, 5.0
@@ -105,6 +108,8 @@ class Trajectory:
     contact: np.ndarray
     segment: np.ndarray
     plan_time: np.ndarray | None = field(default=None, compare=False, repr=False)
+    #: Of a multi-part plan (:func:`parts_trajectory`): the part each sample's segment moves, a CSV column.
+    part: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     @property
     def duration(self) -> float:
@@ -117,9 +122,15 @@ class Trajectory:
         columns = [self.segment + 1 if c == "segment" else getattr(self, c) for c in COLUMNS]
         table = np.column_stack(columns) if len(self.t) else np.zeros((0, len(COLUMNS)))
         table = table + 0.0  # -0.0 written as 0
-        np.savetxt(text, table, fmt=["%.17g"] * 8 + ["%d"] * 2, delimiter=",", header=",".join(COLUMNS),
-                   comments="")
-        return text.getvalue()
+        header = ",".join(COLUMNS + (("part",) if self.part is not None else ()))
+        np.savetxt(text, table, fmt=["%.17g"] * 8 + ["%d"] * 2, delimiter=",", header=header, comments="")
+        if self.part is None:
+            return text.getvalue()
+        # A part's name is a plain printable name (planner.model.parts), but it may hold a comma or a quote.
+        lines = text.getvalue().splitlines()
+        rows = io.StringIO()
+        csv.writer(rows, lineterminator="\n").writerows([line.split(",") + [name] for line, name in zip(lines[1:], self.part)])
+        return f"{lines[0]}\n{rows.getvalue()}"
 
     def write_csv(self, path: str | Path) -> None:
         """Write :meth:`to_csv` to ``path`` atomically (:func:`planner.model.files.write_atomic`)."""
@@ -166,8 +177,8 @@ class _Piece(NamedTuple):
     at: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]  # s -> pose, dpose/ds, z
 
 
-def _push_piece(scene: Scene, index: int, push: Push, corners: np.ndarray, clock: float) -> _Piece:
-    local = edge_contact_pose(scene.slider, push.edge, np.zeros(3))  # pusher frame in the slider frame
+def _push_piece(slider: Slider, index: int, push: Push, corners: np.ndarray, clock: float) -> _Piece:
+    local = edge_contact_pose(slider, push.edge, np.zeros(3))  # pusher frame in the slider frame
     twist = np.asarray(push.twist, dtype=float)
     speed = float(np.linalg.norm(point_velocity(twist, transform_points(corners, local)), axis=1).max())
     origin = point_velocity(twist, local[:2])  # the pusher origin's velocity per unit s, slider frame
@@ -182,7 +193,7 @@ def _push_piece(scene: Scene, index: int, push: Push, corners: np.ndarray, clock
     return _Piece(index, True, float(push.duration), speed, abs(float(twist[2])) * speed, clock, 1.0, at)
 
 
-def _transit_pieces(index: int, transit: Transit, reach: float, clock: float) -> list[_Piece]:
+def _transit_pieces(index: int, transit: Transit | Transfer, reach: float, clock: float) -> list[_Piece]:
     path = np.asarray(transit.pusher_path, dtype=float)
     # The plan's clock runs through the pieces as transit_poses has it, stretched to the duration.
     times = piece_times(path, reach)
@@ -250,16 +261,42 @@ def trajectory(scene: Scene, plan: Plan, max_speed: float = MAX_SPEED, max_accel
     >>> run.duration, len(run.t), float(run.vy.max()), float(run.vx.max())  # 0.3/0.05 + 0.05/0.5 + 0.5/5
     (6.2, 621, 0.05, 0.0)
     """
+    return _timed(scene.pusher, [(scene.slider, s) for s in plan.segments], max_speed, max_accel, max_jerk, rate)
+
+
+def parts_trajectory(scene: PartsScene, plan: PartsPlan, max_speed: float = MAX_SPEED, max_accel: float = MAX_ACCEL,
+                     max_jerk: float = MAX_JERK, rate: float = RATE) -> Trajectory:
+    """:func:`trajectory` of a multi-part plan: the pusher along every move and every transfer in
+    order (a transfer is followed as a transit is, rest to rest on each piece), with the ``part``
+    each sample's segment belongs to (a transfer's: the part it goes to).
+
+    >>> from planner.model.scene_file import load_scene
+    >>> from planner.queries.session import Planner
+    >>> scene = load_scene("scenes/parts/swap.yaml")
+    >>> run = parts_trajectory(scene, Planner(scene).plan())
+    >>> run.to_csv().splitlines()[0], sorted(set(run.part.tolist()))
+    ('t,x,y,theta,vx,vy,omega,z,contact,segment,part', ['blue', 'red'])
+    """
+    segments = plan.segments
+    motion = _timed(scene.pusher, [(scene.part(name).slider, s) for name, s in segments], max_speed, max_accel,
+                    max_jerk, rate)
+    names = np.array([name for name, _ in segments] or [""])
+    return replace(motion, part=names[motion.segment] if len(motion.t) else np.zeros(0, dtype=str))
+
+
+def _timed(pusher: Pusher, segments: list[tuple[Slider, Push | Transit | Transfer]], max_speed: float,
+           max_accel: float, max_jerk: float, rate: float) -> Trajectory:
+    """The trajectory along ``segments``, each with the part it moves (module docstring)."""
     if not all(0 < value < math.inf for value in (max_speed, max_accel, max_jerk, rate)):
         raise ValueError("limits and rate must be positive and finite")
-    if not plan.segments:
+    if not segments:
         return Trajectory(*(np.zeros(0) for _ in COLUMNS), np.zeros(0))
-    corners = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
+    corners = pusher_frame_body(pusher.width, pusher.depth)
     reach = float(np.linalg.norm(corners, axis=1).max())
     pieces: list[_Piece] = []
     clock = 0.0
-    for i, segment in enumerate(plan.segments):
-        pieces += ([_push_piece(scene, i, segment, corners, clock)] if segment.kind == "push"
+    for i, (slider, segment) in enumerate(segments):
+        pieces += ([_push_piece(slider, i, segment, corners, clock)] if segment.kind == "push"
                    else _transit_pieces(i, segment, reach, clock))
         clock += segment.duration
     laws = [_time_law(p, max_speed, max_accel, max_jerk) for p in pieces]
