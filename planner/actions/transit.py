@@ -39,7 +39,7 @@ from ..model.plan_file import Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
-__all__ = ["AIRBORNE", "ARC_STEP", "TransitPlanner", "contact_pose", "edge_contact_pose", "in_plane_moves", "path_duration", "piece_times",
+__all__ = ["AIRBORNE", "ARC_STEP", "TransitPlanner", "backed_off", "contact_pose", "edge_contact_pose", "in_plane_moves", "path_duration", "piece_times",
            "standoff", "transit_pieces", "transit_poses"]
 
 #: Largest turn of the pusher between two poses of a walk round a corner of the part.
@@ -91,6 +91,16 @@ def contact_pose(part_pose: ArrayLike, point: ArrayLike, normal: ArrayLike, gap:
     local = np.asarray(point, dtype=float) + gap * np.asarray(normal, dtype=float)
     x, y = transform_points(local[None], part_pose)[0]
     return np.array([x, y, float(wrap_angle(math.atan2(-normal[1], -normal[0]) + part_pose[2]))])
+
+
+def backed_off(pose: ArrayLike, distance: float) -> np.ndarray:
+    """The pusher frame's pose ``distance`` behind ``pose``, along its own -x.
+
+    >>> backed_off([1.0, 0.0, math.pi / 2], 0.1).round(12).tolist()
+    [1.0, -0.1, 1.570796326795]
+    """
+    x, y, theta = np.asarray(pose, dtype=float)
+    return np.array([x - distance * math.cos(theta), y - distance * math.sin(theta), theta])
 
 
 def edge_contact_pose(slider: Slider, edge: int, part_pose: ArrayLike) -> np.ndarray:

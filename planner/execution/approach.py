@@ -21,13 +21,13 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from ..actions.transit import TransitPlanner, edge_contact_pose, path_duration, standoff
+from ..actions.transit import TransitPlanner, backed_off, edge_contact_pose, path_duration, standoff
 from ..model.bodies import pusher_frame_body, slider_at
 from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
-__all__ = ["CLEARANCE", "GRAZE", "LEAD_IN", "PART_STEP", "approach", "backed_off", "first_edge", "lead_in_pose"]
+__all__ = ["CLEARANCE", "GRAZE", "LEAD_IN", "PART_STEP", "approach", "first_edge", "lead_in_pose"]
 
 #: How far behind the first contact a run begins, m: more than the start errors a perception
 #: system makes (a centimetre or two), so the part is met, not overlapped.
@@ -39,16 +39,6 @@ GRAZE = 0.001
 #: Least distance of the pusher's moves from obstacles and walls, m: conservative advancement
 #: needs one above zero to end (it steps by the clearance, which a grazing move runs down to 0).
 CLEARANCE = 0.0005
-
-
-def backed_off(pose: ArrayLike, distance: float) -> np.ndarray:
-    """The pusher frame's pose ``distance`` behind ``pose``, along its own -x.
-
-    >>> backed_off([1.0, 0.0, math.pi / 2], 0.1).round(12).tolist()
-    [1.0, -0.1, 1.570796326795]
-    """
-    x, y, theta = np.asarray(pose, dtype=float)
-    return np.array([x - distance * math.cos(theta), y - distance * math.sin(theta), theta])
 
 
 def first_edge(plan: Plan) -> int:

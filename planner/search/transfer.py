@@ -15,7 +15,6 @@ OMPL's path simplifier. The search is seeded and capped by iterations, so a seed
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import replace
 
@@ -26,27 +25,17 @@ from ompl import geometric as og
 
 from mechanics import wrap_angle
 
-from ..actions.transit import path_duration, standoff
+from ..actions.transit import backed_off, path_duration, standoff
 from ..model.bodies import pusher_frame_body
 from ..model.parts import PartsScene
 from ..model.parts_plan import Transfer
 from ..world.validity import CollisionModel
 from .planning import _seed_ompl
 
-__all__ = ["TRANSFER_ITERATIONS", "TransferPaths", "backed_off"]
+__all__ = ["TRANSFER_ITERATIONS", "TransferPaths"]
 
 #: Iterations of RRT-Connect for one transfer on the table (a seed then decides its path).
 TRANSFER_ITERATIONS = 4000
-
-
-def backed_off(pose: ArrayLike, distance: float) -> np.ndarray:
-    """The pusher frame ``pose`` moved back (along its own -x) by ``distance``.
-
-    >>> backed_off([1.0, 2.0, math.pi / 2], 0.5).round(12).tolist()
-    [1.0, 1.5, 1.570796327]
-    """
-    x, y, theta = (float(v) for v in pose)
-    return np.array([x - distance * math.cos(theta), y - distance * math.sin(theta), theta]).round(9)
 
 
 class TransferPaths:
