@@ -74,6 +74,7 @@ from .actions.region_cache import cache_folder
 from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEFAULT_TRANSIT, MAX_OPTIMIZE,
                             MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS, TRANSITS, PlannerOptions)
 from .model.parts import PartsScene
+from .model.parts_plan import PartsPlan
 from .model.scene import Scene, placement_fault, write_scene
 from .model.scene_file import load_scene
 from .queries.session import plan
@@ -207,7 +208,7 @@ class Inputs:
     out: Path  # the output folder (not created yet)
     verify: int | None  # --verify N
     plan_path: str | None  # --plan FILE
-    given: Plan | None  # that file's plan, checked against the scene and run from its start, instead of planning
+    given: Plan | PartsPlan | None  # that file's plan, checked against the scene and run from its start, instead of planning
     reach: int | None = None  # --reach N: pushes of the reachable-set map
     engine: tuple[str, int | None, str | None] | None = None  # --engine, --jobs, --address: where the map runs
     trajectory: bool = False  # --trajectory: write the pusher's trajectory
@@ -255,7 +256,9 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     if args.sim_cf_offset is not None:
         from .execution.mujoco_sim import support_centre
 
-        support_centre(scene, args.sim_cf_offset)
+        for one in ([scene.move_scene(n, scene.starts) for n in scene.names] if isinstance(scene, PartsScene)
+                    else [scene]):
+            support_centre(one, args.sim_cf_offset)
     if args.sim_start_error is not None:  # found now; the rest (the pusher's lead-in, the bumps) once planned
         moved = scene.start + _radians(args.sim_start_error)
         if (fault := placement_fault(scene.slider, scene.obstacles, scene.workspace, moved)) is not None:
@@ -277,7 +280,12 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     if args.export_scene is not None and os.path.isdir(args.export_scene):
         raise SceneError("--export-scene", f"{shown(args.export_scene)} is a folder")
     given = None
-    if args.plan is not None:
+    if args.plan is not None and isinstance(scene, PartsScene):
+        from .execution.fit import fit_parts_plan  # with the re-simulator: only for a plan file
+        from .model.parts_plan import load_parts_plan
+
+        given = fit_parts_plan(scene, load_parts_plan(args.plan))
+    elif args.plan is not None:
         from .execution.fit import fit_plan  # with the re-simulator: only for a plan file
 
         given = fit_plan(scene, load_plan(args.plan))
@@ -362,8 +370,9 @@ def _check_simulation(args: argparse.Namespace) -> None:
     needs_mujoco()
 
 
-#: What a multi-part scene does not take (yet): each flag with why.
-_ONE_PART = ("--plan", "--reach", "--export-scene", "--verify", "--simulate")
+#: The flags a multi-part scene does not take: maps, scene export, and the closed loop's perturbations.
+_ONE_PART = ("--reach", "--export-scene", "--sim-start-error", "--sim-bump", "--sim-pose-noise", "--closed-loop",
+             "--mjcf", "--engine", "--jobs", "--address")
 
 
 def _check_parts(args: argparse.Namespace) -> None:
@@ -502,22 +511,34 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
 
 
 def _plan_parts(inputs: Inputs) -> int:
-    """Plan a multi-part scene and write its plan (``stablepush.plan/2``) and recording."""
-    from .queries.session import PartsPlanner
+    """Plan (or load) a multi-part plan, verify or simulate it if asked, and write its plan
+    (``stablepush.plan/2``), recording and trajectory."""
+    scene, out, seed = inputs.scene, inputs.out, inputs.seed
+    if inputs.given is not None:
+        result = inputs.given
+    else:
+        from .queries.session import PartsPlanner
 
-    scene, out = inputs.scene, inputs.out
-    tty = sys.stderr.isatty()
-    if tty:
-        print(f"planning {scene.name}: {len(scene.parts)} parts with {inputs.planner} (seed {inputs.seed}, limit "
-              f"{inputs.time_limit:g} s) ...", file=sys.stderr, flush=True)
-    result = PartsPlanner(scene, progress=_progress if tty else None).plan()
-    if tty:
-        print("\r\033[K", end="", file=sys.stderr, flush=True)
-    motion = None
+        tty = sys.stderr.isatty()
+        if tty:
+            print(f"planning {scene.name}: {len(scene.parts)} parts with {inputs.planner} (seed {seed}, limit "
+                  f"{inputs.time_limit:g} s) ...", file=sys.stderr, flush=True)
+        result = PartsPlanner(scene, progress=_progress if tty else None).plan()
+        if tty:
+            print("\r\033[K", end="", file=sys.stderr, flush=True)
+    check = motion = simulation = None
+    if inputs.verify and result.solved:
+        from .execution.parts_verify import verify_parts
+
+        check = verify_parts(scene, result, inputs.verify, seed)
     if inputs.trajectory and result.solved:
         from .execution.trajectory import parts_trajectory  # loads ruckig, only for --trajectory
 
         motion = parts_trajectory(scene, result)
+    if inputs.simulate and result.solved:
+        from .execution.parts_sim import simulate_parts  # MuJoCo is loaded only for --simulate
+
+        simulation = simulate_parts(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset)
     try:
         with staged_folder(out) as stage:
             from .outputs.parts_recording import write_parts_recording  # rerun: only now
@@ -531,10 +552,17 @@ def _plan_parts(inputs: Inputs) -> int:
     if not result.solved:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
         return 2
+    head = (f"loaded {inputs.plan_path}: {result.contents()}" if inputs.given is not None
+            else f"solved: {result.headline()}, planning time {result.planning_time_s:.2f} s")
     extra = f", {scene.name}.trajectory.csv" if motion is not None else ""
-    print(f"solved: {result.headline()}, planning time {result.planning_time_s:.2f} s -> {out}/{scene.name}.json, "
-          f"{scene.name}.rrd{extra}")
-    return 0
+    lines = [f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}"]
+    for report in (check, simulation):
+        if report is not None:
+            lines += [*report.lines(), report.summary()]
+    if len(lines) > 1:
+        lines[-1] += f" (outputs in {out})"
+    print("\n".join(lines))
+    return 0 if all(r is None or r.passed for r in (check, simulation)) else 3
 
 
 def _export_scene(scene: Scene, inputs: Inputs) -> None:

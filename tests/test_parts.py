@@ -156,7 +156,8 @@ def test_cli_plans_a_multi_part_scene(tmp_path):
 @pytest.mark.parametrize("changes, args, words", [
     ({"parts.1.start": [0.02, 0.02, 0]}, [], "parts[1].start: part 'b' overlaps part 'a' at their starts"),
     ({"parts.1.name": "a"}, [], "parts[1].name: part 'a' is named twice"),
-    ({}, ["--verify", "2"], "--verify: is for one-part scenes"),
+    ({}, ["--reach", "1"], "--reach: is for one-part scenes"),
+    ({}, ["--simulate", "1", "--closed-loop"], "--closed-loop: is for one-part scenes"),
 ])
 def test_cli_bad_multi_part_input_is_one_line(tmp_path, changes, args, words):
     scene = tmp_path / "bad.yaml"
@@ -165,3 +166,50 @@ def test_cli_bad_multi_part_input_is_one_line(tmp_path, changes, args, words):
     assert done.returncode == 1 and done.stderr.startswith(f"plan: error: {words}")
     assert done.stderr.count("\n") == 1 and not done.stdout
     assert not (tmp_path / "out").exists()
+
+
+def test_channel_simulates_with_every_part_delivered(tmp_path):
+    pytest.importorskip("mujoco")
+    done = run_plan("scenes/parts/channel.yaml", "--simulate", "2", "--out", tmp_path / "out")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "simulate: passed: 2/2 runs with every part in its goal" in done.stdout
+    assert "at least 2/2 parts delivered" in done.stdout
+
+
+def _shove(tmp_path):
+    """A scene where b stands on a's straight way and stays put, and a doctored plan that pushes a
+    straight through b (the plan of a alone, as if b were not there)."""
+    from planner.model.parts_plan import Move
+    from planner.queries.session import plan as plan_one
+
+    spec = _scene(**{"parts.1.start": [0.15, 0.0, 90], "parts.1.goal": [0.15, 0.0, 90]})
+    scene = parse_scene(spec)
+    alone = plan_one(parse_scene({"slider": {"vertices": BLOCK}, "pusher": spec["pusher"],
+                                  "workspace": spec["workspace"], "start": [0, 0, 0], "goal": [0.3, 0, 0]}), seed=1)
+    assert alone.solved
+    doctored = PartsPlan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, starts=scene.starts,
+                         goals=scene.goals, moves=[Move("a", alone.segments)], delivered=("a", "b"),
+                         switch_cost=0.25, cfs={p.name: p.slider.cf for p in scene.parts})
+    (tmp_path / "shove.yaml").write_text(yaml.safe_dump(spec))
+    (tmp_path / "shove.json").write_text(doctored.to_json())
+    return tmp_path / "shove.yaml", tmp_path / "shove.json"
+
+
+def test_a_doctored_plan_that_shoves_a_part_fails_verify_and_simulate(tmp_path):
+    scene, doctored = _shove(tmp_path)
+    checked = run_plan(scene, "--verify", "4", "--plan", doctored, "--out", tmp_path / "v")
+    assert checked.returncode == 3, checked.stdout + checked.stderr
+    assert "move 1/1 (a)" in checked.stdout and "meets b: FAILED" in checked.stdout
+    pytest.importorskip("mujoco")
+    run = run_plan(scene, "--simulate", "1", "--plan", doctored, "--out", tmp_path / "s")
+    assert run.returncode == 3, run.stdout + run.stderr
+    assert "a touches b" in run.stdout and "misses the goal: b" in run.stdout
+
+
+def test_a_plan_file_for_other_starts_is_bad_input(tmp_path, plans):
+    data = plans["swap"].to_dict()
+    data["parts"]["red"]["start"][0] += 0.05  # and so no segment of red follows on from it
+    (tmp_path / "other.json").write_text(json.dumps(data))
+    done = run_plan("scenes/parts/swap.yaml", "--verify", "2", "--plan", tmp_path / "other.json", "--out", tmp_path / "o")
+    assert done.returncode == 1 and done.stderr.startswith("plan: error: plan.")
+    assert not (tmp_path / "o").exists()

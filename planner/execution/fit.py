@@ -28,21 +28,24 @@ computations (a path hugging a wall for kilometres) is refused rather than check
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 
 import numpy as np
 
 from mechanics import point_velocity, wrap_angle
 
-from ..actions.transit import in_plane_moves
+from ..actions.transit import edge_contact_pose, in_plane_moves
 from ..model.bodies import body_outline
 from ..model.fields import SceneError, pose_text
+from ..model.parts import PartsScene
+from ..model.parts_plan import Move, PartsPlan, Transfer
 from ..model.plan_file import Plan, Push, rechain
 from ..model.scene import Scene
 from ..world.validity import CollisionModel, advances, pose_along
 from .verify import check_chain
 
-__all__ = ["CLEARANCE", "MAX_CHECKS", "MAX_TRAVEL", "fit_plan"]
+__all__ = ["CLEARANCE", "MAX_CHECKS", "MAX_TRAVEL", "body_speed", "fit_parts_plan", "fit_plan"]
 
 #: Least clearance (in part radii) a loaded plan's pushes and transits must keep: a millionth.
 CLEARANCE = 1e-6
@@ -104,7 +107,7 @@ def _fit(scene: Scene, plan: Plan) -> Plan:
                                        f"{_miss(scene, plan.start, scene.start)}")
     for k, segment in enumerate(plan.segments):
         if segment.kind == "push":
-            travel = _speed(scene, segment) * segment.duration
+            travel = body_speed(scene, segment) * segment.duration
             if not travel <= MAX_TRAVEL:
                 raise SceneError(f"plan.segments[{k}]", f"carries the body {travel:.3g} m, more than {MAX_TRAVEL:g} m")
     moved = replace(plan, start=scene.start.copy(), goal=scene.goal.copy(), segments=rechain(plan.segments, scene.start))
@@ -115,7 +118,7 @@ def _fit(scene: Scene, plan: Plan) -> Plan:
     return moved
 
 
-def _speed(scene: Scene, push: Push) -> float:
+def body_speed(scene: Scene, push: Push) -> float:
     """The largest speed of any point of the body (part and pusher) under ``push``'s twist."""
     outline = body_outline(scene.slider, push.edge, scene.pusher.width, scene.pusher.depth)
     return float(np.linalg.norm(point_velocity(push.twist, outline), axis=1).max())
@@ -146,7 +149,7 @@ def _check_clear(scene: Scene, plan: Plan) -> None:
         try:
             if segment.kind == "push":
                 at = pose_along(segment.start, segment.twist)
-                free = advances(lambda t: clearance(at(t), segment.edge), segment.duration, _speed(scene, segment),
+                free = advances(lambda t: clearance(at(t), segment.edge), segment.duration, body_speed(scene, segment),
                                 margin)
             else:
                 free = all(model.pusher_move_is_free(a, b, margin) for a, b in in_plane_moves(segment))
@@ -157,3 +160,81 @@ def _check_clear(scene: Scene, plan: Plan) -> None:
             what = "the push" if segment.kind == "push" else "the pusher's transit"
             raise SceneError(f"plan.segments[{k}]", f"{what} meets an obstacle or a workspace wall of the scene "
                                                     f"(from the part at {pose_text(segment.start)})")
+
+
+def fit_parts_plan(scene: PartsScene, plan: PartsPlan) -> PartsPlan:
+    """``plan`` (a ``stablepush.plan/2``) checked to be a plan for the multi-part ``scene``: solved,
+    the scene's parts at the scene's starts, each move a plan of its part that :func:`fit_plan`
+    accepts with the scene's obstacles and walls (a buffer move ending where it ends), each
+    transfer flush on the part it leaves and the part it reaches and clear of obstacles and walls,
+    and every part ending within tolerance of its goal. What the parts do to each other (a push
+    that shoves another part, a transfer through one) is not refused here: it is what ``--verify``
+    and ``--simulate`` find, exit 3.
+
+    Raises
+    ------
+    SceneError
+        Naming the plan field that does not fit the scene.
+    """
+    if not plan.solved:
+        raise SceneError("plan.solved", "is false: the file holds no way to the goals to check or run"
+                                        + (f" ({plan.reason})" if plan.reason else ""))
+    if sorted(plan.names) != sorted(scene.names):
+        raise SceneError("plan.parts", f"are {', '.join(plan.names)}, but the scene's parts are {', '.join(scene.names)}")
+    size = max(1.0, float(np.max(np.abs(scene.workspace))))
+    for part in scene.parts:
+        if np.abs(plan.starts[part.name] - part.start).max() > 1e-9 * size:
+            raise SceneError(f"plan.parts.{part.name}.start", f"is {pose_text(plan.starts[part.name])}, not the scene's "
+                                                              f"start {pose_text(part.start)}")
+    poses, offset = scene.starts, 0
+    last_move = {m.part: k for k, m in enumerate(plan.moves)}
+    for k, move in enumerate(plan.moves):
+        if move.transfer is not None:
+            _fit_transfer(scene, move.transfer, poses, plan.moves[k - 1], move, offset)
+            offset += 1
+        alone = replace(scene.move_scene(move.part, poses), obstacles=scene.obstacles)
+        goal = alone.goal if last_move[move.part] == k else move.end
+        try:
+            fit_plan(replace(alone, goal=goal), Plan(scene=plan.scene, solved=True, planner=plan.planner, seed=plan.seed,
+                                                 planning_time_s=0.0, start=move.start, goal=goal,
+                                                 segments=move.segments, cf=plan.cfs.get(move.part)))
+        except SceneError as err:
+            raise SceneError(_in_plan(err.field, offset, move.part), err.problem) from None
+        offset += len(move.segments)
+        poses[move.part] = move.end
+    for part in scene.parts:
+        if not scene.within_tolerance(part.name, poses[part.name]):
+            raise SceneError(f"plan.parts.{part.name}.final", f"is {pose_text(poses[part.name])}, not within tolerance "
+                                                              f"of the part's goal {pose_text(part.goal)}")
+    return replace(plan, goals=scene.goals)
+
+
+def _in_plan(field: str, offset: int, part: str) -> str:
+    """A one-part plan's field as the multi-part plan names it: its segments numbered among all of them.
+
+    >>> _in_plan("plan.segments[2].twist", 5, "a"), _in_plan("plan.final", 5, "a")
+    ('plan.segments[7].twist', 'plan.parts.a.final')
+    """
+    if (m := re.match(r"plan\.segments\[(\d+)\]", field)) is not None:
+        return f"plan.segments[{int(m.group(1)) + offset}]{field[m.end():]}"
+    return f"plan.parts.{part}.{field.removeprefix('plan.')}"
+
+
+def _fit_transfer(scene: PartsScene, transfer: Transfer, poses: dict[str, np.ndarray], before: Move, after: Move,
+                  index: int) -> None:
+    """Refuse ``transfer`` (segment ``index``) unless it leaves ``before``'s part from its last contact, reaches
+    ``after``'s first contact, and its in-plane moves keep clear of the obstacles and walls."""
+    name = f"plan.segments[{index}]"
+    last, first = before.segments[-1], after.segments[0]
+    ends = ((transfer.pusher_path[0], before.part, last.edge), (transfer.pusher_path[-1], after.part,
+                                                                  first.edge if first.kind == "push" else first.from_edge))
+    for pose, part, edge in ends:
+        flush = edge_contact_pose(scene.part(part).slider, edge, poses[part])
+        if np.abs(pose[:2] - flush[:2]).max() > 1e-9 or abs(float(wrap_angle(pose[2] - flush[2]))) > 1e-9:
+            raise SceneError(f"{name}.pusher_path", f"does not {'start' if part == before.part else 'end'} flush on "
+                                                    f"part {part}'s edge {edge}")
+    alone = replace(scene.move_scene(after.part, poses), obstacles=scene.obstacles)
+    model = CollisionModel(alone, ())
+    margin = CLEARANCE * alone.slider.radius
+    if not all(model.pusher_move_is_free(a, b, margin) for a, b in in_plane_moves(transfer)):
+        raise SceneError(name, "the pusher's transfer meets an obstacle or a workspace wall of the scene")

@@ -1,0 +1,270 @@
+"""Multi-part plans run open-loop in MuJoCo: every part a body on its own feet, the pusher following
+the whole sequence of moves and transfers blindly.
+
+The model is :func:`planner.execution.mujoco_sim.mjcf`'s, with every part in it (each a rigid body
+on the feet of its own support distribution, moving in the plane) and the contacts that can tell
+a bad plan from a good one: the pusher against every part, every part against every other part
+(with the table's friction: a part shoved by another moves as it would), and every part against
+the walls and obstacles. A run fails if any part ends outside its goal tolerance, if the pusher
+slips on the part it pushes (:data:`~planner.execution.mujoco_sim.SLIP`, measured per push as for
+one part), or if any part ever touches another part, a wall or an obstacle, or the pusher touches
+a part other than the one it moves (or, on a transfer, leaves): a push that shoves a second part
+is caught.
+
+Run ``k`` gives each part the ``k``-th foot set of :func:`~planner.execution.mujoco_sim.feet` for
+that part, and begins with the pusher behind the first move's first contact, moving in.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from mechanics import relative_pose
+
+from ..model.bodies import convex_pieces, pusher_frame_body
+from ..model.parts import PartsScene
+from ..model.parts_plan import PartsPlan
+from ..model.plan_file import Plan
+from ..world.validity import CollisionModel
+from .mujoco_sim import (FOOT, MASS, PUSHER_MASS, SETTLE, SLIP, TABLE_MU, THICKNESS, TIMESTEP, WALL_HEIGHT, Feet,
+                         _error, _follower, _lead_in, _numbers, _prism, _second_moment, feet, needs_mujoco)
+from .trajectory import Trajectory, parts_trajectory
+
+__all__ = ["PartsRun", "PartsSimulation", "parts_mjcf", "simulate_parts"]
+
+
+def parts_mjcf(scene: PartsScene, supports: dict[str, Feet], mu: float | None = None,
+               starts: dict[str, ArrayLike] | None = None) -> str:
+    """The MuJoCo model of ``scene`` with each part on its ``supports`` feet at ``starts``
+    (default: the scene's), pusher-part friction ``mu`` (default: the planned ``pusher.mu``).
+    Part ``k`` (scene order) is the body ``part<k>`` of geoms ``part<k>_<j>``."""
+    mu = scene.pusher.mu if mu is None else mu
+    starts = scene.starts if starts is None else starts
+    assets, world, pairs, bodies, qpos = [], [], [], [], []
+    xmin, ymin, xmax, ymax = scene.workspace
+    span, wall = max(xmax - xmin, ymax - ymin), 0.05
+    walls = [((xmin - wall / 2, (ymin + ymax) / 2), (wall / 2, (ymax - ymin) / 2 + wall)),
+             ((xmax + wall / 2, (ymin + ymax) / 2), (wall / 2, (ymax - ymin) / 2 + wall)),
+             (((xmin + xmax) / 2, ymin - wall / 2), ((xmax - xmin) / 2 + wall, wall / 2)),
+             (((xmin + xmax) / 2, ymax + wall / 2), ((xmax - xmin) / 2 + wall, wall / 2))]
+    blocks = [f"wall{k}" for k in range(4)]
+    for name, (c, h) in zip(blocks, walls):
+        world.append(f'<geom name="{name}" type="box" pos="{_numbers([*c, WALL_HEIGHT / 2])}" '
+                     f'size="{_numbers([*h, WALL_HEIGHT / 2])}" rgba=".5 .5 .5 1"/>')
+    for i, obstacle in enumerate(scene.obstacles):
+        for j, piece in enumerate(convex_pieces(obstacle)):
+            name = f"obstacle{i}_{j}"
+            assets.append(_prism(name, piece, 0.0, WALL_HEIGHT))
+            world.append(f'<geom name="{name}" type="mesh" mesh="{name}" rgba=".6 .3 .3 1"/>')
+            blocks.append(name)
+    height = THICKNESS / 2 + 2 * FOOT
+    geoms: list[list[str]] = []
+    for k, part in enumerate(scene.parts):
+        pieces = convex_pieces(part.slider.polygon)
+        support = supports[part.name]
+        body = []
+        geoms.append([f"part{k}_{j}" for j in range(len(pieces))])
+        for j, piece in enumerate(pieces):
+            assets.append(_prism(f"part{k}_{j}", piece, -THICKNESS / 2, THICKNESS / 2))
+            body.append(f'<geom name="part{k}_{j}" type="mesh" mesh="part{k}_{j}" rgba=".2 .4 .8 1"/>')
+        for i, (p, w) in enumerate(zip(support.points, support.weights)):
+            body.append(f'<body name="foot{k}_{i}" pos="{_numbers([*p, -THICKNESS / 2 - FOOT])}">'
+                        f'<joint name="foot{k}_{i}" type="slide" axis="0 0 1"/>'
+                        f'<inertial pos="0 0 0" mass="{w * MASS:.17g}" diaginertia="1e-9 1e-9 1e-9"/>'
+                        f'<geom name="foot{k}_{i}" type="sphere" size="{FOOT}" rgba=".1 .1 .1 1"/></body>')
+            pairs.append(f'<pair geom1="table" geom2="foot{k}_{i}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>')
+        inertia = MASS * _second_moment(pieces, support.centre)
+        bodies.append(f"""<body name="part{k}" pos="0 0 {height:.17g}">
+      <joint name="part{k}_x" type="slide" axis="1 0 0"/>
+      <joint name="part{k}_y" type="slide" axis="0 1 0"/>
+      <joint name="part{k}_theta" type="hinge" axis="0 0 1"/>
+      <inertial pos="{_numbers([*support.centre, 0])}" mass="{MASS}" diaginertia="{_numbers([inertia / 2, inertia / 2, inertia])}"/>
+      {chr(10).join('      ' + g for g in body).strip()}
+    </body>""")
+        qpos += [*np.asarray(starts[part.name], dtype=float), *np.zeros(len(support.points))]
+    for k, own in enumerate(geoms):
+        for g in own:
+            pairs.append(f'<pair geom1="pusher" geom2="{g}" condim="3" friction="{mu} {mu} 0 0 0"/>')
+            pairs += [f'<pair geom1="{b}" geom2="{g}" condim="1"/>' for b in blocks]
+            pairs += [f'<pair geom1="{g}" geom2="{h}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>'
+                      for other in geoms[k + 1:] for h in other]
+    top = THICKNESS + 2 * FOOT + 0.01
+    assets.append(_prism("pusher", pusher_frame_body(scene.pusher.width, scene.pusher.depth), 0.0, top))
+    return f"""<mujoco model={quoteattr(scene.name)}>
+  <option timestep="{TIMESTEP}" cone="elliptic" impratio="10" solver="Newton" iterations="50" tolerance="1e-10"/>
+  <default>
+    <geom contype="0" conaffinity="0"/>
+  </default>
+  <asset>
+    {chr(10).join('    ' + a for a in assets).strip()}
+  </asset>
+  <worldbody>
+    <geom name="table" type="plane" size="{_numbers([span, span, 0.1])}" pos="{_numbers([(xmin + xmax) / 2, (ymin + ymax) / 2, 0])}" rgba=".9 .9 .85 1"/>
+    {chr(10).join('    ' + w for w in world).strip()}
+    {chr(10).join('    ' + b for b in bodies).strip()}
+    <body name="pusher" gravcomp="1">
+      <joint name="pusher_x" type="slide" axis="1 0 0"/>
+      <joint name="pusher_y" type="slide" axis="0 1 0"/>
+      <joint name="pusher_z" type="slide" axis="0 0 1"/>
+      <joint name="pusher_theta" type="hinge" axis="0 0 1"/>
+      <inertial pos="0 0 0" mass="{PUSHER_MASS}" diaginertia="{_numbers([PUSHER_MASS * 0.01] * 3)}"/>
+      <geom name="pusher" type="mesh" mesh="pusher" rgba=".1 .1 .1 1"/>
+    </body>
+  </worldbody>
+  <contact>
+    {chr(10).join('    ' + p for p in pairs).strip()}
+  </contact>
+  <keyframe>
+    <key name="start" qpos="{_numbers([*qpos, 0, 0, 0, 0])}"/>
+  </keyframe>
+</mujoco>
+"""
+
+
+@dataclass(frozen=True)
+class PartsRun:
+    """One open-loop run of a multi-part plan: each part's final error against its goal (m,
+    rad), the worst slip of a push (m), and the faults met: contacts that must not happen, as
+    ``(first time s, what)``; a fault is reported once, at its first sample."""
+
+    kinds: tuple[str, ...]  # each part's foot set
+    goal_errors: dict[str, tuple[float, float]]
+    in_goal: dict[str, bool]
+    slip: float
+    slip_segment: int  # where the worst slip was (a segment of PartsPlan.segments, from 0), -1 if none
+    faults: tuple[tuple[float, str], ...]
+    seconds: float
+    simulated: float
+    poses: dict[str, np.ndarray]  # each part's simulated pose at every trajectory sample
+
+    @property
+    def passed(self) -> bool:
+        return all(self.in_goal.values()) and self.slip <= SLIP and not self.faults
+
+    def line(self, k: int, n: int) -> str:
+        worst = max(self.goal_errors, key=lambda name: self.goal_errors[name][0])
+        missed = [name for name, ok in self.in_goal.items() if not ok]
+        faults = ([f"misses the goal: {', '.join(missed)}"] if missed else []) + (
+            [f"SLIPS (segment {self.slip_segment + 1})"] if self.slip > SLIP else []) + [
+            f"{what} at {t:.1f} s" for t, what in self.faults[:3]] + (
+            [f"{len(self.faults) - 3} more faults"] if len(self.faults) > 3 else [])
+        return (f"simulate {k}/{n} ({', '.join(sorted(set(self.kinds)))} feet): worst goal error "
+                f"{self.goal_errors[worst][0]:.2e} m ({worst}); slip {self.slip:.2e} m; {self.seconds:.1f} s for "
+                f"{self.simulated:.1f} s: {'; '.join(faults) if faults else 'ok'}")
+
+
+@dataclass(frozen=True)
+class PartsSimulation:
+    """Outcome of :func:`simulate_parts`: a :class:`PartsRun` per foot set."""
+
+    runs: tuple[PartsRun, ...]
+    mu: float
+    motion: Trajectory
+
+    @property
+    def passed(self) -> bool:
+        return all(r.passed for r in self.runs)
+
+    def lines(self) -> list[str]:
+        return [r.line(k, len(self.runs)) for k, r in enumerate(self.runs, 1)]
+
+    def summary(self) -> str:
+        delivered = min(sum(r.in_goal.values()) for r in self.runs)
+        parts = len(self.runs[0].in_goal)
+        return (f"simulate: {'passed' if self.passed else 'FAILED'}: {sum(r.passed for r in self.runs)}/{len(self.runs)} "
+                f"runs with every part in its goal, without slip or a touch (MuJoCo, pusher mu {self.mu:g}, table mu "
+                f"{TABLE_MU:g}); at least {delivered}/{parts} parts delivered in every run; worst slip "
+                f"{max(r.slip for r in self.runs):.2e} m, {sum(r.seconds for r in self.runs):.1f} s")
+
+
+def simulate_parts(scene: PartsScene, plan: PartsPlan, n: int = 3, seed: int = 1, mu: float | None = None,
+                   cf_offset: ArrayLike = (0.0, 0.0)) -> PartsSimulation:
+    """Run ``plan`` open-loop in MuJoCo once per foot set (module docstring).
+
+    Raises
+    ------
+    SceneError
+        If MuJoCo is missing, or ``cf_offset`` puts a part's centre of pressure off it.
+    """
+    needs_mujoco()
+    first = plan.moves[0]
+    lead_scene = scene.move_scene(first.part, scene.starts)
+    lead_plan = Plan(scene=None, solved=True, planner=plan.planner, seed=plan.seed, planning_time_s=0.0,
+                     start=first.start, goal=first.end, segments=first.segments)
+    lead = _lead_in(lead_scene, lead_plan, CollisionModel(lead_scene, lead_scene.pusher.edges))
+    motion = parts_trajectory(scene, plan)
+    sets = {p.name: feet(scene.move_scene(p.name, scene.starts), n, seed, cf_offset) for p in scene.parts}
+    runs = tuple(_run(scene, plan, motion, lead, {name: s[k] for name, s in sets.items()}, mu) for k in range(n))
+    return PartsSimulation(runs, scene.pusher.mu if mu is None else mu, motion)
+
+
+def _run(scene: PartsScene, plan: PartsPlan, motion: Trajectory, lead: Trajectory, supports: dict[str, Feet],
+         mu: float | None) -> PartsRun:
+    import mujoco  # only when simulating
+
+    clock = time.perf_counter()
+    model = mujoco.MjModel.from_xml_string(parts_mjcf(scene, supports, mu))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("start").id)
+    names = scene.names
+    slots = {n: model.joint(f"part{k}_x").qposadr[0] + np.arange(3) for k, n in enumerate(names)}
+    owner = {model.geom(f"part{k}_{j}").id: n for k, n in enumerate(names)
+             for j in range(len(convex_pieces(scene.part(n).slider.polygon)))}
+    blocks = {model.geom(i).id for i in range(model.ngeom) if model.geom(i).name.startswith(("wall", "obstacle"))}
+    pusher_geom = model.geom("pusher").id
+    qpos = model.joint("pusher_x").qposadr[0] + np.arange(4)
+    qvel = model.joint("pusher_x").dofadr[0] + np.arange(4)
+    led, follow = _follower(lead), _follower(motion)
+    pushed = [name for name, _ in plan.segments]
+    # The pusher may touch the part of its segment, and on a transfer the part it leaves: a transit
+    # or a transfer begins (and ends) in contact.
+    allowed = [{name, s.from_part} if s.kind == "transfer" else {name} for name, s in plan.segments]
+
+    def step_to(t: float) -> None:
+        while data.time < t - TIMESTEP / 2:
+            u = data.time - SETTLE
+            pose, rate = led(max(u, 0.0)) if u < lead.duration else follow(u - lead.duration)
+            data.qpos[qpos] = pose
+            data.qvel[qvel] = rate if u >= 0 else 0.0
+            mujoco.mj_step(model, data)
+
+    times = motion.t + SETTLE + lead.duration
+    poses = {n: np.empty((len(times), 3)) for n in names}
+    slips, starts, faults, seen = np.zeros(len(plan.segments)), {}, [], set()
+    step_to(SETTLE + lead.duration)
+    for row, t in enumerate(times):
+        step_to(t)
+        for n in names:
+            poses[n][row] = data.qpos[slots[n]]
+        k = int(motion.segment[row])
+        for c in data.contact[:data.ncon]:
+            if c.dist >= 0:
+                continue
+            pair = {c.geom1, c.geom2}
+            touched = sorted({owner[g] for g in pair if g in owner})
+            if len(touched) == 2:
+                fault = f"{touched[0]} touches {touched[1]}"
+            elif touched and pair & blocks:
+                fault = f"{touched[0]} touches a wall or obstacle"
+            elif touched and pusher_geom in pair and touched[0] not in allowed[k]:
+                fault = f"the pusher touches {touched[0]}"
+            else:
+                continue
+            if fault not in seen:
+                seen.add(fault)
+                faults.append((float(motion.t[row]), fault))
+        if motion.contact[row]:
+            face = relative_pose(poses[pushed[k]][row], [motion.x[row], motion.y[row], motion.theta[row]])[:2]
+            first = starts.setdefault(k, face)
+            slips[k] = max(slips[k], float(np.linalg.norm(face - first)))
+    errors = {n: _error(poses[n][-1], scene.part(n).goal) for n in names}
+    worst = int(np.argmax(slips)) if len(slips) and slips.max() > 0 else -1
+    return PartsRun(tuple(supports[n].kind for n in names), errors,
+                    {n: scene.within_tolerance(n, poses[n][-1]) for n in names}, float(slips.max(initial=0.0)), worst,
+                    tuple(faults), time.perf_counter() - clock, float(motion.duration + lead.duration), poses)
+
