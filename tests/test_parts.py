@@ -213,3 +213,15 @@ def test_a_plan_file_for_other_starts_is_bad_input(tmp_path, plans):
     done = run_plan("scenes/parts/swap.yaml", "--verify", "2", "--plan", tmp_path / "other.json", "--out", tmp_path / "o")
     assert done.returncode == 1 and done.stderr.startswith("plan: error: plan.")
     assert not (tmp_path / "o").exists()
+
+
+def test_a_batch_plans_multi_part_scenes_as_the_command_does(tmp_path):
+    """Two workers or one, the batch's plan files are the plans the seed decides."""
+    for jobs in (1, 2):
+        done = run_plan("scenes/parts/swap.yaml", "--seeds", "1:2", "--jobs", jobs, "--out", tmp_path / f"j{jobs}")
+        assert done.returncode == 0, done.stdout + done.stderr
+    for seed in (1, 2):
+        one, two = (json.loads((tmp_path / f"j{j}" / f"swap-s{seed}.json").read_text()) for j in (1, 2))
+        assert one["format"] == "stablepush.plan/2" and one["solved"]
+        assert one["segments"] == two["segments"]
+    replay_parts_plan(spec_of("swap"), one)

@@ -33,6 +33,7 @@ from ..model.fields import SceneError, number, shown
 from ..model.options import (check_optimize, check_planner, check_regions, check_seed, check_switch_cost,
                              check_time_limit, check_transit)
 from ..model.plan_file import Plan
+from ..model.parts import PartsScene
 from ..model.scene import Scene
 from ..model.scene_file import load_scene
 from ..queries.reachability import certify_unreachable
@@ -73,9 +74,14 @@ class Task:
     overrides: Mapping[str, Any] = field(default_factory=dict)
     digest: str | None = None  # SHA-256 of the scene file's bytes (None for a Scene given as such)
 
-    def planned_scene(self) -> Scene:
-        """The scene as planned: the goal and overrides applied."""
+    def planned_scene(self) -> Scene | PartsScene:
+        """The scene as planned: the goal and overrides applied (a multi-part scene takes neither
+        a goal, its parts have theirs, nor a CF offset, which is a part's)."""
         scene, o = self.scene, self.overrides
+        if isinstance(scene, PartsScene):
+            for name, given in (("goal", self.goal), ("overrides.cf_offset", o.get("cf_offset"))):
+                if given is not None:
+                    raise SceneError(name, "is for one-part scenes: a scene with parts has a goal and a CF per part")
         if self.goal is not None:
             scene = replace(scene, goal=np.asarray(self.goal, dtype=float))
         options = {"name" if key == "planner" else key: o[key] for key in _OPTIONS if key in o}
@@ -254,7 +260,7 @@ def make_tasks(scenes: Iterable[str | Path | Scene], seeds: Sequence[int] | None
     """
     loaded, digests = [], []
     for s in scenes:
-        if isinstance(s, Scene):
+        if isinstance(s, (Scene, PartsScene)):
             loaded.append(s)
             digests.append(None)
             continue
@@ -294,6 +300,13 @@ def _checked(variant: Mapping[str, Any]) -> dict[str, Any]:
     return {key: OVERRIDES[key](value, f"overrides.{key}") for key, value in variant.items()}
 
 
+def _one_part(scene: Scene | PartsScene) -> list[Scene]:
+    """The one-part scenes whose regions ``scene`` plans with: itself, or each of its parts'."""
+    if isinstance(scene, PartsScene):
+        return [scene.move_scene(name, scene.starts) for name in scene.names]
+    return [scene]
+
+
 def _region_keys(scene: Scene) -> tuple:
     """What a scene's exact regions depend on, to compute them once for all tasks alike."""
     p = scene.pusher
@@ -308,16 +321,16 @@ def shared_regions(tasks: Iterable[Task] | TaskList) -> dict[str, Any]:
     shared: dict[str, Any] = {}
     seen = set()
     for task in tasks.setups() if isinstance(tasks, TaskList) else tasks:
-        scene = task.planned_scene()
-        if _region_keys(scene) in seen:
-            continue
-        seen.add(_region_keys(scene))
-        try:
-            edge_controls(scene)
-        except SceneError:
-            continue
-        p = scene.pusher
-        shared |= regions_held(scene.slider, p.edges, p.mu, p.width, scene.cf_uncertainty)
+        for scene in _one_part(task.planned_scene()):
+            if _region_keys(scene) in seen:
+                continue
+            seen.add(_region_keys(scene))
+            try:
+                edge_controls(scene)
+            except SceneError:
+                continue
+            p = scene.pusher
+            shared |= regions_held(scene.slider, p.edges, p.mu, p.width, scene.cf_uncertainty)
     return shared
 
 
@@ -332,10 +345,10 @@ def run_task(task: Task, shared: Mapping[str, Any] | None) -> dict[str, Any]:
         if cache.get(key) is None:
             cache.put(key, region)
     scene = task.planned_scene()
-    p = scene.pusher
-    missing = sum(not is_cached(scene.slider, e, p.mu, p.width, scene.planner.regions, scene.cf_uncertainty)
-                  for e in p.edges)
-    unreachable = certify_unreachable(scene, regions=False)
+    missing = sum(not is_cached(one.slider, e, one.pusher.mu, one.pusher.width, one.planner.regions, one.cf_uncertainty)
+                  for one in _one_part(scene) for e in one.pusher.edges)
+    # A multi-part plan says itself which parts it could not deliver; the certificates are one part's.
+    unreachable = None if isinstance(scene, PartsScene) else certify_unreachable(scene, regions=False)
     if unreachable:
         result = Plan(scene=scene.path, solved=False, planner=scene.planner.name, seed=task.seed, planning_time_s=0.0,
                       start=scene.start.copy(), goal=scene.goal.copy(),

@@ -7,8 +7,9 @@ everything else is prose, kept as written. The blocks:
 
 - ``quick-subset``: the tests the quick subset leaves out (tests/slow_tests.txt);
 - ``summary-line``: the ``plan`` command's line for junction, seed 1;
-- ``parking-picture``, ``junction-picture``: a picture (docs/NAME.png, redrawn; its PNG text holds
-  the plan's headline) and its caption, from the seed-1 plan;
+- ``parking-picture``, ``junction-picture``, ``tray-picture``: a picture (docs/NAME.png, redrawn;
+  its PNG text holds the plan's headline) and its caption, from the seed-1 plan (the tray is
+  ``scenes/parts/tray.yaml``, six parts);
 - ``mujoco-table``: every shipped scene's seed-1 plan run in MuJoCo on 8 support distributions
   (:mod:`planner.bench.simulate`; about two minutes, needs the mujoco extra; ``--no-mujoco`` keeps
   the committed table).
@@ -30,10 +31,12 @@ from pathlib import Path
 
 from ..model.extras import have, needs
 from ..model.plan_file import Plan
-from ..model.scene import Scene, load_scene
+from ..model.parts import PartsScene
+from ..model.scene import Scene
+from ..model.scene_file import load_scene
 from ..queries.session import plan
 
-__all__ = ["BLOCK", "MUJOCO_RUNS", "README", "blocks", "caption", "mujoco_table", "quick_subset", "regenerate",
+__all__ = ["BLOCK", "MUJOCO_RUNS", "PICTURES", "README", "blocks", "caption", "mujoco_table", "parts_caption", "quick_subset", "regenerate",
            "seed_one", "summary_line", "table_plans"]
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -52,6 +55,8 @@ STORIES = {
                 "into the branch; the orange line is the path of its centre of friction",
 }
 MOVES = {"plane": "walk round the part", "lift": "lift over the part"}
+#: The pictures: scene (under scenes/) and picture name (under docs/).
+PICTURES = {"parking": "parking", "junction": "junction", "parts/tray": "tray"}
 
 
 @cache
@@ -89,6 +94,17 @@ def caption(name: str) -> str:
     return f"![A plan for scenes/{name}.yaml](docs/{name}.png)\n\n{_wrapped(text)}"
 
 
+def parts_caption(name: str) -> str:
+    """The picture of the seed-1 plan of the multi-part scene ``name`` and its caption."""
+    _, result = seed_one(name)
+    order = ", ".join(dict.fromkeys(m.part for m in result.moves))
+    text = (f"*`scenes/{name}.yaml`, seed 1: {result.headline()}. Each part is drawn in its colour where it "
+            f"starts (grey), where its goal is (dashed) and where the plan leaves it (bold), with the path of its "
+            f"centre of friction; purple, the pusher's transfers from one part to the next. The parts go in "
+            f"the order {order}.*")
+    return f"![A plan for scenes/{name}.yaml](docs/{PICTURES[name]}.png)\n\n{_wrapped(text)}"
+
+
 def _wrapped(text: str) -> str:
     """``text`` in lines of at most 100 characters, as the README's prose, with its last newline."""
     return textwrap.fill(text, 100, break_long_words=False, break_on_hyphens=False) + "\n"
@@ -122,7 +138,8 @@ def mujoco_table() -> str:
 def blocks(mujoco: bool = True) -> dict[str, Callable[[], str]]:
     """What makes each block, by name (the MuJoCo table only with ``mujoco``)."""
     made = {"quick-subset": quick_subset, "summary-line": summary_line,
-            "parking-picture": lambda: caption("parking"), "junction-picture": lambda: caption("junction")}
+            "parking-picture": lambda: caption("parking"), "junction-picture": lambda: caption("junction"),
+            "tray-picture": lambda: parts_caption("parts/tray")}
     return made | ({"mujoco-table": mujoco_table} if mujoco else {})
 
 
@@ -148,10 +165,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.check:
         print("stale: " + ", ".join(stale) if stale else "every generated block is current")
         return 1 if stale else 0
-    from ..outputs.picture import draw_plan
+    from ..outputs.picture import draw_parts_plan, draw_plan
 
-    for name in ("parking", "junction"):
-        draw_plan(*seed_one(name), str(ROOT / "docs" / f"{name}.png"))
+    for name, picture in PICTURES.items():
+        scene, result = seed_one(name)
+        (draw_parts_plan if isinstance(scene, PartsScene) else draw_plan)(scene, result, str(ROOT / "docs" / f"{picture}.png"))
     if fresh != text:
         README.write_text(fresh)
     print(f"regenerated: {', '.join(made)}; stale before: {', '.join(stale) or 'none'}")

@@ -18,12 +18,15 @@ from mechanics import exp_twist, transform_points
 
 from ..model.bodies import pusher_frame_body, pusher_polygon
 from ..model.extras import have, needs, pyplot
+from ..model.parts import PartsScene
+from ..model.parts_plan import PartsPlan
 from ..model.plan_file import Plan, Transit
-from ..model.scene import Scene, load_scene
+from ..model.scene import Scene
+from ..model.scene_file import load_scene
 from ..queries.session import plan
 from ..actions.transit import transit_pieces, transit_poses
 
-__all__ = ["TRANSIT", "draw_plan", "main"]
+__all__ = ["TRANSIT", "draw_parts_plan", "draw_plan", "main"]
 
 #: Colour of the pusher's moves between edges, apart from the part's blue and the CF path's orange.
 TRANSIT = "#8e44ad"
@@ -87,6 +90,47 @@ def draw_plan(scene: Scene, result: Plan, path: str, copies_per_metre: float = 4
     plt.close(fig)
 
 
+def draw_parts_plan(scene: PartsScene, result: PartsPlan, path: str) -> None:
+    """Write a PNG of the multi-part plan ``result`` for ``scene`` to ``path``: each part in its
+    colour (the recording's, :func:`~planner.outputs.parts_recording.part_colours`) at its start
+    (thin, grey) and where the plan leaves it (bold), its goal dashed, the path of its centre of
+    friction over all its moves, and the pusher's transfers between parts in purple (dashed where
+    lifted); the plan's headline as the PNG's ``Description`` text."""
+    plt = pyplot()
+    from .parts_recording import part_colours  # rerun: only when drawing several parts
+
+    xmin, ymin, xmax, ymax = scene.workspace
+    fig, ax = plt.subplots(figsize=(7, 7 * (ymax - ymin) / (xmax - xmin)), dpi=110)
+    ax.add_patch(plt.Rectangle((xmin, ymin), xmax - xmin, ymax - ymin, fill=False, lw=1.5, color="0.3"))
+    for obstacle in scene.obstacles:
+        ax.fill(*obstacle.exterior.xy, color="#c8504b", alpha=0.85, lw=0)
+    colours = {n: "#%02x%02x%02x" % tuple(c) for n, c in part_colours(scene).items()}
+    finals = result.finals
+    for part in scene.parts:
+        outline = np.vstack([part.slider.vertices, part.slider.vertices[:1]])
+        ax.plot(*transform_points(outline, part.start).T, color="0.55", lw=0.8)
+        ax.plot(*transform_points(outline, part.goal).T, "--", color=colours[part.name], lw=1.0)
+        ax.plot(*transform_points(outline, finals[part.name]).T, color=colours[part.name], lw=2.0)
+        x, y = transform_points(part.slider.cf[None], finals[part.name])[0]
+        ax.annotate(part.name, (x, y), ha="center", va="center", fontsize=7, color=colours[part.name])
+    for move in result.moves:
+        cf = scene.part(move.part).slider.cf[None]
+        trail = [transform_points(cf, s.start)[0] for s in move.segments[:1]]
+        for s in move.segments:
+            if s.kind == "push":
+                trail += [transform_points(cf, q)[0] for q in exp_twist(s.start, s.twist, np.linspace(0, s.duration, 60))]
+        ax.plot(*np.array(trail).T, color=colours[move.part], lw=1.0, alpha=0.8)
+        if move.transfer is not None:
+            for xy, airborne in transit_pieces(move.transfer):
+                ax.plot(*xy.T, ":" if airborne else "-", color=TRANSIT, lw=0.9, alpha=0.8, zorder=3)
+    ax.set_xlim(xmin, xmax), ax.set_ylim(ymin, ymax)
+    ax.set_aspect("equal")
+    ax.set_title(f"{scene.name}: {result.contents()}" if result.solved else f"{scene.name}: not solved")
+    fig.tight_layout()
+    fig.savefig(path, metadata={"Description": f"{scene.name}: {result.headline() if result.solved else 'not solved'}"})
+    plt.close(fig)
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m planner.outputs.picture", description=__doc__.splitlines()[0])
     p.add_argument("scene")
@@ -96,7 +140,7 @@ def main(argv: list[str] | None = None) -> int:
     if not have("matplotlib"):  # before the planning, one line
         sys.exit(f"{p.prog}: error: {needs('matplotlib')}")
     scene = load_scene(args.scene)
-    draw_plan(scene, plan(scene, seed=args.seed), args.out)
+    (draw_parts_plan if isinstance(scene, PartsScene) else draw_plan)(scene, plan(scene, seed=args.seed), args.out)
     return 0
 
 
