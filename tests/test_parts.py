@@ -225,3 +225,21 @@ def test_a_batch_plans_multi_part_scenes_as_the_command_does(tmp_path):
         assert one["format"] == "stablepush.plan/2" and one["solved"]
         assert one["segments"] == two["segments"]
     replay_parts_plan(spec_of("swap"), one)
+
+
+def test_a_part_that_cannot_be_delivered_gives_a_partial_plan_naming_it(tmp_path):
+    """c's goal lies inside a closed ring of walls: the others are delivered, the plan is not
+    solved, and both the plan and the command's line say which part is missing and why."""
+    ring = [{"box": {"center": c, "size": s}} for c, s in (([0.3, -0.3], [0.2, 0.02]), ([0.3, -0.1], [0.2, 0.02]),
+                                                          ([0.21, -0.2], [0.02, 0.2]), ([0.39, -0.2], [0.02, 0.2]))]
+    spec = _scene(obstacles=ring)
+    spec["parts"].append({"name": "c", "vertices": BLOCK, "start": [-0.3, -0.3, 0], "goal": [0.3, -0.2, 0]})
+    plan = Planner(parse_scene(spec), {"seed": 1, "time_limit": 20}).plan()
+    assert not plan.solved and plan.delivered == ("a", "b")
+    assert "not delivered: c" in plan.reason
+    (tmp_path / "ring.yaml").write_text(yaml.safe_dump(spec))
+    done = run_plan(tmp_path / "ring.yaml", "--out", tmp_path / "out", "--time-limit", "20")
+    assert done.returncode == 2 and done.stderr.startswith("plan: not solved: ") and "not delivered: c" in done.stderr
+    data = json.loads((tmp_path / "out" / "ring.json").read_text())
+    assert not data["solved"] and [n for n, p in data["parts"].items() if p["delivered"]] == ["a", "b"]
+    replay_parts_plan({**spec, "parts": spec["parts"][:2]}, {**data, "parts": {k: data["parts"][k] for k in "ab"}})

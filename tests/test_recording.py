@@ -607,3 +607,27 @@ def test_a_half_turn_of_the_part_gives_the_twin_edges_analysis(tmp_path):
             assert turned.symmetric_difference(polygon).area <= 1e-3 * polygon.area + 1e-12, (name, sense)
     with pytest.raises(AssertionError, match="an exact region was computed"):
         analysis.analysis(scene, 1, held)
+
+
+def test_a_multi_part_recording_moves_every_part_on_one_timeline(tmp_path):
+    """Every part is its own labelled entity; at the last frame each outline is where the plan
+    leaves the part (placed here from the scene's vertices), at the first where it starts; the
+    transfers are drawn, one strip per piece; the summary names the parts delivered."""
+    from planner.outputs.parts_recording import write_parts_recording
+
+    scene = planner.load_scene(Path(__file__).resolve().parents[1] / "scenes" / "parts" / "swap.yaml")
+    result = planner.Planner(scene).plan()
+    path = tmp_path / "swap.rrd"
+    write_parts_recording(path, scene, result)
+    verify(path)
+    assert {"/world/parts/red", "/world/parts/blue", "/world/transfers", "/world/pusher"} <= entities(path)
+    for part in scene.parts:
+        strips = rrd_rows(path, f"/world/parts/{part.name}", "LineStrips3D:strips", "time")
+        (_, first), (_, last) = strips[0], strips[-1]
+        np.testing.assert_allclose(first[0], closed(placed(part.slider.vertices, part.start)), atol=1e-6)
+        np.testing.assert_allclose(last[0], closed(placed(part.slider.vertices, result.finals[part.name])), atol=1e-6)
+        [(_, labels)] = rrd_rows(path, f"/world/parts/{part.name}", "LineStrips3D:labels")
+        assert labels == [part.name]
+    [(_, transfers)] = rrd_rows(path, "/world/transfers", "LineStrips3D:strips")
+    assert len(transfers) == result.transfers  # walks on the table: one strip each
+    assert "delivered: 2 of 2 parts" in summary_rows(path)

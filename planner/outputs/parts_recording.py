@@ -53,7 +53,9 @@ def part_colours(scene: PartsScene) -> dict[str, list[int]]:
 
 def _summary(scene: PartsScene, plan: PartsPlan) -> list[str]:
     head = f"{scene.name}: planner {plan.planner}, seed {plan.seed}"
-    delivered = f"delivered: {', '.join(plan.delivered) or 'none'} of {', '.join(scene.names)}"
+    missing = [n for n in scene.names if n not in plan.delivered]
+    delivered = (f"delivered: {len(plan.delivered)} of {len(scene.names)} parts"
+                 + (f"; not delivered: {', '.join(missing)}" if missing else ""))
     if not plan.solved:
         return [f"{head}: not solved: {plan.reason}", delivered]
     return [f"{head}: solved with {plan.contents()}",

@@ -67,29 +67,40 @@ class _Best:
     delivered: int
 
 
-def plan_parts(scene: PartsScene, session_of: Callable[[str, dict[str, np.ndarray]], PartSession], paths: TransferPaths,
-               seed: int, time_limit: float) -> PartsPlan:
+def plan_parts(scene: PartsScene, session_of: Callable[[str, dict[str, np.ndarray] | None], PartSession],
+               paths: TransferPaths, seed: int, time_limit: float) -> PartsPlan:
     """Plan every part of ``scene`` from its start to its goal (module docstring) within
     ``time_limit`` seconds, each move planned by ``session_of(part, poses)`` (a one-part session
-    of the part with the others at ``poses``) and each transfer by ``paths``, seeded by ``seed``."""
+    of the part with the others at ``poses``; with ``poses`` None, among the obstacles alone) and
+    each transfer by ``paths``, seeded by ``seed``.
+
+    A part whose goal the certificates show unreachable among the obstacles alone cannot be
+    delivered in any order: it is left where it is (an obstacle to the others), the rest are
+    planned, and the plan, not solved, says why."""
     clock = time.perf_counter()
-    search = _Search(scene, session_of, paths, seed, clock + time_limit, time_limit)
+    hopeless = {p.name: reason for p in scene.parts if not scene.within_tolerance(p.name, p.start)
+                and (reason := session_of(p.name, None).certify_unreachable(p.goal)) is not None}
+    search = _Search(scene, session_of, paths, seed, clock + time_limit, time_limit, tuple(hopeless))
     found = search.run(scene.starts)
     moves = found if found is not None else search.best.moves
     finals = scene.starts | {m.part: m.end for m in moves}
     delivered = tuple(n for n in scene.names if scene.within_tolerance(n, finals[n]))
-    return PartsPlan(scene=scene.path, solved=found is not None, planner=scene.planner.name, seed=seed,
+    solved = found is not None and not hopeless
+    reason = "" if solved else search.why(delivered) if found is None else "; ".join(
+        f"not delivered: {n}: its goal is certified unreachable among the obstacles: {r}" for n, r in hopeless.items())
+    return PartsPlan(scene=scene.path, solved=solved, planner=scene.planner.name, seed=seed,
                      planning_time_s=time.perf_counter() - clock, starts=scene.starts, goals=scene.goals,
-                     moves=moves, delivered=delivered, reason="" if found is not None else search.why(delivered),
+                     moves=moves, delivered=delivered, reason=reason,
                      switch_cost=scene.planner.switch_cost, cfs={p.name: p.slider.cf.copy() for p in scene.parts})
 
 
 class _Search:
     """One depth-first search of :func:`plan_parts`."""
 
-    def __init__(self, scene: PartsScene, session_of: Callable[[str, dict[str, np.ndarray]], PartSession],
-                 paths: TransferPaths, seed: int, deadline: float, limit: float):
+    def __init__(self, scene: PartsScene, session_of: Callable[[str, dict[str, np.ndarray] | None], PartSession],
+                 paths: TransferPaths, seed: int, deadline: float, limit: float, hopeless: tuple[str, ...] = ()):
         self.scene, self.session_of, self.paths, self.seed, self.deadline = scene, session_of, paths, seed, deadline
+        self.hopeless = hopeless
         self.per_move = max(1.0, MOVE_SHARE * limit)
         self.seen: set[tuple] = set()
         self.best = _Best([], -1)
@@ -106,8 +117,8 @@ class _Search:
 
     def _search(self, poses: dict[str, np.ndarray], moves: list[Move], buffers: int) -> list[Move] | None:
         scene = self.scene
-        pending = [n for n in scene.names if not scene.within_tolerance(n, poses[n])]
-        delivered = len(scene.names) - len(pending)
+        pending = [n for n in scene.names if not scene.within_tolerance(n, poses[n]) and n not in self.hopeless]
+        delivered = len(scene.names) - len(pending) - len(self.hopeless)
         if delivered > self.best.delivered or (delivered == self.best.delivered and len(moves) < len(self.best.moves)):
             self.best = _Best(list(moves), delivered)
         if not pending:
@@ -125,6 +136,8 @@ class _Search:
         if buffers >= len(scene.names):
             return None
         for name in self._blockers(pending, poses, bodies):
+            if moves and moves[-1].part == name:  # from one buffer pose to another: nothing gained
+                continue
             for spot in self._buffers(name, poses, bodies, pending):
                 if (found := self._try(poses, moves, buffers + 1, name, spot)) is not None:
                     return found

@@ -361,13 +361,16 @@ class PartsPlanner:
         request = PlanRequest.of(self.options, seed=seed, time_limit=time_limit)
         return plan_parts(self.scene, self.session, self.paths, request.seed, request.time_limit)
 
-    def session(self, part: str, poses: Mapping[str, np.ndarray]) -> Planner:
-        """The one-part session of moving ``part`` with the others at ``poses`` (kept: the
-        :data:`REMEMBERED_PLANS` latest)."""
-        key = (part, *(tuple(np.round(poses[n], 9).tolist()) for n in self.scene.names if n != part))
+    def session(self, part: str, poses: Mapping[str, np.ndarray] | None) -> Planner:
+        """The one-part session of moving ``part`` with the others at ``poses``, or (``poses``
+        None) among the obstacles alone; kept: the :data:`REMEMBERED_PLANS` latest."""
+        key = (part, *(() if poses is None else (tuple(np.round(poses[n], 9).tolist())
+                                                 for n in self.scene.names if n != part)), poses is None)
         if key not in self._sessions:
-            self._sessions[key] = Planner(self.scene.move_scene(part, poses), cache=self._cache,
-                                          progress=self._progress)
+            alone = self.scene.move_scene(part, self.scene.starts if poses is None else poses)
+            if poses is None:
+                alone = replace(alone, obstacles=self.scene.obstacles)
+            self._sessions[key] = Planner(alone, cache=self._cache, progress=self._progress)
             while len(self._sessions) > REMEMBERED_PLANS:
                 self._sessions.popitem(last=False)
         self._sessions.move_to_end(key)
