@@ -195,10 +195,18 @@ def replay_transit(spec: dict, seg: dict, part_pose: np.ndarray, blocked: shapel
         flush = flush_pose(verts, edge, part_pose)
         np.testing.assert_allclose(at[:2], flush[:2], atol=1e-9, err_msg=f"transit {seg} not flush on edge {edge}")
         assert angle_diff(at[2], flush[2]) < 1e-9, f"transit {seg} not square to edge {edge}"
-    part = place(verts, part_pose)
+    duration = sweep_pusher(pusher, seg, blocked, {"part": place(verts, part_pose)}, "part", "part")
+    assert abs(duration - seg["duration"]) <= 1e-9, f"transit {seg} takes {duration} s at 1 m/s"
+
+
+def sweep_pusher(pusher: dict, seg: dict, blocked: shapely.Geometry, parts: dict, first: str, last: str) -> float:
+    """Sweep the pusher along ``seg``'s ``pusher_path`` (a transit or transfer): every in-plane
+    piece clear of ``blocked``, touching part ``first`` of ``parts`` at the first pose and part
+    ``last`` at the last, and no part anywhere else; returns the path's duration at 1 m/s."""
+    path = np.asarray(seg["pusher_path"], float)
     rectangle = pusher_rectangle(pusher["width"], pusher["depth"])
     reach = math.hypot(pusher["depth"], pusher["width"] / 2)  # the body point farthest from the face centre
-    last = len(path) - 2
+    end = len(path) - 2
     duration = 0.0
     for k, (p, q) in enumerate(zip(path, path[1:])):
         shift, turn = math.dist(p[:2], q[:2]), angle_diff(p[2], q[2])
@@ -211,13 +219,12 @@ def replay_transit(spec: dict, seg: dict, part_pose: np.ndarray, blocked: shapel
         for s in np.linspace(0.0, 1.0, n):
             q_s = interpolate(p, q, s)
             body = place(rectangle, q_s)
-            assert body.distance(blocked) > SAMPLE / 2, f"pusher collides at {q_s} in transit {seg}"
-            gap = body.distance(part)
-            if (k, s) in ((0, 0.0), (last, 1.0)):
-                assert gap < 1e-9, f"pusher not touching the part at {q_s}, an end of transit {seg}"
-            else:
-                assert gap > 0, f"pusher touches the part at {q_s} in transit {seg}"
-    assert abs(duration - seg["duration"]) <= 1e-9, f"transit {seg} takes {duration} s at 1 m/s"
+            assert body.distance(blocked) > SAMPLE / 2, f"pusher collides at {q_s} in {seg['kind']} {seg}"
+            for name, part in parts.items():
+                touching = (k, s) == (0, 0.0) and name == first or (k, s) == (end, 1.0) and name == last
+                gap = body.distance(part)
+                assert gap < 1e-9 if touching else gap > 0, f"pusher and part {name} at {q_s} in {seg['kind']} {seg}"
+    return duration
 
 
 def replay_parts_plan(spec: dict, plan: dict) -> None:
@@ -280,24 +287,6 @@ def replay_transfer(spec: dict, seg: dict, poses: dict, from_edge: int) -> None:
         flush = flush_pose(parts[part]["vertices"], edge, poses[part])
         np.testing.assert_allclose(at[:2], flush[:2], atol=1e-9, err_msg=f"transfer not flush on {part}'s edge {edge}")
         assert angle_diff(at[2], flush[2]) < 1e-9
-    blocked = blocked_region(spec)
     bodies = {n: place(p["vertices"], poses[n]) for n, p in parts.items()}
-    rectangle = pusher_rectangle(pusher["width"], pusher["depth"])
-    reach = math.hypot(pusher["depth"], pusher["width"] / 2)
-    last = len(path) - 2
-    duration = 0.0
-    for k, (p, q) in enumerate(zip(path, path[1:])):
-        shift, turn = math.dist(p[:2], q[:2]), angle_diff(p[2], q[2])
-        duration += shift + reach * turn
-        if seg["mode"] == "lift" and k == 1:
-            continue
-        n = max(1, math.ceil((shift + reach * turn) / SAMPLE), math.ceil(turn / TURN)) + 1
-        for s in np.linspace(0.0, 1.0, n):
-            q_s = interpolate(p, q, s)
-            body = place(rectangle, q_s)
-            assert body.distance(blocked) > SAMPLE / 2, f"pusher collides at {q_s} in transfer {seg['to_part']}"
-            for name, part in bodies.items():
-                touching = (k, s) == (0, 0.0) and name == seg["from_part"] or (k, s) == (last, 1.0) and name == seg["to_part"]
-                gap = body.distance(part)
-                assert gap < 1e-9 if touching else gap > 0, f"pusher and part {name} at {q_s} in a transfer"
+    duration = sweep_pusher(pusher, seg, blocked_region(spec), bodies, seg["from_part"], seg["to_part"])
     assert abs(duration - seg["duration"]) <= 1e-9

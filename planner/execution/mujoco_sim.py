@@ -60,21 +60,22 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import relative_pose, transform_points, wrap_angle
+from mechanics import Slider, relative_pose, transform_points, wrap_angle
 from mechanics.quasistatic import grid_support, tripod_supports
 
 from ..actions.transit import edge_contact_pose
 from ..model.bodies import convex_pieces, pusher_frame_body, slider_at
 from ..model.fields import SceneError
 from ..model.files import write_atomic
+from ..model.parts import PartsScene
 from ..model.plan_file import Plan, Transit
 from ..model.scene import Scene, placement_fault
 from ..world.validity import CollisionModel
 from .approach import first_edge, lead_in_pose
 from .trajectory import Trajectory, planned_part, trajectory
 
-__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Simulation", "feet", "mjcf", "needs_mujoco",
-           "World", "perturbations", "simulate", "support_centre", "write_mjcf"]
+__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Simulation", "document", "feet", "mjcf",
+           "needs_mujoco", "part_body", "table", "World", "perturbations", "simulate", "support_centre", "write_mjcf"]
 
 #: The one line ``plan --simulate`` prints (after ``plan: error: --simulate: ``) without MuJoCo.
 MISSING = "needs MuJoCo: pip install 'stablepush[mujoco]'"
@@ -172,19 +173,12 @@ def _second_moment(pieces: list[np.ndarray], centre: np.ndarray) -> float:
     return total / area
 
 
-def mjcf(scene: Scene, support: Feet, mu: float | None = None, start: ArrayLike | None = None,
-         keys: ArrayLike | None = None) -> str:
-    """The MuJoCo model (MJCF XML) of ``scene`` with the part on ``support``'s feet, starting at
-    ``start`` (default: the scene's start), and pusher-part friction ``mu`` (default: the planned
-    ``scene.pusher.mu``); module docstring, "The model".
-
-    ``keys``, rows ``(t, part x, y, theta, pusher x, y, z, theta)``, become keyframes ``t=<t>``
-    (the first named ``start``) so that a viewer can step along a run; without them the one
-    keyframe ``start`` has the part at ``start`` and the pusher at the world origin."""
-    mu = scene.pusher.mu if mu is None else mu
-    assets, world, pairs = [], [], []
+def table(scene: Scene | PartsScene) -> tuple[list[str], list[str], list[str]]:
+    """The MJCF of what stands on the table: mesh assets, world geoms (the workspace walls and the
+    obstacles as prisms, non-convex ones as their convex pieces) and the names of those geoms."""
+    assets, world = [], []
     xmin, ymin, xmax, ymax = scene.workspace
-    span, wall = max(xmax - xmin, ymax - ymin), 0.05
+    wall = 0.05
     walls = [((xmin - wall / 2, (ymin + ymax) / 2), (wall / 2, (ymax - ymin) / 2 + wall)),
              ((xmax + wall / 2, (ymin + ymax) / 2), (wall / 2, (ymax - ymin) / 2 + wall)),
              (((xmin + xmax) / 2, ymin - wall / 2), ((xmax - xmin) / 2 + wall, wall / 2)),
@@ -199,28 +193,18 @@ def mjcf(scene: Scene, support: Feet, mu: float | None = None, start: ArrayLike 
             assets.append(_prism(name, piece, 0.0, WALL_HEIGHT))
             world.append(f'<geom name="{name}" type="mesh" mesh="{name}" rgba=".6 .3 .3 1"/>')
             blocks.append(name)
-    pieces = convex_pieces(scene.slider.polygon)
-    part = []
-    for j, piece in enumerate(pieces):
-        assets.append(_prism(f"part{j}", piece, -THICKNESS / 2, THICKNESS / 2))
-        part.append(f'<geom name="part{j}" type="mesh" mesh="part{j}" rgba=".2 .4 .8 1"/>')
-    for k, (p, w) in enumerate(zip(support.points, support.weights)):
-        # A foot slides vertically in the part and carries its share of the weight to the table.
-        part.append(f'<body name="foot{k}" pos="{_numbers([*p, -THICKNESS / 2 - FOOT])}">'
-                    f'<joint name="foot{k}" type="slide" axis="0 0 1"/>'
-                    f'<inertial pos="0 0 0" mass="{w * MASS:.17g}" diaginertia="1e-9 1e-9 1e-9"/>'
-                    f'<geom name="foot{k}" type="sphere" size="{FOOT}" rgba=".1 .1 .1 1"/></body>')
-        pairs.append(f'<pair geom1="table" geom2="foot{k}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>')
-    inertia = MASS * _second_moment(pieces, support.centre)
-    pose = scene.start if start is None else np.asarray(start, dtype=float)
-    height = THICKNESS / 2 + 2 * FOOT
-    pusher = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
+    return assets, world, blocks
+
+
+def document(scene: Scene | PartsScene, assets: list[str], world: list[str], bodies: list[str], pairs: list[str],
+             keys: list[str]) -> str:
+    """The MJCF document of ``scene``: the options, the table plane, ``world``'s geoms, the part
+    ``bodies``, the pusher (a prism of its outline on x, y, z and heading joints, last in the
+    joints' order), the contact ``pairs`` and the ``keys``."""
+    xmin, ymin, xmax, ymax = scene.workspace
+    span = max(xmax - xmin, ymax - ymin)
     top = THICKNESS + 2 * FOOT + 0.01
-    for j in range(len(pieces)):
-        pairs.append(f'<pair geom1="pusher" geom2="part{j}" condim="3" friction="{mu} {mu} 0 0 0" />')
-        pairs += [f'<pair geom1="{b}" geom2="part{j}" condim="1"/>' for b in blocks]
-    assets.append(_prism("pusher", pusher, 0.0, top))
-    # The part's frame is the slider frame; gravity acts at the support's centre.
+    assets = assets + [_prism("pusher", pusher_frame_body(scene.pusher.width, scene.pusher.depth), 0.0, top)]
     return f"""<mujoco model={quoteattr(scene.name)}>
   <option timestep="{TIMESTEP}" cone="elliptic" impratio="10" solver="Newton" iterations="50" tolerance="1e-10"/>
   <default>
@@ -232,13 +216,7 @@ def mjcf(scene: Scene, support: Feet, mu: float | None = None, start: ArrayLike 
   <worldbody>
     <geom name="table" type="plane" size="{_numbers([span, span, 0.1])}" pos="{_numbers([(xmin + xmax) / 2, (ymin + ymax) / 2, 0])}" rgba=".9 .9 .85 1"/>
     {chr(10).join('    ' + w for w in world).strip()}
-    <body name="part" pos="0 0 {height:.17g}">
-      <joint name="part_x" type="slide" axis="1 0 0"/>
-      <joint name="part_y" type="slide" axis="0 1 0"/>
-      <joint name="part_theta" type="hinge" axis="0 0 1"/>
-      <inertial pos="{_numbers([*support.centre, 0])}" mass="{MASS}" diaginertia="{_numbers([inertia / 2, inertia / 2, inertia])}"/>
-      {chr(10).join('      ' + g for g in part).strip()}
-    </body>
+    {chr(10).join('    ' + b for b in bodies).strip()}
     <body name="pusher" gravcomp="1">
       <joint name="pusher_x" type="slide" axis="1 0 0"/>
       <joint name="pusher_y" type="slide" axis="0 1 0"/>
@@ -252,10 +230,60 @@ def mjcf(scene: Scene, support: Feet, mu: float | None = None, start: ArrayLike 
     {chr(10).join('    ' + p for p in pairs).strip()}
   </contact>
   <keyframe>
-    {chr(10).join('    ' + k for k in _keyframes(pose, len(support.points), keys)).strip()}
+    {chr(10).join('    ' + k for k in keys).strip()}
   </keyframe>
 </mujoco>
 """
+
+
+def part_body(name: str, prefix: str, slider: Slider, support: Feet) -> tuple[list[str], str, list[str], list[str]]:
+    """The MJCF of a part on ``support``'s feet, its body called ``name`` and its joints, geoms and
+    feet ``<prefix>_x``..., ``<prefix><j>``, ``foot<prefix-less k>``: its mesh assets, the body, its
+    geoms' names and its feet's table contacts. The part's frame is the slider frame; gravity
+    acts at the support's centre (module docstring, "The model")."""
+    pieces = convex_pieces(slider.polygon)
+    assets, geoms, part, pairs = [], [], [], []
+    for j, piece in enumerate(pieces):
+        assets.append(_prism(f"{prefix}{j}", piece, -THICKNESS / 2, THICKNESS / 2))
+        part.append(f'<geom name="{prefix}{j}" type="mesh" mesh="{prefix}{j}" rgba=".2 .4 .8 1"/>')
+        geoms.append(f"{prefix}{j}")
+    feet_name = prefix.replace("part", "foot")
+    for k, (p, w) in enumerate(zip(support.points, support.weights)):
+        # A foot slides vertically in the part and carries its share of the weight to the table.
+        part.append(f'<body name="{feet_name}{k}" pos="{_numbers([*p, -THICKNESS / 2 - FOOT])}">'
+                    f'<joint name="{feet_name}{k}" type="slide" axis="0 0 1"/>'
+                    f'<inertial pos="0 0 0" mass="{w * MASS:.17g}" diaginertia="1e-9 1e-9 1e-9"/>'
+                    f'<geom name="{feet_name}{k}" type="sphere" size="{FOOT}" rgba=".1 .1 .1 1"/></body>')
+        pairs.append(f'<pair geom1="table" geom2="{feet_name}{k}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>')
+    inertia = MASS * _second_moment(pieces, support.centre)
+    height = THICKNESS / 2 + 2 * FOOT
+    body = f"""<body name="{name}" pos="0 0 {height:.17g}">
+      <joint name="{name}_x" type="slide" axis="1 0 0"/>
+      <joint name="{name}_y" type="slide" axis="0 1 0"/>
+      <joint name="{name}_theta" type="hinge" axis="0 0 1"/>
+      <inertial pos="{_numbers([*support.centre, 0])}" mass="{MASS}" diaginertia="{_numbers([inertia / 2, inertia / 2, inertia])}"/>
+      {chr(10).join('      ' + g for g in part).strip()}
+    </body>"""
+    return assets, body, geoms, pairs
+
+
+def mjcf(scene: Scene, support: Feet, mu: float | None = None, start: ArrayLike | None = None,
+         keys: ArrayLike | None = None) -> str:
+    """The MuJoCo model (MJCF XML) of ``scene`` with the part on ``support``'s feet, starting at
+    ``start`` (default: the scene's start), and pusher-part friction ``mu`` (default: the planned
+    ``scene.pusher.mu``); module docstring, "The model".
+
+    ``keys``, rows ``(t, part x, y, theta, pusher x, y, z, theta)``, become keyframes ``t=<t>``
+    (the first named ``start``) so that a viewer can step along a run; without them the one
+    keyframe ``start`` has the part at ``start`` and the pusher at the world origin."""
+    mu = scene.pusher.mu if mu is None else mu
+    assets, world, blocks = table(scene)
+    part_assets, body, geoms, pairs = part_body("part", "part", scene.slider, support)
+    for g in geoms:
+        pairs.append(f'<pair geom1="pusher" geom2="{g}" condim="3" friction="{mu} {mu} 0 0 0" />')
+        pairs += [f'<pair geom1="{b}" geom2="{g}" condim="1"/>' for b in blocks]
+    pose = scene.start if start is None else np.asarray(start, dtype=float)
+    return document(scene, assets + part_assets, world, [body], pairs, _keyframes(pose, len(support.points), keys))
 
 
 def _keyframes(start: np.ndarray, feet: int, keys: ArrayLike | None) -> list[str]:

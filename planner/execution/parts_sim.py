@@ -19,20 +19,19 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from mechanics import relative_pose
 
-from ..model.bodies import convex_pieces, pusher_frame_body
+from ..model.bodies import convex_pieces
 from ..model.parts import PartsScene
 from ..model.parts_plan import PartsPlan
 from ..model.plan_file import Plan
 from ..world.validity import CollisionModel
-from .mujoco_sim import (FOOT, MASS, PUSHER_MASS, SETTLE, SLIP, TABLE_MU, THICKNESS, TIMESTEP, WALL_HEIGHT, Feet,
-                         _error, _follower, _lead_in, _numbers, _prism, _second_moment, feet, needs_mujoco)
+from .mujoco_sim import (SETTLE, SLIP, TABLE_MU, TIMESTEP, Feet, _error, _follower, _lead_in, _numbers, document, feet,
+                         needs_mujoco, part_body, table)
 from .trajectory import Trajectory, parts_trajectory
 
 __all__ = ["PartsRun", "PartsSimulation", "parts_mjcf", "simulate_parts"]
@@ -45,85 +44,22 @@ def parts_mjcf(scene: PartsScene, supports: dict[str, Feet], mu: float | None = 
     Part ``k`` (scene order) is the body ``part<k>`` of geoms ``part<k>_<j>``."""
     mu = scene.pusher.mu if mu is None else mu
     starts = scene.starts if starts is None else starts
-    assets, world, pairs, bodies, qpos = [], [], [], [], []
-    xmin, ymin, xmax, ymax = scene.workspace
-    span, wall = max(xmax - xmin, ymax - ymin), 0.05
-    walls = [((xmin - wall / 2, (ymin + ymax) / 2), (wall / 2, (ymax - ymin) / 2 + wall)),
-             ((xmax + wall / 2, (ymin + ymax) / 2), (wall / 2, (ymax - ymin) / 2 + wall)),
-             (((xmin + xmax) / 2, ymin - wall / 2), ((xmax - xmin) / 2 + wall, wall / 2)),
-             (((xmin + xmax) / 2, ymax + wall / 2), ((xmax - xmin) / 2 + wall, wall / 2))]
-    blocks = [f"wall{k}" for k in range(4)]
-    for name, (c, h) in zip(blocks, walls):
-        world.append(f'<geom name="{name}" type="box" pos="{_numbers([*c, WALL_HEIGHT / 2])}" '
-                     f'size="{_numbers([*h, WALL_HEIGHT / 2])}" rgba=".5 .5 .5 1"/>')
-    for i, obstacle in enumerate(scene.obstacles):
-        for j, piece in enumerate(convex_pieces(obstacle)):
-            name = f"obstacle{i}_{j}"
-            assets.append(_prism(name, piece, 0.0, WALL_HEIGHT))
-            world.append(f'<geom name="{name}" type="mesh" mesh="{name}" rgba=".6 .3 .3 1"/>')
-            blocks.append(name)
-    height = THICKNESS / 2 + 2 * FOOT
-    geoms: list[list[str]] = []
+    assets, world, blocks = table(scene)
+    bodies, pairs, geoms, qpos = [], [], [], []
     for k, part in enumerate(scene.parts):
-        pieces = convex_pieces(part.slider.polygon)
-        support = supports[part.name]
-        body = []
-        geoms.append([f"part{k}_{j}" for j in range(len(pieces))])
-        for j, piece in enumerate(pieces):
-            assets.append(_prism(f"part{k}_{j}", piece, -THICKNESS / 2, THICKNESS / 2))
-            body.append(f'<geom name="part{k}_{j}" type="mesh" mesh="part{k}_{j}" rgba=".2 .4 .8 1"/>')
-        for i, (p, w) in enumerate(zip(support.points, support.weights)):
-            body.append(f'<body name="foot{k}_{i}" pos="{_numbers([*p, -THICKNESS / 2 - FOOT])}">'
-                        f'<joint name="foot{k}_{i}" type="slide" axis="0 0 1"/>'
-                        f'<inertial pos="0 0 0" mass="{w * MASS:.17g}" diaginertia="1e-9 1e-9 1e-9"/>'
-                        f'<geom name="foot{k}_{i}" type="sphere" size="{FOOT}" rgba=".1 .1 .1 1"/></body>')
-            pairs.append(f'<pair geom1="table" geom2="foot{k}_{i}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>')
-        inertia = MASS * _second_moment(pieces, support.centre)
-        bodies.append(f"""<body name="part{k}" pos="0 0 {height:.17g}">
-      <joint name="part{k}_x" type="slide" axis="1 0 0"/>
-      <joint name="part{k}_y" type="slide" axis="0 1 0"/>
-      <joint name="part{k}_theta" type="hinge" axis="0 0 1"/>
-      <inertial pos="{_numbers([*support.centre, 0])}" mass="{MASS}" diaginertia="{_numbers([inertia / 2, inertia / 2, inertia])}"/>
-      {chr(10).join('      ' + g for g in body).strip()}
-    </body>""")
-        qpos += [*np.asarray(starts[part.name], dtype=float), *np.zeros(len(support.points))]
+        more, body, own, feet_pairs = part_body(f"part{k}", f"part{k}_", part.slider, supports[part.name])
+        assets += more
+        bodies.append(body)
+        geoms.append(own)
+        pairs += feet_pairs
+        qpos += [*np.asarray(starts[part.name], dtype=float), *np.zeros(len(supports[part.name].points))]
     for k, own in enumerate(geoms):
         for g in own:
             pairs.append(f'<pair geom1="pusher" geom2="{g}" condim="3" friction="{mu} {mu} 0 0 0"/>')
             pairs += [f'<pair geom1="{b}" geom2="{g}" condim="1"/>' for b in blocks]
             pairs += [f'<pair geom1="{g}" geom2="{h}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>'
                       for other in geoms[k + 1:] for h in other]
-    top = THICKNESS + 2 * FOOT + 0.01
-    assets.append(_prism("pusher", pusher_frame_body(scene.pusher.width, scene.pusher.depth), 0.0, top))
-    return f"""<mujoco model={quoteattr(scene.name)}>
-  <option timestep="{TIMESTEP}" cone="elliptic" impratio="10" solver="Newton" iterations="50" tolerance="1e-10"/>
-  <default>
-    <geom contype="0" conaffinity="0"/>
-  </default>
-  <asset>
-    {chr(10).join('    ' + a for a in assets).strip()}
-  </asset>
-  <worldbody>
-    <geom name="table" type="plane" size="{_numbers([span, span, 0.1])}" pos="{_numbers([(xmin + xmax) / 2, (ymin + ymax) / 2, 0])}" rgba=".9 .9 .85 1"/>
-    {chr(10).join('    ' + w for w in world).strip()}
-    {chr(10).join('    ' + b for b in bodies).strip()}
-    <body name="pusher" gravcomp="1">
-      <joint name="pusher_x" type="slide" axis="1 0 0"/>
-      <joint name="pusher_y" type="slide" axis="0 1 0"/>
-      <joint name="pusher_z" type="slide" axis="0 0 1"/>
-      <joint name="pusher_theta" type="hinge" axis="0 0 1"/>
-      <inertial pos="0 0 0" mass="{PUSHER_MASS}" diaginertia="{_numbers([PUSHER_MASS * 0.01] * 3)}"/>
-      <geom name="pusher" type="mesh" mesh="pusher" rgba=".1 .1 .1 1"/>
-    </body>
-  </worldbody>
-  <contact>
-    {chr(10).join('    ' + p for p in pairs).strip()}
-  </contact>
-  <keyframe>
-    <key name="start" qpos="{_numbers([*qpos, 0, 0, 0, 0])}"/>
-  </keyframe>
-</mujoco>
-"""
+    return document(scene, assets, world, bodies, pairs, [f'<key name="start" qpos="{_numbers([*qpos, 0, 0, 0, 0])}"/>'])
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@ import numpy as np
 
 from .fields import SceneError, integer, keys, number, shown, vector
 from .json_file import read_json
-from .plan_file import MAX_BYTES, TRANSIT_MODES, Push, Transit, _floats, path_cost, path_length
+from .plan_file import MAX_BYTES, Push, Transit, _floats, path_cost, path_length, read_pusher_path
 
 __all__ = ["FORMAT", "Move", "PartsPlan", "Transfer", "load_parts_plan"]
 
@@ -58,18 +58,8 @@ class Transfer:
         for key in ("from_part", "to_part"):
             if spec[key] not in names:
                 raise SceneError(f"{name}.{key}", f"must name a part of the plan ({', '.join(names)}), got {shown(spec[key])}")
-        if spec["mode"] not in TRANSIT_MODES:
-            raise SceneError(f"{name}.mode", f"must be one of {', '.join(TRANSIT_MODES)}, got {shown(spec['mode'])}")
-        path = spec["pusher_path"]
-        if not isinstance(path, list) or len(path) < 2:
-            raise SceneError(f"{name}.pusher_path", "must be a list of at least two [x, y, theta] poses")
-        if spec["mode"] == "lift" and len(path) != 4:
-            raise SceneError(f"{name}.pusher_path", f"a lift has exactly 4 poses, got {len(path)}")
-        duration = number(spec["duration"], f"{name}.duration")
-        if duration < 0:
-            raise SceneError(f"{name}.duration", f"must be >= 0, got {duration}")
-        return cls(spec["from_part"], spec["to_part"], integer(spec["to_edge"], f"{name}.to_edge"), spec["mode"],
-                   np.array([vector(p, f"{name}.pusher_path[{i}]", 3) for i, p in enumerate(path)]), duration)
+        mode, path, duration = read_pusher_path(spec, name)
+        return cls(spec["from_part"], spec["to_part"], integer(spec["to_edge"], f"{name}.to_edge"), mode, path, duration)
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,7 @@ from .fields import SceneError, integer, keys, number, vector
 from .json_file import read_json
 
 __all__ = ["FORMAT", "MAX_BYTES", "TRANSIT_MODES", "Push", "Transit", "Plan", "append_push", "load_plan", "path_cost",
-           "path_length", "rechain"]
+           "path_length", "read_pusher_path", "rechain"]
 
 FORMAT = "stablepush.plan/1"
 #: Largest plan file read: a plan of ten thousand segments with their transits' paths.
@@ -174,24 +174,32 @@ class Transit:
     def from_dict(cls, data: Any, name: str, pose: np.ndarray) -> "Transit":
         """Read a transit of a plan file with the part at ``pose``, checking every field."""
         spec = keys(data, name, ("kind", "from_edge", "to_edge", "mode", "pusher_path", "duration"))
-        if spec["mode"] not in TRANSIT_MODES:
-            raise SceneError(f"{name}.mode", f"must be one of {', '.join(TRANSIT_MODES)}, got {spec['mode']!r}")
-        path = spec["pusher_path"]
-        if not isinstance(path, list) or len(path) < 2:
-            raise SceneError(f"{name}.pusher_path", "must be a list of at least two [x, y, theta] poses")
-        if spec["mode"] == "lift" and len(path) != 4:
-            raise SceneError(f"{name}.pusher_path", f"a lift has exactly 4 poses, got {len(path)}")
-        duration = number(spec["duration"], f"{name}.duration")
-        if duration < 0:
-            raise SceneError(f"{name}.duration", f"must be >= 0, got {duration}")
+        mode, path, duration = read_pusher_path(spec, name)
         return cls(
             from_edge=integer(spec["from_edge"], f"{name}.from_edge"),
             to_edge=integer(spec["to_edge"], f"{name}.to_edge"),
-            mode=spec["mode"],
-            pusher_path=np.array([vector(p, f"{name}.pusher_path[{i}]", 3) for i, p in enumerate(path)]),
+            mode=mode,
+            pusher_path=path,
             duration=duration,
             pose=np.array(pose, dtype=float),
         )
+
+
+def read_pusher_path(spec: dict, name: str) -> tuple[str, np.ndarray, float]:
+    """The ``mode``, ``pusher_path`` and ``duration`` of a transit (or a multi-part plan's
+    transfer) read from a file, checked: a known mode, at least two poses (a lift exactly four),
+    a duration >= 0."""
+    if spec["mode"] not in TRANSIT_MODES:
+        raise SceneError(f"{name}.mode", f"must be one of {', '.join(TRANSIT_MODES)}, got {spec['mode']!r}")
+    path = spec["pusher_path"]
+    if not isinstance(path, list) or len(path) < 2:
+        raise SceneError(f"{name}.pusher_path", "must be a list of at least two [x, y, theta] poses")
+    if spec["mode"] == "lift" and len(path) != 4:
+        raise SceneError(f"{name}.pusher_path", f"a lift has exactly 4 poses, got {len(path)}")
+    duration = number(spec["duration"], f"{name}.duration")
+    if duration < 0:
+        raise SceneError(f"{name}.duration", f"must be >= 0, got {duration}")
+    return spec["mode"], np.array([vector(p, f"{name}.pusher_path[{i}]", 3) for i, p in enumerate(path)]), duration
 
 
 def append_push(segments: list, push: Push) -> None:

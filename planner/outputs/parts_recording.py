@@ -31,13 +31,14 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from ..actions.transit import transit_pieces, transit_poses
+from ..actions.transit import transit_poses
 from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
 from ..model.parts import PartsScene
 from ..model.parts_plan import PartsPlan
 from .frames import FRAMES_PER_RADIUS, MAX_FRAMES, sample
-from .recording import (_BOLD, _DARK, _GREY, _LIFTED, _LINE, _RED, _THIN, _closed, _log_text, _top_view, _z, _zs)
+from .recording import (_BOLD, _DARK, _GREY, _LIFTED, _THIN, _closed, _log_pusher_paths, _log_table, _log_text,
+                        _top_view, _z)
 
 __all__ = ["PALETTE", "part_colours", "write_parts_recording"]
 
@@ -116,28 +117,15 @@ def write_parts_recording(path: str | Path, scene: PartsScene, plan: PartsPlan) 
     colours = part_colours(scene)
     try:
         rec.send_blueprint(blueprint, make_active=True, make_default=True)
-        rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-        box = _closed([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax]])
-        rec.log("world/workspace", rr.LineStrips3D([_z(box)], colors=_DARK, radii=_LINE), static=True)
-        rec.log("world/obstacles", rr.LineStrips3D(
-            _zs(_closed(o.exterior.coords[:-1]) for o in scene.obstacles), colors=_RED, radii=_BOLD,
-            labels=[f"obstacle {k}" for k in range(len(scene.obstacles))]), static=True)
+        _log_table(rec, scene)
         for entity, which, colour in (("world/starts", "start", None), ("world/goals", "goal", True)):
             strips = [_z(place(_closed(p.slider.vertices), getattr(p, which)[None])[0], "ghost") for p in scene.parts]
             rec.log(entity, rr.LineStrips3D(strips, colors=[colours[p.name] if colour else _GREY for p in scene.parts],
                                             radii=_THIN, labels=[f"{p.name} {which}" for p in scene.parts]), static=True)
-        transfers = [(k, m.part, xy, up) for k, m in enumerate(m for m in plan.moves if m.transfer is not None)
-                     for xy, up in transit_pieces(m.transfer)]
-        rec.log("world/transfers", rr.LineStrips3D(
-            [_z(xy, "path") for *_, xy, _ in transfers], colors=[_LIFTED if up else _DARK for *_, up in transfers],
-            radii=[_THIN if up else _LINE for *_, up in transfers],
-            labels=[f"transfer {k + 1} to {name}{' lifted' if up else ''}" for k, name, _, up in transfers]), static=True)
-        transits = [(k, xy, up) for k, t in enumerate(s for m in plan.moves for s in m.segments if s.kind == "transit")
-                    for xy, up in transit_pieces(t)]
-        rec.log("world/transits", rr.LineStrips3D(
-            [_z(xy, "path") for _, xy, _ in transits], colors=[_LIFTED if up else _DARK for *_, up in transits],
-            radii=[_THIN if up else _LINE for *_, up in transits],
-            labels=[f"transit {k + 1}{' lifted' if up else ''}" for k, _, up in transits]), static=True)
+        hops = [m for m in plan.moves if m.transfer is not None]
+        _log_pusher_paths(rec, "world/transfers", [(f"transfer {k + 1} to {m.part}", m.transfer) for k, m in enumerate(hops)])
+        _log_pusher_paths(rec, "world/transits", [(f"transit {k + 1}", t) for k, t in enumerate(
+            s for m in plan.moves for s in m.segments if s.kind == "transit")])
         _log_text(rec, "log", _summary(scene, plan), "INFO" if plan.solved else "WARN")
         if plan.moves:
             times, poses, pusher, lifted = _frames(scene, plan)

@@ -101,7 +101,9 @@ from ..actions.region_cache import RegionCache
 from ..actions.transit import transit_pieces
 from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
-from ..model.plan_file import Plan
+from ..model.parts import PartsScene
+from ..model.parts_plan import Transfer
+from ..model.plan_file import Plan, Transit
 from ..model.scene import Scene
 from .analysis import STATUS, analysis
 from .frames import FRAMES_PER_RADIUS, frames, history
@@ -178,26 +180,37 @@ def _log_text(rec: rr.RecordingStream, entity: str, lines: list[str], level: str
                      columns=rr.TextLog.columns(text=lines, level=[level] * len(lines)))
 
 
-def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
+def _log_table(rec: rr.RecordingStream, scene: Scene | PartsScene) -> None:
+    """The world's axes, ``/world/workspace`` and ``/world/obstacles``, static."""
     xmin, ymin, xmax, ymax = scene.workspace
-    outline = _closed(scene.slider.vertices)
-    ghosts = place(outline, np.array([scene.start, scene.goal]))
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     box = _closed([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax]])
     rec.log("world/workspace", rr.LineStrips3D([_z(box)], colors=_DARK, radii=_LINE), static=True)
     rec.log("world/obstacles", rr.LineStrips3D(
         _zs(_closed(o.exterior.coords[:-1]) for o in scene.obstacles), colors=_RED, radii=_BOLD,
         labels=[f"obstacle {k}" for k in range(len(scene.obstacles))]), static=True)
+
+
+def _log_pusher_paths(rec: rr.RecordingStream, entity: str, moves: list[tuple[str, Transit | Transfer]]) -> None:
+    """The path of the pusher's face centre on each of ``moves`` (label, transit or transfer),
+    static: one strip per piece, a lift's airborne piece thin and faint, labelled ``... lifted``."""
+    pieces = [(label, xy, up) for label, move in moves for xy, up in transit_pieces(move)]
+    rec.log(entity, rr.LineStrips3D(
+        [_z(xy, "path") for _, xy, _ in pieces], colors=[_LIFTED if up else _DARK for *_, up in pieces],
+        radii=[_THIN if up else _LINE for *_, up in pieces],
+        labels=[f"{label}{' lifted' if up else ''}" for label, _, up in pieces]), static=True)
+
+
+def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
+    outline = _closed(scene.slider.vertices)
+    ghosts = place(outline, np.array([scene.start, scene.goal]))
+    _log_table(rec, scene)
     rec.log("world/start", rr.LineStrips3D(_z(ghosts[:1]), colors=_GREY, radii=_LINE, labels="start"), static=True)
     rec.log("world/goal", rr.LineStrips3D(_z(ghosts[1:]), colors=_GOAL, radii=_LINE, labels="goal"), static=True)
     rec.log("world/tree", rr.LineStrips3D(_z(np.asarray(plan.tree, dtype=float).reshape(-1, 2, 2), "tree"),
                                           colors=_GREY, radii=_THIN), static=True)
-    pieces = [(k, xy, up) for k, t in enumerate(s for s in plan.segments if s.kind == "transit")
-              for xy, up in transit_pieces(t)]
-    rec.log("world/transits", rr.LineStrips3D(
-        [_z(xy, "path") for _, xy, _ in pieces], colors=[_LIFTED if up else _DARK for *_, up in pieces],
-        radii=[_THIN if up else _LINE for *_, up in pieces],
-        labels=[f"transit {k + 1}{' lifted' if up else ''}" for k, _, up in pieces]), static=True)
+    _log_pusher_paths(rec, "world/transits", [(f"transit {k + 1}", t) for k, t in
+                                              enumerate(s for s in plan.segments if s.kind == "transit")])
     _log_text(rec, "log", _summary(scene, plan), "INFO" if plan.solved else "WARN")
 
 

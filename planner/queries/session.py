@@ -54,7 +54,7 @@ from .reachability import Certificates, Reach, answers
 from .reachable_set import ReachableSet, reachable_set
 
 __all__ = ["JOINED_PLANS", "JOIN_SLACK", "PartsPlanner", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
-           "reachability"]
+           "reachability", "session_options"]
 
 #: Without a time limit, :meth:`Planner.reachability` grows its search for this long plus this
 #: much per goal left open by the certificates (at most the options' time limit): on the shipped
@@ -116,13 +116,7 @@ class Planner:
         self.clock = time.perf_counter()
         if not isinstance(scene, Scene):
             raise SceneError("scene", f"must be a Scene (planner.load_scene), got {type(scene).__name__}")
-        if isinstance(options, PlannerOptions):
-            # Checked as any options are: a PlannerOptions may be made without its checks.
-            self.options = PlannerOptions().merged({k: v for k, v in asdict(options).items() if v is not None})
-        elif options is None or isinstance(options, Mapping):
-            self.options = scene.planner.merged(options)
-        else:
-            raise SceneError("options", f"must be PlannerOptions or a mapping, got {type(options).__name__}")
+        self.options = session_options(scene, options)
         #: The scene as planned: its ``planner`` block is these options.
         self.scene = scene.with_options(self.options)
         self.model = CollisionModel(self.scene, self.scene.pusher.edges)
@@ -342,12 +336,7 @@ class PartsPlanner:
 
     def __init__(self, scene: PartsScene, options: PlannerOptions | Mapping[str, Any] | None = None, *,
                  cache: RegionCache | None = None, progress: Callable[[int, int], None] | None = None):
-        if isinstance(options, PlannerOptions):
-            self.options = PlannerOptions().merged({k: v for k, v in asdict(options).items() if v is not None})
-        elif options is None or isinstance(options, Mapping):
-            self.options = scene.planner.merged(options)
-        else:
-            raise SceneError("options", f"must be PlannerOptions or a mapping, got {type(options).__name__}")
+        self.options = session_options(scene, options)
         self.scene = scene.with_options(self.options)
         self._cache, self._progress = cache, progress
         self._sessions: OrderedDict[tuple, Planner] = OrderedDict()
@@ -375,6 +364,21 @@ class PartsPlanner:
                 self._sessions.popitem(last=False)
         self._sessions.move_to_end(key)
         return self._sessions[key]
+
+
+def session_options(scene: Scene | PartsScene, options: PlannerOptions | Mapping[str, Any] | None) -> PlannerOptions:
+    """A session's options: a :class:`PlannerOptions` in place of the scene's (checked as any
+    options are: one may be made without its checks), or a mapping of changes to the scene's.
+
+    >>> from planner import load_scene
+    >>> session_options(load_scene("scenes/battery.yaml"), {"seed": 7}).seed
+    7
+    """
+    if isinstance(options, PlannerOptions):
+        return PlannerOptions().merged({k: v for k, v in asdict(options).items() if v is not None})
+    if options is None or isinstance(options, Mapping):
+        return scene.planner.merged(options)
+    raise SceneError("options", f"must be PlannerOptions or a mapping, got {type(options).__name__}")
 
 
 def _anchors(segments: list[Push | Transit]) -> list[tuple[np.ndarray, int, list[Push | Transit]]]:
