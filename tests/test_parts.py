@@ -243,3 +243,11 @@ def test_a_part_that_cannot_be_delivered_gives_a_partial_plan_naming_it(tmp_path
     data = json.loads((tmp_path / "out" / "ring.json").read_text())
     assert not data["solved"] and [n for n, p in data["parts"].items() if p["delivered"]] == ["a", "b"]
     replay_parts_plan({**spec, "parts": spec["parts"][:2]}, {**data, "parts": {k: data["parts"][k] for k in "ab"}})
+
+
+def test_transfers_fly_where_the_scene_lets_the_pusher_lift(tmp_path):
+    spec = spec_of("swap")
+    spec["pusher"]["transit"] = "lift"
+    plan = Planner(parse_scene(spec), {"seed": 1}).plan()
+    assert plan.solved and plan.transfers and all(m.transfer.mode == "lift" for m in plan.moves[1:])
+    replay_parts_plan(spec, json.loads(plan.to_json()))
