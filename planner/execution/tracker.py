@@ -295,7 +295,8 @@ class Tracker:
             # back to the part; then one that begins on an edge the pusher can get to from there.
             found = None
             if self._approach(pusher, part, self._edge) is not None:
-                found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge])
+                found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge],
+                                          observed=True)
             if found is None or not found.solved:
                 world = self.session.world
                 others = [c.edge for c in world.controls if c.edge != self._edge] if world is not None else []
@@ -303,7 +304,8 @@ class Tracker:
                 if not reached and found is None:
                     return self._give_up(now, error, "no free approach from the pusher to any edge of the part")
                 if reached:
-                    found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=reached)
+                    found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=reached,
+                                              observed=True)
         except SceneError as err:  # the pusher has no room at the observed pose
             return self._give_up(now, error, f"no plan from the observed pose: {err.problem}")
         if not found.solved or not found.segments:
