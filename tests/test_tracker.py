@@ -60,6 +60,11 @@ def test_a_known_start_offset_is_re_planned_from_the_observed_pose(junction):
     pose, height, _, contact = tracker.pusher_at(len(kinds) / RATE - 1 / RATE)
     assert height == 0.0 and not contact and np.allclose(pose, held)
     assert 0 < np.linalg.norm(held[:2] - lead_in_pose(scene, session.model, plan)[:2]) < 0.03
+    # The new plan begins once it was found: until then the pusher stays where it stopped.
+    begins = replan.time + replan.latency
+    waiting, _, rate, _ = tracker.pusher_at(replan.time + replan.latency / 2)
+    assert replan.latency > 0 and np.allclose(waiting, held) and not rate.any()
+    assert np.linalg.norm(tracker.pusher_at(begins + 0.5)[0][:2] - held[:2]) > 1e-4
     # Followed with the part where the new plan has it, the run ends in the goal with no more re-plans.
     now, last = len(kinds) / RATE, None
     while last not in ("done", "give_up") and now < 100:

@@ -28,7 +28,11 @@ session, which joins that pose to the plan it remembers for the goal in millisec
 ``'done'``; else a re-plan.
 
 **Re-planning** asks first for a plan whose first push is on the edge the pusher is at (if it
-can come back to it), then for one beginning on an edge it has a free approach to.
+can come back to it), then for one beginning on an edge it has a free approach to; from the
+observed pose, the pusher needs only the room every push keeps
+(``Planner.plan(observed=True)``). The new plan begins when the planning is done (the
+observation's time plus the planning's wall-clock time, :attr:`Replan.latency`): a robot that
+gets it that much later finds the pusher at its beginning, held still until then.
 
 **Giving up.** When the goal is certified unreachable from the observed pose
 (:meth:`planner.Planner.certify_unreachable`), when the planner finds no plan from it, when the
@@ -226,7 +230,7 @@ class Tracker:
         if self._held is not None:
             pose, height = self._held
             return pose.copy(), height, np.zeros(4), False
-        m, u = self.motion, now - self._since
+        m, u = self.motion, max(now - self._since, 0.0)  # before a re-plan's start: at its first sample, at rest
         column = [np.interp(u, m.t, c) for c in (m.x, m.y, self._theta, m.z, m.vx, m.vy, m.omega)]
         k = min(int(np.searchsorted(m.t, u)), len(m.t) - 1)
         rise = np.interp(u, m.t, np.gradient(m.z, m.t)) if len(m.t) > 1 else 0.0
@@ -310,12 +314,14 @@ class Tracker:
             return self._give_up(now, error, f"no plan from the observed pose: {err.problem}")
         if not found.solved or not found.segments:
             return self._give_up(now, error, f"no plan from the observed pose: {found.reason or 'no segments'}")
-        problem = self._begin(found, pusher, part, now)
+        latency = time.perf_counter() - clock
+        # The new plan begins when it is there: the pusher held still until then.
+        problem = self._begin(found, pusher, part, now + latency)
         if problem:
             self._held = (pusher, 0.0)
             return self._give_up(now, error, problem)
         trigger, trigger_error, why = self._trigger
-        self.replans.append(Replan(now, part, trigger, trigger_error, why, time.perf_counter() - clock, found))
+        self.replans.append(Replan(now, part, trigger, trigger_error, why, latency, found))
         return self._command("replan", now, error, found)
 
     def _give_up(self, now: float, error: tuple[float, float], reason: str) -> Command:
