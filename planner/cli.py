@@ -179,7 +179,8 @@ def _parser() -> argparse.ArgumentParser:
                         "an open loop observes nothing)")
     p.add_argument("--closed-loop", action="store_true",
                    help="with --simulate: observe the part at 20 Hz and re-plan from where it is when it strays from "
-                        "the plan (planner.execution.tracker); the summary counts the re-plans")
+                        "the plan (planner.execution.tracker); the summary counts the re-plans; with --trajectory "
+                        "each run's executed pusher path is written as <name>.executed-<k>.csv")
     p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")
     p.add_argument("--export-scene", metavar="FILE",
                    help="also write the scene as planned to FILE (YAML, the plain schema: CAD files and boxes "

@@ -45,7 +45,8 @@ PATIENCE, GRACE = 3.0, 20.0
 @dataclass(frozen=True)
 class ClosedRun:
     """One closed-loop run on one foot set: the part's true final pose against the goal, the
-    re-plans (:class:`~.tracker.Replan`), why the tracker gave up (empty if it did not), samples
+    re-plans (:class:`~.tracker.Replan`) and the times it went on without one
+    (:attr:`~.tracker.Tracker.carried`), why the tracker gave up (empty if it did not), samples
     of the part touching a wall or obstacle, wall and simulated seconds, the pusher's executed
     path (a :class:`~.trajectory.Trajectory` at :data:`~.trajectory.RATE` Hz) and the part's
     true pose at each of its samples."""
@@ -60,6 +61,7 @@ class ClosedRun:
     simulated: float
     executed: Trajectory
     part: np.ndarray
+    carried: tuple[tuple[float, str], ...] = ()
 
     @property
     def passed(self) -> bool:
@@ -77,7 +79,15 @@ class ClosedRun:
                    f" triggered by {'; '.join(_trigger(r) for r in self.replans)})" if self.replans else "")
         return (f"closed loop {k}/{n} ({self.feet.kind}, {len(self.feet.points)} feet): goal error "
                 f"{self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad; {len(self.replans)} re-plans{latency}; "
+                f"{_carried(self.carried)}"
                 f"{self.seconds:.1f} s for {self.simulated:.1f} s: {', '.join(faults) if faults else 'ok'}")
+
+
+def _carried(carried: tuple[tuple[float, str], ...]) -> str:
+    """The times the loop went on with its plan for want of a new one, if any."""
+    if not carried:
+        return ""
+    return f"went on with the plan {len(carried)} times for want of a re-plan (first at t={carried[0][0]:.2f} s: {carried[0][1]}); "
 
 
 def _trigger(replan: Replan) -> str:
@@ -159,7 +169,7 @@ def _run(session: Planner, plan: Plan, support: Feet, mu: float | None, start: n
     error = (math.hypot(*(end[:2] - scene.goal[:2])), abs(float((end[2] - scene.goal[2] + np.pi) % (2 * np.pi) - np.pi)))
     reason = tracker.reason or ("" if tracker.done else f"not done after {limit:.0f} s")
     return ClosedRun(support, error, scene.within_tolerance(end), tuple(tracker.replans), reason, collisions,
-                     time.perf_counter() - clock, float(table[-1, 0]), executed, part)
+                     time.perf_counter() - clock, float(table[-1, 0]), executed, part, tuple(tracker.carried))
 
 
 def closed_loop(session: Planner, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
