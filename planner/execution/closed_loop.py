@@ -87,7 +87,7 @@ def _carried(carried: tuple[tuple[float, str], ...]) -> str:
     """The times the loop went on with its plan for want of a new one, if any."""
     if not carried:
         return ""
-    return f"went on with the plan {len(carried)} times for want of a re-plan (first at t={carried[0][0]:.2f} s: {carried[0][1]}); "
+    return f"went on with the plan {len(carried)} time{'s' if len(carried) > 1 else ''} for want of a re-plan (first at t={carried[0][0]:.2f} s: {carried[0][1]}); "
 
 
 def _trigger(replan: Replan) -> str:

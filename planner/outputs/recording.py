@@ -86,7 +86,8 @@ to settle and the re-plans' latencies included; not on ``step``), at :data:`RUN_
   the new plan, and ``/world/closed_loop/<k>/replan/<j>/start`` a point at the CF of the
   observed pose it was planned from, labelled ``re-plan <j> at <t> s``;
 * ``/log/closed_loop`` -- ``TextLog``: at 0 the loop's summary and the runs' lines (``WARN``
-  when it failed), and a row at each re-plan's time saying what triggered it.
+  when it failed), and a row at each re-plan's time saying what triggered it, and at each time
+  the run went on with its plan for want of a re-plan, saying why.
 
 (The re-plans' latencies are in the runs' clocks, so a closed loop's recording differs a little
 from one run of it to the next.)
@@ -315,6 +316,10 @@ def _log_closed_loop(rec: rr.RecordingStream, scene: Scene, loop: ClosedLoop) ->
                 labels=[f"re-plan {j} at {replan.time:.2f} s"]))
             rec.log("log/closed_loop", rr.TextLog(f"run {k}, re-plan {j} at {replan.time:.2f} s: {replan.why} "
                                                   f"({replan.latency * 1e3:.0f} ms)", level="INFO"))
+        for when, reason in run.carried:
+            rec.set_time("time", duration=when)
+            rec.log("log/closed_loop", rr.TextLog(f"run {k} went on with its plan at {when:.2f} s: {reason}",
+                                                  level="WARN"))
         rec.reset_time()
     _log_text(rec, "log/closed_loop", [loop.summary(), *loop.lines()], "INFO" if loop.passed else "WARN")
 
