@@ -182,7 +182,8 @@ def _parser() -> argparse.ArgumentParser:
                         "an open loop observes nothing)")
     p.add_argument("--closed-loop", action="store_true",
                    help="with --simulate: observe the part at 20 Hz and re-plan from where it is when it strays from "
-                        "the plan (planner.execution.tracker); the summary counts the re-plans")
+                        "the plan (planner.execution.tracker); the summary counts the re-plans; with --trajectory "
+                        "each run's executed pusher path is written as <name>.executed-<k>.csv")
     p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")
     p.add_argument("--export-scene", metavar="FILE",
                    help="also write the scene as planned to FILE (YAML, the plain schema: CAD files and boxes "
@@ -497,8 +498,9 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
             if inputs.given is not None
             else f"solved: {result.headline()}, "
                  f"planning time {result.planning_time_s:.2f} s{_first_found(result)}")
-    executed = motion is not None and inputs.closed_loop and simulation is not None
-    extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{f', {scene.name}.executed.csv' if executed else ''}{f', {scene.name}-reach.png' if reach else ''}"
+    executed = simulation.executed_files(scene.name) if motion is not None and inputs.closed_loop and simulation is not None else []
+    executed = executed[:1] + ([f"... {executed[-1]}"] if len(executed) > 1 else [])
+    extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{''.join(f', {f}' for f in executed)}{f', {scene.name}-reach.png' if reach else ''}"
     lines = [f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}"]
     if check is not None:
         lines += [*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]
@@ -611,14 +613,15 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
     of ``simulation``'s first run to ``mjcf`` if both are given, and the plan JSON into ``out``,
     creating it if need be. The plan file comes last: where it is, the run wrote everything. A new
     ``out`` appears with all of them at once (:func:`~planner.model.files.staged_folder`). A closed
-    loop's runs (``closed``) are not in the recording (their plans change as they go); with
-    ``motion``, its first run's executed pusher path is written beside it, ``<name>.executed.csv``."""
+    loop's runs (``closed``) are drawn in the recording on their own clocks, their re-plans with
+    them; with ``motion``, each run's executed pusher path is written beside it,
+    ``<name>.executed-<k>.csv``."""
     stage = out
     try:
         with staged_folder(out) as stage:
-            # The recording shows an open-loop run against its plan; a closed loop's plans change.
-            shown_run = None if closed else simulation
-            write_recording(stage / f"{scene.name}.rrd", scene, result, check, reach, shown_run)
+            # An open-loop run is drawn against its plan; a closed loop's runs against their own clocks.
+            write_recording(stage / f"{scene.name}.rrd", scene, result, check, reach, None if closed else simulation,
+                            simulation if closed else None)
             if reach is not None:
                 from .queries.reachable_set import write_png
 
@@ -627,7 +630,7 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
             if motion is not None:
                 motion.write_csv(stage / f"{scene.name}.trajectory.csv")
                 if closed and simulation is not None:
-                    simulation.write_executed(stage / f"{scene.name}.executed.csv")
+                    simulation.write_executed(stage, scene.name)
             if simulation is not None and mjcf is not None:
                 simulation.write_mjcf(_within(mjcf, out, stage), scene)
             write_atomic(stage / f"{scene.name}.json", result.to_json())

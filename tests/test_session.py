@@ -74,6 +74,33 @@ def test_a_replan_joined_to_a_known_plan_costs_about_what_a_search_finds(parking
     np.testing.assert_allclose(joined.final, first.final, atol=1e-9)
 
 
+def test_a_part_observed_near_a_wall_is_re_planned_with_the_pushes_margin():
+    """narrow_junction's block 8 mm to the side and 2 degrees off its start: the pusher's body
+    (part and pusher) is 1.6-2.3 mm from the corridor's walls on the edges it could push, more than
+    the margin every push keeps but less than the half step a search needs at its start. Asked
+    for, that start is bad input; observed (the part is there), the re-plan joins it to the
+    known plan by pushes checked all along, and the independent replay passes it; without a
+    known plan to join, no search is started from there."""
+    path = ROOT / "scenes" / "narrow_junction.yaml"
+    scene = load_scene(path)
+    session = Planner(scene)
+    assert session.plan(seed=1).solved
+    start = scene.start + [-0.008, 0.009, math.radians(-2)]
+    step = scene.slider.radius / 10  # the search's step (planner.actions.controls.step_length)
+    room = {e: session.model.clearance(start, e) for e in scene.pusher.edges}
+    assert max(room.values()) < step / 2 and sorted(room.values())[-2] > scene.slider.radius / 40
+    with pytest.raises(SceneError) as err:
+        session.plan(start=start, seed=1)
+    assert err.value.field == "start"
+    again = session.plan(start=start, seed=1, observed=True)
+    assert again.solved, again.reason
+    spec = yaml.safe_load(path.read_text())
+    spec["start"] = [float(start[0]), float(start[1]), math.degrees(start[2])]
+    replay_plan(spec, again.to_dict())
+    alone = session.plan(start=start, seed=1, observed=True, reuse=False)
+    assert not alone.solved and "too little room for a search" in alone.reason
+
+
 def test_without_reuse_a_session_plans_as_the_one_shot_plan_does(parking):
     """Same seed, same plan: a session without reuse, asked twice, and the one-shot plan()."""
     session = Planner(parking)

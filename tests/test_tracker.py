@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 from planner import Planner, load_scene
-from planner.execution.approach import lead_in_pose
+from planner.actions.transit import edge_contact_pose
+from planner.execution.approach import approach, lead_in_pose
 from planner.execution.tracker import CONFIRM, SETTLE, Tracker, mean_pose
 from planner.model.fields import SceneError
 from planner.model.scene import parse_scene
@@ -60,6 +61,11 @@ def test_a_known_start_offset_is_re_planned_from_the_observed_pose(junction):
     pose, height, _, contact = tracker.pusher_at(len(kinds) / RATE - 1 / RATE)
     assert height == 0.0 and not contact and np.allclose(pose, held)
     assert 0 < np.linalg.norm(held[:2] - lead_in_pose(scene, session.model, plan)[:2]) < 0.03
+    # The new plan begins once it was found: until then the pusher stays where it stopped.
+    begins = replan.time + replan.latency
+    waiting, _, rate, _ = tracker.pusher_at(replan.time + replan.latency / 2)
+    assert replan.latency > 0 and np.allclose(waiting, held) and not rate.any()
+    assert np.linalg.norm(tracker.pusher_at(begins + 0.5)[0][:2] - held[:2]) > 1e-4
     # Followed with the part where the new plan has it, the run ends in the goal with no more re-plans.
     now, last = len(kinds) / RATE, None
     while last not in ("done", "give_up") and now < 100:
@@ -124,3 +130,84 @@ def test_bad_arguments_name_their_field(junction):
 
 def test_the_mean_of_headings_across_the_cut_is_near_pi():
     assert abs(abs(mean_pose([[0, 0, math.pi - 0.2], [0, 0, -math.pi + 0.1]])[2]) - (math.pi - 0.05)) < 1e-12
+
+
+def pushing(tracker: Tracker, after: float = 1.0) -> float:
+    """A time ``after`` seconds into the plan's first push (on the tracker's clock)."""
+    m = tracker.motion
+    begins = float(m.t[np.flatnonzero(m.contact)[0]])
+    assert m.contact[np.searchsorted(m.t, begins + after)]
+    return tracker._since + begins + after
+
+
+def drifted(tracker: Tracker, now: float, along: float) -> np.ndarray:
+    """The planned part pose at ``now`` moved ``along`` metres along the pusher's face (its own y)."""
+    pusher, _, _, _ = tracker.pusher_at(now)
+    return on_plan(tracker, now) + along * np.array([-math.sin(pusher[2]), math.cos(pusher[2]), 0.0])
+
+
+def test_a_part_sliding_along_the_pusher_is_re_planned_for_less_friction(junction):
+    """The part drifts along the face, 1 mm an observation, while the plan pushes it: slip. The
+    re-plan assumes half the planned friction, and says so. A part knocked 12 mm along the face
+    in one observation (a jump past the 5 mm threshold) is re-planned for the planned friction."""
+    session, plan = junction
+    planned = session.scene.pusher.mu
+    for offset, mu in ((lambda j: 0.001 * j, planned / 2), (lambda j: 0.012 * (j > 0), planned)):
+        tracker = Tracker(session, plan)
+        now, j, kinds = pushing(tracker), -1, []
+        while not kinds or kinds[-1] in ("follow", "stop"):
+            j += kinds[-1:] != ["stop"]  # the part stays where it is once the pusher stops
+            kinds.append(tracker.observe(now, drifted(tracker, now, offset(j))).kind)
+            now += 1 / RATE
+        assert kinds[-1] == "replan" and kinds.count("stop") == SETTLE, tracker.reason
+        (replan,) = tracker.replans
+        assert replan.mu == mu and ("slid" in replan.why) == (mu < planned)
+        assert tracker.session.scene.pusher.mu == mu and replan.plan.solved
+
+
+def test_where_no_plan_starts_the_pusher_goes_on_with_its_plan_then_looks_again():
+    """narrow_junction's block 12 mm along and 6 mm across its corridor, turned 7 degrees, leaves
+    the pusher no room flush on any face: no plan starts there. The pusher goes on with the plan
+    from where it stopped, deaf to the part being off it until it has moved the part's radius on;
+    then a part back on the plan is followed to the goal."""
+    scene = load_scene(ROOT / "scenes" / "narrow_junction.yaml")
+    session = Planner(scene)
+    plan = session.plan(seed=1)
+    tracker = Tracker(session, plan, pusher=lead_in_pose(scene, session.model, plan))
+    askew = scene.start + [0.012, 0.006, math.radians(-7)]
+    assert max(session.model.clearance(askew, e) for e in scene.pusher.edges) < scene.slider.radius / 40
+    kinds = [tracker.observe(k / RATE, askew).kind for k in range(CONFIRM + SETTLE)]
+    assert kinds[-1] == "follow" and tracker.replans == [] and not tracker.reason
+    ((when, reason),) = tracker.carried
+    assert when == (len(kinds) - 1) / RATE and "no room" in reason
+    stopped, _, _, _ = tracker.pusher_at(when)
+    # Deaf while the pusher moves the part's radius on: the part still off the plan changes nothing.
+    now = when + 1 / RATE
+    while np.linalg.norm(tracker.pusher_at(now)[0][:2] - stopped[:2]) < 0.9 * scene.slider.radius:
+        assert tracker.observe(now, askew).kind == "follow"
+        now += 1 / RATE
+    last = None
+    while last not in ("done", "give_up") and now < 200:
+        last = tracker.observe(now, on_plan(tracker, now)).kind
+        now += 1 / RATE
+    assert last == "done" and tracker.replans == [] and len(tracker.carried) == 1
+
+
+def test_where_the_arm_lifts_the_pusher_is_lifted_over_to_a_face_it_cannot_walk_to():
+    """In narrow_junction's corridor the pusher cannot walk round the block (transit: lift): from
+    the face it pushes, the way to the opposite face is a lift. Its two moves on the table are
+    clear of the walls, it lands at the standoff in front of that face and moves in flush."""
+    scene = load_scene(ROOT / "scenes" / "narrow_junction.yaml")
+    session = Planner(scene)
+    edges = list(scene.pusher.edges)
+    pushed, opposite = 1, 3  # the block's two ends (its +x and -x faces), across it along the corridor
+    at = edge_contact_pose(scene.slider, pushed, scene.start)
+    way = approach(scene, session.model, session.world.transits, at, scene.start, opposite, edges)
+    assert way is not None and way.mode == "lift"
+    path = np.asarray(way.pusher_path)
+    contact = edge_contact_pose(scene.slider, opposite, scene.start)
+    assert np.allclose(path[0], at) and np.allclose(path[-1], contact)
+    assert all(session.model.pusher_clearance(p) > 0 for p in path)
+    # Backed straight off the face it left; landed in front of the new one, facing it.
+    assert np.isclose(path[1][2], at[2]) and np.isclose(path[2][2], contact[2])
+    assert 0 < np.linalg.norm(path[2][:2] - contact[:2]) <= 0.02

@@ -14,7 +14,8 @@
 A draw that puts the part on an obstacle or on the pusher is drawn again. Each case runs once
 open loop and once closed loop on the grid foot set; a row per case, then the totals: runs in the
 goal without touching a wall or obstacle (open loop: slip is not counted, a part met off its
-planned contact slides along the face by design), re-plans and their latency (median, max).
+planned contact slides along the face by design), re-plans and their latency (median, max), and
+how often the loop went on with its plan for want of a re-plan.
 Needs the mujoco extra.
 """
 
@@ -116,13 +117,15 @@ def main(argv: list[str] | None = None) -> int:
                   f"| {'ok' if open_ok else 'FAIL'} ({open_run.goal_error[0] * 1e3:.1f} mm"
                   f"{', collides' if open_run.collisions else ''}) "
                   f"| {'ok' if closed_run.passed else 'FAIL'} ({closed_run.goal_error[0] * 1e3:.1f} mm"
-                  f"{'; ' + closed_run.reason if closed_run.reason else ''}) | {len(closed_run.replans)} | {timing} |",
+                  f"{', collides' if closed_run.collisions else ''}{'; ' + closed_run.reason if closed_run.reason else ''}"
+                  f"{f'; went on {len(closed_run.carried)} times' if closed_run.carried else ''}) "
+                  f"| {len(closed_run.replans)} | {timing} |",
                   flush=True)
     if total:
         timing = (f"re-plans {len(latencies)}, latency median {np.median(latencies) * 1e3:.0f} ms, "
                   f"max {max(latencies) * 1e3:.0f} ms" if latencies else "no re-plans")
-        print(f"\nopen loop {opened}/{total} ({100 * opened / total:.0f} %), closed loop {closed}/{total} "
-              f"({100 * closed / total:.0f} %); {timing}")
+        print(f"\nopen loop {opened}/{total} ({100 * opened / total:.1f} %), closed loop {closed}/{total} "
+              f"({100 * closed / total:.1f} %); {timing}")
     return 0
 
 

@@ -10,7 +10,10 @@ pose in front of the new first edge (straight, or walking round the part as a tr
 against obstacles and walls by conservative advancement; every move but the last (the move in)
 is also kept off the part, sampled every :data:`PART_STEP` (the pusher's body shrunk by
 :data:`GRAZE`, so that a pusher leaving a face it was pressing, a fraction of a millimetre into
-it in a simulation, is not taken for one going through the part).
+it in a simulation, is not taken for one going through the part). Where the scene's arm lifts the
+pusher (``transit: lift``) and no way on the table is free, the pusher backs off, is lifted over
+to the standoff pose and moves in, as a lift transit does: only the two moves on the table are
+checked.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from ..actions.transit import TransitPlanner, backed_off, edge_contact_pose, path_duration, standoff
+from ..actions.transit import TransitPlanner, backed_off, edge_contact_pose, in_plane_moves, path_duration, standoff
 from ..model.bodies import pusher_frame_body, slider_at
 from ..model.plan_file import Plan, Push, Transit
 from ..model.scene import Scene
@@ -72,8 +75,8 @@ def _off_part(scene: Scene, part: shapely.Polygon, a: np.ndarray, b: np.ndarray)
 def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | None, pusher: ArrayLike,
              part: ArrayLike, edge: int, edges: list[int]) -> Transit | None:
     """The pusher's collision-checked path from its pose ``pusher`` to the contact on ``edge`` of
-    the part at ``part`` (module docstring), as a transit (mode ``'plane'``), or None if none of
-    the ways tried is free. ``edges`` are those the pusher may be put on (for a walk round).
+    the part at ``part`` (module docstring), as a transit (mode ``'plane'``, or ``'lift'`` where
+    the scene lifts), or None if none of the ways tried is free. ``edges`` are those the pusher may be put on (for a walk round).
 
     The ways, in order: straight to the standoff pose and in; backed off (by the transits'
     standoff, three times it, or :data:`LEAD_IN`: a pusher stopped after a knock may be on the
@@ -107,4 +110,11 @@ def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | Non
                 _off_part(scene, body, a, b) for a, b in moves[int(backing):-1]):
             path = np.array(way)
             return Transit(edge, edge, "plane", path, path_duration(path, reach), part.copy())
+    if transits is not None and transits.mode == "lift":
+        for back in (gap, 3 * gap, LEAD_IN):
+            for front in fronts:
+                path = np.array([pusher, backed_off(pusher, back), front, contact])
+                lift = Transit(edge, edge, "lift", path, path_duration(path, reach), part.copy())
+                if all(model.pusher_move_is_free(a, b, CLEARANCE) for a, b in in_plane_moves(lift)):
+                    return lift
     return None

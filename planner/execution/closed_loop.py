@@ -6,9 +6,10 @@ the pusher begins behind the first contact. Here the pusher follows a
 :class:`~.tracker.Tracker`: every ``1 / OBSERVE_HZ`` seconds of simulated time the part's pose,
 with Gaussian noise of the given deviations, is handed to it, and the pusher is set before every
 step to where the tracker has it (stopped while the tracker waits for the part to settle, then
-along the approach to the new plan's first contact and the new plan). Simulated time stands still
-while the tracker re-plans (the part is at rest and the pusher stopped, so waiting changes nothing
-but the clock); the wall time it took is the re-plan's latency.
+along the approach to the new plan's first contact and the new plan). While the tracker re-plans,
+simulated time goes on as the wall clock did (the re-plan's latency), the pusher held still: the
+new plan begins after it, as on a robot. So a run is repeatable up to those waits, which differ
+from one run to the next by milliseconds with the part at rest.
 
 A run ends when the tracker is done (the part observed at rest within the goal tolerance) or gives
 up, or after :data:`PATIENCE` times the first plan's duration plus :data:`GRACE` seconds.
@@ -44,9 +45,11 @@ PATIENCE, GRACE = 3.0, 20.0
 @dataclass(frozen=True)
 class ClosedRun:
     """One closed-loop run on one foot set: the part's true final pose against the goal, the
-    re-plans (:class:`~.tracker.Replan`), why the tracker gave up (empty if it did not), samples
-    of the part touching a wall or obstacle, wall and simulated seconds, and the pusher's executed
-    path (a :class:`~.trajectory.Trajectory` at :data:`~.trajectory.RATE` Hz)."""
+    re-plans (:class:`~.tracker.Replan`) and the times it went on without one
+    (:attr:`~.tracker.Tracker.carried`), why the tracker gave up (empty if it did not), samples
+    of the part touching a wall or obstacle, wall and simulated seconds, the pusher's executed
+    path (a :class:`~.trajectory.Trajectory` at :data:`~.trajectory.RATE` Hz) and the part's
+    true pose at each of its samples."""
 
     feet: Feet
     goal_error: tuple[float, float]
@@ -57,6 +60,8 @@ class ClosedRun:
     seconds: float
     simulated: float
     executed: Trajectory
+    part: np.ndarray
+    carried: tuple[tuple[float, str], ...] = ()
 
     @property
     def passed(self) -> bool:
@@ -74,7 +79,15 @@ class ClosedRun:
                    f" triggered by {'; '.join(_trigger(r) for r in self.replans)})" if self.replans else "")
         return (f"closed loop {k}/{n} ({self.feet.kind}, {len(self.feet.points)} feet): goal error "
                 f"{self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad; {len(self.replans)} re-plans{latency}; "
+                f"{_carried(self.carried)}"
                 f"{self.seconds:.1f} s for {self.simulated:.1f} s: {', '.join(faults) if faults else 'ok'}")
+
+
+def _carried(carried: tuple[tuple[float, str], ...]) -> str:
+    """The times the loop went on with its plan for want of a new one, if any."""
+    if not carried:
+        return ""
+    return f"went on with the plan {len(carried)} time{'s' if len(carried) > 1 else ''} for want of a re-plan (first at t={carried[0][0]:.2f} s: {carried[0][1]}); "
 
 
 def _trigger(replan: Replan) -> str:
@@ -111,9 +124,16 @@ class ClosedLoop:
         """Write the first run's model, the part at its perturbed start (:func:`.mujoco_sim.mjcf`)."""
         write_mjcf(path, scene, self.runs[0].feet, self.mu, self.start)
 
-    def write_executed(self, path: str | Path) -> None:
-        """Write the first run's executed pusher path as CSV (the trajectory CSV's columns)."""
-        self.runs[0].executed.write_csv(path)
+    def executed_files(self, name: str) -> list[str]:
+        """The executed paths' file names, one per run: ``<name>.executed-<k>.csv``, ``k`` the
+        run's number in :meth:`lines`."""
+        return [f"{name}.executed-{k}.csv" for k in range(1, len(self.runs) + 1)]
+
+    def write_executed(self, folder: str | Path, name: str) -> None:
+        """Write each run's executed pusher path as CSV into ``folder`` (the trajectory CSV's
+        columns; :meth:`executed_files`)."""
+        for run, file in zip(self.runs, self.executed_files(name)):
+            run.executed.write_csv(Path(folder) / file)
 
 
 def _run(session: Planner, plan: Plan, support: Feet, mu: float | None, start: np.ndarray, bumps: tuple,
@@ -134,7 +154,7 @@ def _run(session: Planner, plan: Plan, support: Feet, mu: float | None, start: n
         u = k / RATE
         world.step_to(SETTLE + u, pusher)
         pose, height, rate, contact = tracker.pusher_at(u)
-        rows.append([u, *pose, *rate[:3], height, contact, len(tracker.replans)])
+        rows.append([u, *pose, *rate[:3], height, contact, len(tracker.replans), *world.pose()])
         collisions += world.colliding()
         if k % every == 0:
             seen = world.pose() + rng.normal(0.0, [noise[0], noise[0], noise[1]])
@@ -144,11 +164,12 @@ def _run(session: Planner, plan: Plan, support: Feet, mu: float | None, start: n
     table = np.array(rows)
     table[:, 3] = (table[:, 3] + np.pi) % (2 * np.pi) - np.pi
     executed = Trajectory(*table[:, :8].T, table[:, 8].astype(int), table[:, 9].astype(int))
+    part = table[:, 10:13]
     end = world.pose()
     error = (math.hypot(*(end[:2] - scene.goal[:2])), abs(float((end[2] - scene.goal[2] + np.pi) % (2 * np.pi) - np.pi)))
     reason = tracker.reason or ("" if tracker.done else f"not done after {limit:.0f} s")
     return ClosedRun(support, error, scene.within_tolerance(end), tuple(tracker.replans), reason, collisions,
-                     time.perf_counter() - clock, float(table[-1, 0]), executed)
+                     time.perf_counter() - clock, float(table[-1, 0]), executed, part, tuple(tracker.carried))
 
 
 def closed_loop(session: Planner, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,

@@ -28,12 +28,32 @@ session, which joins that pose to the plan it remembers for the goal in millisec
 ``'done'``; else a re-plan.
 
 **Re-planning** asks first for a plan whose first push is on the edge the pusher is at (if it
-can come back to it), then for one beginning on an edge it has a free approach to.
+can come back to it), then for one beginning on an edge it has a free approach to; from the
+observed pose, the pusher needs only the room every push keeps
+(``Planner.plan(observed=True)``). The new plan begins when the planning is done (the
+observation's time plus the planning's wall-clock time, :attr:`Replan.latency`): a robot that
+gets it that much later finds the pusher at its beginning, held still until then.
+
+**Friction.** A push that does not stick is what a pusher with less friction than planned
+shows: the part drifts off the plan while it is pushed, still against the pusher's face. So a
+deviation confirmed while the plan pushes, with the part within the position threshold of the
+pusher's body, that grew gradually (no observation's error differs from the one before by as
+much as the thresholds, as a knock's does), is taken for slip: the re-plan, and those after it,
+assume :data:`FRICTION_STEP` times the friction the last plan assumed (a session of its own), down
+to :data:`FRICTION_FLOOR` times the planned. Sticking at a lower friction implies sticking at any
+higher one, so a plan for too low a friction still holds; it is only more cautious.
+
+**Going on.** When the planner finds no plan from the observed pose, or the pusher has no free
+approach to any edge (a part turned in a narrow corridor leaves no room for the pusher flush on
+any face), the pusher goes on with the plan it has, from where it stopped: a flat pusher that
+meets a part askew turns it flush and funnels its error (open loop in MuJoCo), after which a plan
+may exist. Deviations are not looked at until the pusher has moved the part's radius on along the
+plan (or the plan ends); then the loop looks again. Each time counts against the budget.
 
 **Giving up.** When the goal is certified unreachable from the observed pose
-(:meth:`planner.Planner.certify_unreachable`), when the planner finds no plan from it, when the
-pusher has no free approach to any edge, or when the re-plans exceed the budget,
-the tracker gives up with the reason and holds the pusher where it is.
+(:meth:`planner.Planner.certify_unreachable`), when no plan is found from where the plan has
+ended, or when the re-plans and the goings-on exceed the budget, the tracker gives up with the
+reason and holds the pusher where it is.
 
 Times are the caller's clock (seconds, increasing); poses ``(x, y, theta)`` in metres and radians.
 """
@@ -46,17 +66,20 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
+import shapely
 from numpy.typing import ArrayLike
 
 from mechanics import wrap_angle
 
+from ..model.bodies import pusher_frame_body, slider_at
 from ..model.fields import SceneError, poses
 from ..model.plan_file import Plan, Transit
 from ..queries.session import Planner
 from .approach import approach, first_edge
 from .trajectory import Trajectory, planned_part, trajectory
 
-__all__ = ["BUDGET", "CONFIRM", "REPLAN_LIMIT", "FRACTION", "SETTLE", "SIGMAS", "Command", "Replan", "Tracker", "mean_pose"]
+__all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "REPLAN_LIMIT", "FRACTION", "SETTLE", "SIGMAS",
+           "Command", "Replan", "Tracker", "mean_pose"]
 
 #: Thresholds: this fraction of the goal tolerance, and at least this many noise deviations.
 FRACTION, SIGMAS = 0.5, 5.0
@@ -69,6 +92,9 @@ BUDGET = 8
 #: Default time limit of a re-plan's search, s: a robot waits that long at most (a join to the
 #: remembered plan takes tens of milliseconds; a search on the shipped scenes well under a second).
 REPLAN_LIMIT = 2.0
+#: After slip, a re-plan assumes this times the friction the last plan assumed, and never less
+#: than the floor times the planned (three halvings).
+FRICTION_STEP, FRICTION_FLOOR = 0.5, 0.125
 
 
 @dataclass(frozen=True)
@@ -95,7 +121,8 @@ class Command:
 class Replan:
     """One re-plan: when (the caller's clock), from which observed pose (the mean of the settled
     observations), what triggered it (``trigger``: the observation that confirmed the deviation,
-    and its error), how long the planning took (s) and what it gave."""
+    and its error), how long the planning took (s), what it gave and the pusher friction it
+    assumed."""
 
     time: float
     start: np.ndarray
@@ -104,6 +131,7 @@ class Replan:
     why: str
     latency: float
     plan: Plan
+    mu: float
 
 
 def mean_pose(rows: ArrayLike) -> np.ndarray:
@@ -178,10 +206,13 @@ class Tracker:
         self.time_limit = min(float(time_limit), session.options.time_limit)
         #: The re-plans so far.
         self.replans: list[Replan] = []
+        #: When no plan was found and the pusher went on with the one it had, and why: ``(time, reason)``.
+        self.carried: list[tuple[float, str]] = []
         self.reason = ""  # why the tracker gave up
         self.done = False
-        self._strikes = 0
-        self._trigger: tuple[np.ndarray, tuple[float, float], str] | None = None
+        self._strikes, self._jump, self._last = 0, 0.0, None
+        self._body = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
+        self._trigger: tuple[np.ndarray, tuple[float, float], str, bool] | None = None
         self._window: list[np.ndarray] = []
         self._held: tuple[np.ndarray, float] | None = None
         start = self._pose(plan.start, "plan.start")
@@ -210,8 +241,8 @@ class Tracker:
         self.motion: Trajectory = trajectory(self.scene, led)
         self.expected = planned_part(self.scene, led, self.motion)
         self._theta = np.unwrap(self.motion.theta)
-        self._since = now
-        self._strikes, self._held = 0, None
+        self._since, self._quiet = now, 0.0
+        self._strikes, self._held, self._last = 0, None, None
         return ""
 
     def _approach(self, pusher: np.ndarray, part: np.ndarray, edge: int) -> Transit | None:
@@ -226,7 +257,7 @@ class Tracker:
         if self._held is not None:
             pose, height = self._held
             return pose.copy(), height, np.zeros(4), False
-        m, u = self.motion, now - self._since
+        m, u = self.motion, max(now - self._since, 0.0)  # before a re-plan's start: at its first sample, at rest
         column = [np.interp(u, m.t, c) for c in (m.x, m.y, self._theta, m.z, m.vx, m.vy, m.omega)]
         k = min(int(np.searchsorted(m.t, u)), len(m.t) - 1)
         rise = np.interp(u, m.t, np.gradient(m.z, m.t)) if len(m.t) > 1 else 0.0
@@ -238,6 +269,7 @@ class Tracker:
 
     def _stop(self, now: float) -> None:
         pose, height, _, _ = self.pusher_at(now)
+        self._stopped = min(max(now - self._since, 0.0), self.motion.duration)  # on the plan's clock
         k = min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
         self._edge = self._segments[int(self.motion.segment[k])].edge
         self._held, self._window = (pose, height), []
@@ -267,25 +299,50 @@ class Tracker:
             if len(self._window) < self.settle:
                 return self._command("stop", now, error)
             return self._settled(now, mean_pose(self._window), error)
-        beyond = error[0] > self.threshold[0] or error[1] > self.threshold[1]
-        self._strikes = self._strikes + 1 if beyond else 0
+        beyond = (error[0] > self.threshold[0] or error[1] > self.threshold[1]) and now - self._since >= self._quiet
+        step = 0.0 if self._last is None else max(abs(a - b) / t for a, b, t in zip(error, self._last, self.threshold))
+        self._strikes, self._last = self._strikes + 1 if beyond else 0, error
+        self._jump = max(self._jump, step) if beyond else 0.0  # from the last observation within the thresholds on
         ended = now - self._since >= self.motion.duration
         if self._strikes >= self.confirm or ended:
             why = "the plan ended" if ended and self._strikes < self.confirm else (
                 f"off the plan by {error[0] * 1000:.1f} mm, {math.degrees(error[1]):.1f} deg")
-            self._trigger = (pose, error, why)
+            self._trigger = (pose, error, why, self._strikes >= self.confirm and self._slid(now, pose))
             self._stop(now)
             return self._command("stop", now, error)
         return self._command("follow", now, error)
+
+    def _slid(self, now: float, pose: np.ndarray) -> bool:
+        """Whether the part, observed at ``pose``, strayed as a push that does not stick makes it:
+        while pushed, gradually, still against the pusher (module docstring, "Friction")."""
+        pusher, _, _, contact = self.pusher_at(now)
+        if not contact or self._jump >= 1.0:
+            return False
+        return slider_at(self.scene.slider.polygon, pose).distance(slider_at(self._body, pusher)) < self.threshold[0]
+
+    def _lower_friction(self) -> str:
+        """Re-plan from now on for less friction (module docstring, "Friction"); what to say of it."""
+        pusher = self.session.scene.pusher
+        mu = pusher.mu * FRICTION_STEP
+        if mu < FRICTION_FLOOR * self.scene.pusher.mu * (1 - 1e-9):
+            return ""
+        lower = Planner(replace(self.session.scene, pusher=replace(pusher, mu=mu)), self.session.options)
+        if lower.world is None:  # no stable push at that friction (or no region in time): plan as before
+            return ""
+        self.session = lower
+        return f"; it slid on the pusher: planned for pusher mu {mu:g}"
 
     def _settled(self, now: float, part: np.ndarray, error: tuple[float, float]) -> Command:
         """The part observed at rest at ``part`` (the mean): done, re-planned, or given up."""
         if self.scene.within_tolerance(part):
             self.done = True
             return self._command("done", now, error)
-        if len(self.replans) >= self.budget:
+        if len(self.replans) + len(self.carried) >= self.budget:
             return self._give_up(now, error, f"the re-plan budget ({self.budget}) is spent")
         clock = time.perf_counter()
+        trigger, trigger_error, why, slid = self._trigger
+        if slid:
+            why += self._lower_friction()
         certificate = self.session.certify_unreachable(start=part)
         if certificate:
             return self._give_up(now, error, f"the goal is unreachable from the observed pose: {certificate}")
@@ -295,26 +352,45 @@ class Tracker:
             # back to the part; then one that begins on an edge the pusher can get to from there.
             found = None
             if self._approach(pusher, part, self._edge) is not None:
-                found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge])
+                found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge],
+                                          observed=True)
             if found is None or not found.solved:
                 world = self.session.world
                 others = [c.edge for c in world.controls if c.edge != self._edge] if world is not None else []
                 reached = [e for e in others if self._approach(pusher, part, e) is not None]
                 if not reached and found is None:
-                    return self._give_up(now, error, "no free approach from the pusher to any edge of the part")
+                    return self._carry_on(now, error, "no free approach from the pusher to any edge of the part", clock)
                 if reached:
-                    found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=reached)
+                    found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=reached,
+                                              observed=True)
         except SceneError as err:  # the pusher has no room at the observed pose
-            return self._give_up(now, error, f"no plan from the observed pose: {err.problem}")
+            return self._carry_on(now, error, f"no plan from the observed pose: {err.problem}", clock)
         if not found.solved or not found.segments:
-            return self._give_up(now, error, f"no plan from the observed pose: {found.reason or 'no segments'}")
-        problem = self._begin(found, pusher, part, now)
+            return self._carry_on(now, error, f"no plan from the observed pose: {found.reason or 'no segments'}", clock)
+        latency = time.perf_counter() - clock
+        # The new plan begins when it is there: the pusher held still until then.
+        problem = self._begin(found, pusher, part, now + latency)
         if problem:
             self._held = (pusher, 0.0)
             return self._give_up(now, error, problem)
-        trigger, trigger_error, why = self._trigger
-        self.replans.append(Replan(now, part, trigger, trigger_error, why, time.perf_counter() - clock, found))
+        self.replans.append(Replan(now, part, trigger, trigger_error, why, latency, found, self.session.scene.pusher.mu))
         return self._command("replan", now, error, found)
+
+    def _carry_on(self, now: float, error: tuple[float, float], reason: str, clock: float) -> Command:
+        """No plan from where the part is (``reason``): go on with the plan from where the pusher
+        stopped, deaf to deviations until it has moved the part's radius on (module docstring,
+        "Going on"); give up if the plan had ended or the budget is spent."""
+        if self._stopped >= self.motion.duration or len(self.replans) + len(self.carried) >= self.budget:
+            return self._give_up(now, error, reason)
+        self.carried.append((now, reason))
+        m = self.motion
+        travel = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(m.x), np.diff(m.y)))])
+        on = np.interp(self._stopped, m.t, travel) + self.scene.slider.radius
+        self._quiet = float(np.interp(on, travel, m.t)) if on < travel[-1] else m.duration
+        # It goes on once this was decided, from where it stopped.
+        self._since = now + (time.perf_counter() - clock) - self._stopped
+        self._held, self._strikes, self._last = None, 0, None
+        return self._command("follow", now, error)
 
     def _give_up(self, now: float, error: tuple[float, float], reason: str) -> Command:
         self.reason = reason

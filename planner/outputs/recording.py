@@ -73,6 +73,25 @@ With a :class:`~planner.execution.mujoco_sim.Simulation` (``plan --simulate N``)
   the run leaves the plan and one hides the other while it follows;
 * ``/log/simulate`` -- ``TextLog``, the simulation's summary row (``WARN`` when it failed).
 
+With a :class:`~planner.execution.closed_loop.ClosedLoop` (``plan --simulate N --closed-loop``),
+also, per run ``k`` (from 1, as the output lines number them), on the ``time`` timeline but on
+the run's own clock (seconds since its pusher began to move, its lead-in, the waits for the part
+to settle and the re-plans' latencies included; not on ``step``), at :data:`RUN_FRAMES_HZ`:
+
+* ``/world/closed_loop/<k>/part`` -- the part's outline where MuJoCo has it (started off the
+  plan's start, knocked), labelled ``run <k>``;
+* ``/world/closed_loop/<k>/pusher`` -- the pusher's outline where the loop moved it, and
+  ``/world/closed_loop/<k>/pusher_path`` the path of its frame's origin so far;
+* ``/world/closed_loop/<k>/replan/<j>`` -- from the ``j``-th re-plan's time on: the CF path of
+  the new plan, and ``/world/closed_loop/<k>/replan/<j>/start`` a point at the CF of the
+  observed pose it was planned from, labelled ``re-plan <j> at <t> s``;
+* ``/log/closed_loop`` -- ``TextLog``: at 0 the loop's summary and the runs' lines (``WARN``
+  when it failed), and a row at each re-plan's time saying what triggered it, and at each time
+  the run went on with its plan for want of a re-plan, saying why.
+
+(The re-plans' latencies are in the runs' clocks, so a closed loop's recording differs a little
+from one run of it to the next.)
+
 With a reachable-set map (``plan --reach N``; :mod:`planner.queries.reachable_set`), also:
 
 * ``/world/reach`` -- ``Points3D``, static, one point per reachable cell centre, green for one
@@ -109,14 +128,17 @@ from .analysis import STATUS, analysis
 from .frames import FRAMES_PER_RADIUS, frames, history
 
 if TYPE_CHECKING:  # the simulators behind them import scipy or MuJoCo: not needed to draw a plan
+    from ..execution.closed_loop import ClosedLoop
     from ..execution.mujoco_sim import Simulation
     from ..execution.verify import Verification
     from ..queries.reachable_set import ReachableSet
 
-__all__ = ["GHOST_SAMPLES", "write_recording"]
+__all__ = ["GHOST_SAMPLES", "RUN_FRAMES_HZ", "write_recording"]
 
 #: Most frames per push at which the simulated ghost is drawn (each costs a simulation).
 GHOST_SAMPLES = 10
+#: Frames per second of a closed-loop run's clock.
+RUN_FRAMES_HZ = 10.0
 
 _THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0.5, 1.0, 2.0, 4.0]))
 _GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
@@ -280,6 +302,41 @@ def _log_simulated(rec: rr.RecordingStream, scene: Scene, simulation: Simulation
     _log_text(rec, "log/simulate", [simulation.summary()], "INFO" if simulation.passed else "WARN")
 
 
+def _log_closed_loop(rec: rr.RecordingStream, scene: Scene, loop: ClosedLoop) -> None:
+    """Each closed-loop run's part, pusher, executed path and re-plans, and ``/log/closed_loop``
+    (module docstring)."""
+    outline, body = _closed(scene.slider.vertices), _closed(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
+    for k, run in enumerate(loop.runs, 1):
+        root, t = f"world/closed_loop/{k}", run.executed.t
+        rows = np.unique(np.append(np.searchsorted(t, np.arange(0.0, t[-1], 1.0 / RUN_FRAMES_HZ)), len(t) - 1))
+        clock = [rr.TimeColumn("time", duration=t[rows])]
+        pusher = np.column_stack([run.executed.x, run.executed.y, run.executed.theta])[rows]
+        for entity, strips in ((f"{root}/part", place(outline, run.part[rows])), (f"{root}/pusher", place(body, pusher))):
+            rec.send_columns(entity, indexes=clock, columns=rr.LineStrips3D.columns(strips=_z(strips, "ghost")))
+        rec.send_columns(f"{root}/pusher_path", indexes=clock, columns=rr.LineStrips3D.columns(
+            strips=_zs(history(pusher[:, :2], np.zeros(len(rows), dtype=int)), "path")))
+        rec.log(f"{root}/part", rr.LineStrips3D.from_fields(colors=_SIMULATED, radii=_BOLD, labels=[f"run {k}"]),
+                static=True)
+        rec.log(f"{root}/pusher", rr.LineStrips3D.from_fields(colors=_DARK, radii=_LINE), static=True)
+        rec.log(f"{root}/pusher_path", rr.LineStrips3D.from_fields(colors=_DARK, radii=_THIN), static=True)
+        for j, replan in enumerate(run.replans, 1):
+            rec.set_time("time", duration=replan.time)
+            shown = frames(scene, replan.plan, scene.slider.radius / FRAMES_PER_RADIUS)
+            rec.log(f"{root}/replan/{j}", rr.LineStrips3D([_z(place(scene.slider.cf[None], shown.part)[:, 0], "path")],
+                                                          colors=_COR, radii=_LINE))
+            rec.log(f"{root}/replan/{j}/start", rr.Points3D(
+                _z(place(scene.slider.cf[None], replan.start[None])[0], "marker"), colors=_COR, radii=_DOT,
+                labels=[f"re-plan {j} at {replan.time:.2f} s"]))
+            rec.log("log/closed_loop", rr.TextLog(f"run {k}, re-plan {j} at {replan.time:.2f} s: {replan.why} "
+                                                  f"({replan.latency * 1e3:.0f} ms)", level="INFO"))
+        for when, reason in run.carried:
+            rec.set_time("time", duration=when)
+            rec.log("log/closed_loop", rr.TextLog(f"run {k} went on with its plan at {when:.2f} s: {reason}",
+                                                  level="WARN"))
+        rec.reset_time()
+    _log_text(rec, "log/closed_loop", [loop.summary(), *loop.lines()], "INFO" if loop.passed else "WARN")
+
+
 def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
     """The animated entities; returns the frames' segment indices and times."""
     shown = frames(scene, plan, scene.slider.radius / FRAMES_PER_RADIUS)
@@ -334,7 +391,7 @@ def _top_view(origin: str, name: str, x: float, y: float, half: float) -> rrb.Sp
 
 def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Verification | None = None,
                     reach: ReachableSet | None = None, simulation: Simulation | None = None,
-                    cache: RegionCache | None = None) -> None:
+                    closed_loop: ClosedLoop | None = None, cache: RegionCache | None = None) -> None:
     """Write a rerun recording of ``plan`` for ``scene`` to ``path`` (layout: module docstring).
 
     The recording is made in memory (footer included) and written with
@@ -355,6 +412,8 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         :func:`planner.queries.reachable_set.reachable_set` from the scene's start: adds ``/world/reach``.
     simulation : Simulation, optional
         :func:`planner.execution.mujoco_sim.simulate` of ``plan``: adds the simulated part and the verdict.
+    closed_loop : ClosedLoop, optional
+        :func:`planner.execution.closed_loop.closed_loop` of ``plan``: adds its runs and re-plans.
     cache : RegionCache, optional
         Where the plan's regions and the analysis are found, or kept once computed (default:
         :func:`~planner.actions.region_cache.default_cache`); :func:`~planner.outputs.analysis.prepare` may have filled it.
@@ -391,6 +450,8 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
                 _log_ghost(rec, plan, verification, index, times)
             if simulation is not None:
                 _log_simulated(rec, scene, simulation, times)
+            if closed_loop is not None:
+                _log_closed_loop(rec, scene, closed_loop)
         if reach is not None:
             _log_reach(rec, reach)
         data = stream.read(flush=True)  # the whole recording, footer included

@@ -157,7 +157,7 @@ class Planner:
 
     def plan(self, start: ArrayLike | None = None, goal: ArrayLike | None = None, *, seed: int | None = None,
              time_limit: float | None = None, optimize: int | None = None, planner: str | None = None,
-             reuse: bool = True, edges: Sequence[int] | None = None) -> Plan:
+             reuse: bool = True, edges: Sequence[int] | None = None, observed: bool = False) -> Plan:
         """A plan of guaranteed-stable pushes from ``start`` to ``goal`` (``(x, y, theta)``,
         radians; default: the scene's).
 
@@ -167,7 +167,9 @@ class Planner:
         joined to it by one or two pushes (module docstring). A plan is always solved or says why
         not (``Plan.reason``); a start where the pusher has no room is bad input. ``edges``, if
         given, are the only edges the first push may be on (a robot re-planning with its pusher on
-        the part keeps it there; the plan may still switch, by a checked transit).
+        the part keeps it there; the plan may still switch, by a checked transit). ``observed``:
+        the part is observed at ``start``, so the pusher needs there only the clearance every push
+        keeps, not the search's (:class:`~planner.search.context.PlanningContext`).
 
         Raises
         ------
@@ -180,17 +182,18 @@ class Planner:
         goal = self._pose(goal, "goal", self.scene.goal)
         if edges is not None and not all(isinstance(e, int) and e in self.scene.pusher.edges for e in edges):
             raise SceneError("edges", f"must be allowed edges of the pusher {list(self.scene.pusher.edges)}, got {edges}")
-        return self._plan(start, goal, request, time.perf_counter(), reuse, edges)
+        return self._plan(start, goal, request, time.perf_counter(), reuse, edges, observed)
 
     def _plan(self, start: np.ndarray, goal: np.ndarray, request: PlanRequest, clock: float,
-              reuse: bool = False, edges: Sequence[int] | None = None) -> Plan:
+              reuse: bool = False, edges: Sequence[int] | None = None, observed: bool = False) -> Plan:
         if self._no_push is not None:
             raise self._no_push
         if self.world is None:
             return plan_result(self.scene, request, clock, start, goal, [], self._timeout)
-        context = PlanningContext(self.world, request, start, clock)
+        context = PlanningContext(self.world, request, start, clock, observed)
         if edges is not None:
             context.starts = [k for k in context.starts if self.world.controls[k].edge in edges]
+            context.search_starts = [k for k in context.search_starts if k in context.starts]
             if not context.starts:
                 return plan_result(self.scene, request, clock, start, goal, [],
                                    f"no stable push with room for the pusher at the start on edges {list(edges)}")

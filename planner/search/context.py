@@ -130,19 +130,20 @@ class SearchWorld:
             controls, note = timeout.controls, str(timeout)
         return cls(scene, controls, model, note)
 
-    def start_edges(self, start: np.ndarray) -> list[int]:
-        """The indices of the controls whose edge has room for the pusher at ``start``.
+    def start_edges(self, start: np.ndarray, room: float | None = None) -> list[int]:
+        """The indices of the controls whose edge has room for the pusher at ``start``: a
+        clearance above ``room`` (default: half the search's step, :class:`PlanningContext`).
 
         Raises
         ------
         SceneError
             If none has (naming ``start``).
         """
-        half = self.step / 2
-        starts = [k for k, c in enumerate(self.controls) if self.model.is_clear(start, c.edge, half)]
+        room = self.step / 2 if room is None else room
+        starts = [k for k, c in enumerate(self.controls) if self.model.is_clear(start, c.edge, room)]
         if not starts:
-            if not any(self.model.is_clear(start, e, half) for e in self.scene.pusher.edges):
-                raise SceneError("start", f"the pusher has no room on any allowed edge (needs {half:.4g} m clearance)")
+            if not any(self.model.is_clear(start, e, room) for e in self.scene.pusher.edges):
+                raise SceneError("start", f"the pusher has no room on any allowed edge (needs {room:.4g} m clearance)")
             raise SceneError("start", "the pusher has room only on edges with no stable push")
         return starts
 
@@ -175,6 +176,14 @@ class PlanningContext:
     """One run on a :class:`SearchWorld`: its request, start, clock and deadline, and the edges
     the pusher may start on.
 
+    The search checks its states a step apart, each clear by half a step, so that the motion
+    between two is clear too; a start must be as clear for the search to leave it
+    (:attr:`search_starts`). The plans of one or two pushes (:meth:`direct`, and a session's
+    joins) are checked all along by conservative advancement and need only the margin every push
+    keeps (:func:`~planner.actions.controls.clearance_margin`). For a part ``observed`` where it
+    is (a robot re-planning after a knock: the part and the pusher are there, not asked for),
+    :attr:`starts` are the edges with that margin; else the search's.
+
     Parameters
     ----------
     world : SearchWorld
@@ -182,6 +191,8 @@ class PlanningContext:
     start : the part's start pose (radians)
     clock : float
         When the run started (perf_counter): the time limit counts from there.
+    observed : bool
+        The part is observed at ``start`` (above).
 
     Raises
     ------
@@ -189,11 +200,14 @@ class PlanningContext:
         If the pusher has no room at ``start`` on an edge with stable pushes.
     """
 
-    def __init__(self, world: SearchWorld, request: PlanRequest, start: np.ndarray, clock: float):
+    def __init__(self, world: SearchWorld, request: PlanRequest, start: np.ndarray, clock: float,
+                 observed: bool = False):
         self.world, self.request, self.start, self.clock = world, request, start, clock
         self.scene, self.controls, self.model, self.step = world.scene, world.controls, world.model, world.step
         self.deadline = clock + request.time_limit
-        self.starts = world.start_edges(start)
+        self.starts = world.start_edges(start, world.margin if observed else None)
+        half = self.step / 2
+        self.search_starts = [k for k in self.starts if not observed or self.model.is_clear(start, self.controls[k].edge, half)]
 
     def result(self, goal: np.ndarray, segments: list[Push | Transit], reason: str = "",
                tree: np.ndarray | None = None, improvements: list[tuple[float, float, float]] | None = None) -> Plan:

@@ -94,6 +94,9 @@ def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
     direct = context.direct(region)
     if direct:
         return context.result(goal, direct)
+    if not context.search_starts:
+        return context.result(goal, [], f"no plan of one or two pushes, and the pusher has too little room for a search "
+                                        f"at the start (needs {context.step / 2:.4g} m clearance)")
     search = _Search(context)
     segments, tree, iterations = search.run(region)
     if segments is None:
@@ -236,7 +239,7 @@ class _Search:
         space, si = space_information(context.scene, context.controls, context.model, context.step, region.transits)
         ss = oc.SimpleSetup(si)
         start = context.start
-        for k in context.starts:
+        for k in context.search_starts:
             s = space.allocState()
             s[0].setXY(float(start[0]), float(start[1]))
             s[0].setYaw(float(wrap_angle(start[2])))
