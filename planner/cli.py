@@ -183,7 +183,8 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--closed-loop", action="store_true",
                    help="with --simulate: observe the part at 20 Hz and re-plan from where it is when it strays from "
                         "the plan (planner.execution.tracker); the summary counts the re-plans; with --trajectory "
-                        "each run's executed pusher path is written as <name>.executed-<k>.csv")
+                        "each run's executed pusher path is written as <name>.executed.csv (the first run), "
+                        "<name>.executed-<k>.csv (run k)")
     p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")
     p.add_argument("--export-scene", metavar="FILE",
                    help="also write the scene as planned to FILE (YAML, the plain schema: CAD files and boxes "
@@ -615,7 +616,7 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
     ``out`` appears with all of them at once (:func:`~planner.model.files.staged_folder`). A closed
     loop's runs (``closed``) are drawn in the recording on their own clocks, their re-plans with
     them; with ``motion``, each run's executed pusher path is written beside it,
-    ``<name>.executed-<k>.csv``."""
+    ``<name>.executed.csv`` (the first run) and ``<name>.executed-<k>.csv`` (run k >= 2)."""
     stage = out
     try:
         with staged_folder(out) as stage:

@@ -63,7 +63,7 @@ def test_a_start_error_the_open_loop_carries_to_the_end_is_recovered_closed_loop
     (trigger,) = re.findall(r"triggered by t=([\d.]+) s", out)
     latency = float(re.search(r"latency median (\d+) ms", summary).group(1)) / 1000
     # The executed pusher path starts behind the planned first contact and is where the pusher was.
-    executed = np.loadtxt(tmp_path / "closed" / "junction.executed-1.csv", delimiter=",", skiprows=1)
+    executed = np.loadtxt(tmp_path / "closed" / "junction.executed.csv", delimiter=",", skiprows=1)
     planned = np.loadtxt(tmp_path / "closed" / "junction.trajectory.csv", delimiter=",", skiprows=1)
     assert executed[0, 1] < planned[0, 1] - 0.02 and executed[0, 2] == pytest.approx(planned[0, 2])
     assert set(executed[:, 9].astype(int)) == {1, 2}  # the first plan, then the re-plan (numbered from 1)

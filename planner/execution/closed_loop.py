@@ -125,9 +125,9 @@ class ClosedLoop:
         write_mjcf(path, scene, self.runs[0].feet, self.mu, self.start)
 
     def executed_files(self, name: str) -> list[str]:
-        """The executed paths' file names, one per run: ``<name>.executed-<k>.csv``, ``k`` the
-        run's number in :meth:`lines`."""
-        return [f"{name}.executed-{k}.csv" for k in range(1, len(self.runs) + 1)]
+        """The executed paths' file names, one per run: ``<name>.executed.csv`` for the first (the
+        name scripts read), ``<name>.executed-<k>.csv`` for run ``k`` >= 2 (its number in :meth:`lines`)."""
+        return [f"{name}.executed{'' if k == 1 else f'-{k}'}.csv" for k in range(1, len(self.runs) + 1)]
 
     def write_executed(self, folder: str | Path, name: str) -> None:
         """Write each run's executed pusher path as CSV into ``folder`` (the trajectory CSV's
