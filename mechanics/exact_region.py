@@ -321,10 +321,9 @@ def exact_region(
         inside = (w_lo < points[:, 1]) & (points[:, 1] < w_hi)
         refuted, margin = ~inside, np.full(len(points), np.nan)
         ask = ~proven & inside
-        near = np.broadcast_to(near, ask.shape)
-        for part, start in ((ask & ~near, 0), (ask & near, 1)):
-            if part.any():
-                proven[part], refuted[part], margin[part] = possible_or_not(twists[part], cone, support, refinements, start)
+        if ask.any():
+            start = np.broadcast_to(near, ask.shape)[ask].astype(int)
+            proven[ask], refuted[ask], margin[ask] = possible_or_not(twists[ask], cone, support, refinements, start)
         return proven, refuted, margin
 
     if not trusted and not settled(centre)[0][0]:

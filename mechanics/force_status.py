@@ -84,8 +84,7 @@ def _sticking(twists: np.ndarray, cone: Cone, support: SupportModel,
     refuted = margin > _tolerance(support)
     certified = np.zeros(len(twists), dtype=bool)
     if not refuted.all():  # bounding the cells costs more than the LPs: only where it can help
-        rest = support.batch(twists[~refuted], level)
-        margin[~refuted] = rest.upper_bound(-cone.rows, lams[~refuted]).max(axis=1)
+        margin[~refuted] = batch[~refuted].upper_bound(-cone.rows, lams[~refuted]).max(axis=1)
         certified[~refuted] = margin[~refuted] <= 0
     return certified, refuted, margin
 
@@ -212,7 +211,7 @@ def force_possible(twists: ArrayLike, cone: Cone, support: SupportModel, refinem
 
 
 def possible_or_not(twists: ArrayLike, cone: Cone, support: SupportModel, refinements: int = 1,
-                    start: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    start: int | ArrayLike = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(proven, disproven, margin)`` for each of ``twists`` (shape ``(..., 3)``): P proven (as
     :func:`force_possible`), or P disproven by a sample distribution whose load leaves ``cone`` (a
     real distribution, so the twist is certainly not P); neither: open at the finest level tried.
@@ -220,9 +219,10 @@ def possible_or_not(twists: ArrayLike, cone: Cone, support: SupportModel, refine
     where proven; NaN for a twist settled without samples, a translation): a continuous measure
     of how far a twist is from being certified, for root finding.
 
-    The levels run from ``start`` to ``refinements``, each only for the twists still open, so a
-    batch whose twists lie far from the boundary of the P set costs one level (``start``
-    skips levels known to leave twists near that boundary open).
+    The levels run from ``start`` (one for all twists, or one each) to ``refinements``, each only
+    for the twists still open, so a batch whose twists lie far from the boundary of the P set costs
+    one level (``start`` skips levels known to leave twists near that boundary open); each level
+    is one batch of LPs for all the twists it holds.
 
     >>> from mechanics import ContactConfiguration, Slider, contact_wrench_cone, cor_to_twist
     >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
@@ -239,14 +239,15 @@ def possible_or_not(twists: ArrayLike, cone: Cone, support: SupportModel, refine
     disproven = np.array([verdict is not None and verdict.status != "P" and "P" not in verdict.consistent
                           for verdict in known], dtype=bool)
     margin = np.full(len(flat), np.nan)
+    first = np.minimum(np.broadcast_to(np.asarray(start, dtype=int), v.shape[:-1]).ravel(), refinements)
     open_ = np.array([k for k, verdict in enumerate(known) if verdict is None], dtype=int)
-    for level in range(min(start, refinements), refinements + 1):
-        if len(open_) == 0:
-            break
-        certified, refuted, margin[open_] = _sticking(flat[open_], cone, support, level)
-        proven[open_[certified]] = True
-        disproven[open_[refuted]] = True
-        open_ = open_[~certified & ~refuted]
+    for level in range(int(first.min(initial=refinements)), refinements + 1):
+        ask = open_[first[open_] <= level]
+        if len(ask):
+            certified, refuted, margin[ask] = _sticking(flat[ask], cone, support, level)
+            proven[ask[certified]] = True
+            disproven[ask[refuted]] = True
+        open_ = open_[~proven[open_] & ~disproven[open_]]
     shape = v.shape[:-1]
     return proven.reshape(shape), disproven.reshape(shape), margin.reshape(shape)
 

@@ -48,6 +48,7 @@ fallback.
 
 from __future__ import annotations
 
+import copy
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -68,6 +69,13 @@ __all__ = ["LoadBatch", "SupportCells", "SupportLoads", "SupportModel", "effecti
 COR_DIRECTIONS = 32
 #: Corners of the polygon inscribed in the CF's uncertainty disk that sample centres may reach.
 CF_DIRECTIONS = 32
+#: Twists whose optimal bases a support model keeps per level and set of directions, and how many
+#: such sets (:meth:`SupportModel.warm_bases`).
+WARM_TWISTS = 512
+WARM_DIRECTIONS = 16
+#: Pivots of a warm-started support LP before it starts again from the cold start (a warm basis
+#: can lead into a degenerate vertex the cold one avoids: a sample at the CF).
+WARM_LIMIT = 32
 
 
 def unit_loads(twist: ArrayLike, points: ArrayLike) -> np.ndarray:
@@ -263,6 +271,7 @@ class SupportModel:
         self._cells: dict[int, SupportCells] = {}
         self._lp: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._triangle: dict[int, np.ndarray] = {}
+        self._warm: dict[tuple[int, bytes], tuple[np.ndarray, np.ndarray]] = {}
 
     def __repr__(self) -> str:
         extra = f", cf_radius={self.cf_radius:g}" if self.cf_radius else ""
@@ -352,6 +361,36 @@ class SupportModel:
             self._lp[level] = columns, rhs, start
         return self._lp[level]
 
+    def warm_bases(self, level: int, ys: np.ndarray, twists: np.ndarray) -> np.ndarray:
+        """Starting bases (``K, R, m``) for the LPs of :meth:`LoadBatch.sample_support` at ``level``,
+        directions ``ys`` (``R, 3``) and ``twists`` (``K, 3``): the optimal bases of the nearest
+        twist (by direction, moments in units of :attr:`radius`) :meth:`remember` kept for these
+        directions, else :meth:`envelope_lp`'s start. Any basis of these LPs is feasible for all of
+        them (the constraints do not depend on the twist), and neighbouring twists' optima are a
+        pivot or two apart: a search along a ray pivots little."""
+        start = self.envelope_lp(level)[2]
+        kept = self._warm.get((level, ys.tobytes()))
+        if kept is None:
+            return np.broadcast_to(start, (len(twists), len(ys), len(start)))
+        keys, bases = kept
+        return bases[np.argmax(self._twist_keys(twists) @ keys.T, axis=1)]
+
+    def remember(self, level: int, ys: np.ndarray, twists: np.ndarray, bases: np.ndarray) -> None:
+        """Keep the optimal ``bases`` (``K, R, m``) of ``twists`` for :meth:`warm_bases`, the last
+        ``WARM_TWISTS`` per level and directions (memory bounded whatever the calls)."""
+        key = (level, ys.tobytes())
+        new = self._twist_keys(twists)
+        if key in self._warm:
+            keys, old = self._warm[key]
+            new, bases = np.r_[keys, new], np.concatenate([old, bases])
+        self._warm[key] = new[-WARM_TWISTS:], bases[-WARM_TWISTS:]
+        if len(self._warm) > WARM_DIRECTIONS:  # a caller cycling through many direction sets
+            del self._warm[next(iter(self._warm))]
+
+    def _twist_keys(self, twists: np.ndarray) -> np.ndarray:
+        scaled = twists * np.array([1.0, 1.0, self.radius])
+        return scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
+
     def cf_triangle(self, level: int = 0) -> np.ndarray:
         """Indices of three samples of ``level`` whose triangle holds the CF as deep inside as can be
         (a feasible start for the LPs over distributions centred at the CF; cached)."""
@@ -405,6 +444,13 @@ class LoadBatch:
     def __len__(self) -> int:
         return len(self.twists)
 
+    def __getitem__(self, index: ArrayLike) -> LoadBatch:
+        """The batch of some of the twists (an index or mask), without locating their CORs again."""
+        part = copy.copy(self)
+        part.twists, part.sense, part.cor, part.cor_in_region = (
+            self.twists[index], self.sense[index], self.cor[index], self.cor_in_region[index])
+        return part
+
     def _directions(self, ys: ArrayLike) -> np.ndarray:
         """``ys`` as ``(K, R, 3)``: one set for every twist, or a set per twist."""
         ys = np.asarray(ys, dtype=float)
@@ -419,12 +465,21 @@ class LoadBatch:
         """``(values, lams)``: the largest ``y . L`` over sample distributions, shape ``(K, R)``, and
         the LP's duals ``lam`` (``K, R, 2``), with ``value = max over samples of y . g + lam . (x - CF)``
         (plus ``cf_radius`` times the support of ``-lam`` on the 32-gon of centres)."""
+        shared = np.asarray(ys, dtype=float)
         ys = self._directions(ys)
         k, r = ys.shape[:2]
         columns, rhs, start = self.model.envelope_lp(self.level)
         costs = np.einsum("knj,krj->krn", unit_loads(self.twists[:, None, :], self.cells.points[None]), ys)
         # The centre's columns (uncertain CF) cost nothing.
         costs = np.concatenate([costs, np.zeros((k, r, columns.shape[1] - costs.shape[2]))], axis=2)
+        # One set of directions for all twists (the usual case: a cone's rows) warm-starts each LP
+        # from the optimum of the nearest twist solved before; a twist whose COR lies in the region
+        # has a column of its own, and starts from the CF's triangle.
+        warm = shared.ndim == 2 and k > 0
+        basis = np.array(np.broadcast_to(start, (k, r, len(rhs))))
+        plain = ~self.cor_in_region
+        if warm and plain.any():
+            basis[plain] = self.model.warm_bases(self.level, shared, self.twists[plain])
         if self.cor_in_region.any():
             at_cor = np.where(self.cor_in_region[:, None], np.linalg.norm(self._arm(ys), axis=-1), -np.inf)
             costs = np.concatenate([costs, at_cor[..., None]], axis=2)
@@ -432,7 +487,12 @@ class LoadBatch:
             extra[:, :3, 0] = np.c_[np.ones(k), (self.cor - self.cf) / self.model.radius]
             per_twist = np.concatenate([np.broadcast_to(columns, (k, *columns.shape)), extra], axis=2)
             columns = np.broadcast_to(per_twist[:, None], (k, r, *per_twist.shape[1:])).reshape(k * r, len(rhs), -1)
-        duals, _ = batched_simplex(costs.reshape(k * r, -1), columns, rhs, np.broadcast_to(start, (k * r, len(rhs))))
+        cold = np.broadcast_to(start, (k * r, len(rhs)))
+        duals, _, final = (batched_simplex(costs.reshape(k * r, -1), columns, rhs, basis.reshape(k * r, -1),
+                                           WARM_LIMIT, restart=cold) if warm
+                           else batched_simplex(costs.reshape(k * r, -1), columns, rhs, cold))
+        if warm and plain.any():
+            self.model.remember(self.level, shared, self.twists[plain], final.reshape(k, r, -1)[plain])
         return (duals @ rhs).reshape(k, r), (-duals[:, 1:3] / self.model.radius).reshape(k, r, 2)
 
     def _cell_geometry(self, k: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -594,7 +654,7 @@ class LoadBatch:
         basis = np.c_[np.broadcast_to(triangle, (k, 3)), np.where(values[np.arange(k), least] >= 0, z, z + 1),
                       slacks[slacks != (z + 2 + least)[:, None]].reshape(k, r - 1),
                       np.full((k, int(rho > 0)), a.shape[2] - 1)].astype(int)
-        duals, unbounded = batched_simplex(costs, a, rhs, basis)
+        duals, unbounded, _ = batched_simplex(costs, a, rhs, basis)
         beta, lam, value = -duals[:, :r], -duals[:, r + 1:r + 3] / radius, duals @ rhs
         beta[unbounded], lam[unbounded], value[unbounded] = np.nan, 0.0, np.inf
         return beta, lam, value

@@ -281,7 +281,7 @@ def test_simplex_on_random_degenerate_lps():
     columns = np.vstack([np.ones(len(x)), x.T])
     costs = rng.integers(-3, 4, size=(200, len(x))).astype(float)
     start = np.array([[i for i, p in enumerate(x.tolist()) if p in ([-2, -2], [2, -2], [0, 2])]] * 200)
-    duals, unbounded = batched_simplex(costs, columns, np.array([1.0, 0.0, 0.0]), start)
+    duals, unbounded, _ = batched_simplex(costs, columns, np.array([1.0, 0.0, 0.0]), start)
     assert not unbounded.any()
     for c, pi in zip(costs, duals):
         res = linprog(-c, A_eq=columns, b_eq=[1.0, 0.0, 0.0], bounds=(0, None), method="highs", options=TIGHT)
