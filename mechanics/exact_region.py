@@ -100,6 +100,8 @@ _REACH = 8.0
 #: Where the first rays are certified in one batch, as fractions of the way from STABLE's boundary
 #: to the end of the search: a bracket of the boundary before the secant search.
 _SPREAD = np.array([1 / 16, 1 / 8, 1 / 4, 1 / 2, 1.0])
+#: Most pieces a round of the search cuts a ray's bracket into.
+_SECTIONS = 4
 #: How far (in steps of the resolution) a new ray's boundary may lie from the chord of its
 #: neighbours and end the refinement there.
 _CHORD = 4.0
@@ -376,24 +378,27 @@ def exact_region(
     def search(e: np.ndarray, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: np.ndarray,
                out: np.ndarray) -> None:
         """Narrow each ray's bracket (``lo`` certified, ``hi`` not) to ``step``, side by side, one
-        batch per round; ``out`` keeps the nearest point proven unstable. Where both margins are
-        known, a round certifies two points a step apart about the secant's root (the margin is
-        close to linear near the boundary, so one round often ends the search); else, or when the
-        last round did not halve the bracket, the midpoint."""
-        slow = np.zeros(len(lo), dtype=bool)
+        batch per round; ``out`` keeps the nearest point proven unstable. A round certifies points
+        evenly spaced in each bracket (up to ``_SECTIONS - 1``, fewer once the widest bracket has
+        fewer steps) and, where both margins are known, two points a step apart about the
+        secant's root instead of two of them: the margin is close to linear near the boundary, so
+        the secant often ends the search at once, and where it misses, the even points cut the
+        bracket into many pieces (a batch costs far more than a twist in it)."""
         while len(open_ := np.flatnonzero(hi - lo > step)):
             a, b, fa, fb = lo[open_], hi[open_], f_lo[open_], f_hi[open_]
             width = b - a
             with np.errstate(divide="ignore", invalid="ignore"):
                 root = a + width * fa / (fa - fb)
-            secant = np.isfinite(root) & ~slow[open_] & (width > 2 * step)
-            x = np.where(secant, np.clip(root, a + step / 2, b - step / 2), (a + b) / 2)
-            pair = np.c_[np.where(secant, x - step / 2, x), np.where(secant, x + step / 2, x)]
-            new = bracket(e[open_], a, b, pair, (width <= 16 * step)[:, None])
+            secant = np.isfinite(root) & (width > 2 * step)
+            n = int(np.clip(np.ceil(np.max(width) / step), 1, _SECTIONS - 1))
+            even = a[:, None] + width[:, None] * (np.arange(1, n + 3) / (n + 3))
+            x = np.clip(root, a + step / 2, b - step / 2)[:, None]
+            guided = np.sort(np.c_[a[:, None] + width[:, None] * (np.arange(1, n + 1) / (n + 1)),
+                                   x - step / 2, x + step / 2], axis=1)
+            new = bracket(e[open_], a, b, np.where(secant[:, None], guided, even), (width <= 16 * step)[:, None])
             lo[open_], hi[open_], out[open_] = new[0], new[1], np.minimum(out[open_], new[4])
             f_lo[open_] = np.where(new[0] > a, new[2], fa)
             f_hi[open_] = np.where(new[1] < b, new[3], fb)
-            slow[open_] = new[1] - new[0] > width / 2
 
     # Per ray angle: [base, reach (certified), nearest point not certified, nearest proven unstable].
     found: dict[float, list[float]] = {}

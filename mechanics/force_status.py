@@ -43,7 +43,12 @@ from .cones import Cone
 from .support import SupportModel, unit_loads
 from .twist import cor_to_twist
 
-__all__ = ["Verdict", "force_possible", "force_status", "force_status_regions", "possible_or_not", "ray_twist"]
+#: Sample levels whose support LPs are solved in :func:`possible_or_not`; a finer level bounds the
+#: continuum with the multipliers of the level below (on five test parts, twists at the boundary
+#: certified that way were 0.9 of those certified with their own LP, and more one level finer).
+LP_LEVELS = 2
+
+__all__ = ["LP_LEVELS", "Verdict", "force_possible", "force_status", "force_status_regions", "possible_or_not", "ray_twist"]
 
 
 @dataclass(frozen=True)
@@ -72,27 +77,32 @@ def _tolerance(support: SupportModel) -> float:
     return 1e-9 * (1.0 + float(np.linalg.norm(support.cf)) + support.radius)
 
 
-def _sticking(twists: np.ndarray, cone: Cone, support: SupportModel,
-              level: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(certified, refuted, margin)`` per rotation of ``twists`` (``K, 3``) with the samples of
-    ``level``: every row's support value certified ``<= 0`` (P proven), or some sample
+def _sticking(twists: np.ndarray, cone: Cone, support: SupportModel, level: int,
+              lams: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(certified, refuted, margin, lams)`` per rotation of ``twists`` (``K, 3``) with the samples
+    of ``level``: every row's support value certified ``<= 0`` (P proven), or some sample
     distribution's load violating a row (P disproven); ``margin`` is the largest row's certified
-    bound (the largest sample value where refuted): ``<= 0`` exactly where certified."""
+    bound (the largest sample value where refuted): ``<= 0`` exactly where certified; ``lams`` the
+    multipliers of the certificate (``K, R, 2``). Given ``lams`` (a coarser level's), no LP is
+    solved: this level's cells bound the continuum for them (nothing is refuted)."""
     batch = support.batch(twists, level)
-    values, lams = batch.sample_support(-cone.rows)
-    margin = values.max(axis=1)
-    refuted = margin > _tolerance(support)
+    if lams is None:
+        values, lams = batch.sample_support(-cone.rows)
+        margin = values.max(axis=1)
+        refuted = margin > _tolerance(support)
+    else:
+        margin, refuted = np.full(len(twists), np.nan), np.zeros(len(twists), dtype=bool)
     certified = np.zeros(len(twists), dtype=bool)
     if not refuted.all():  # bounding the cells costs more than the LPs: only where it can help
         margin[~refuted] = batch[~refuted].upper_bound(-cone.rows, lams[~refuted]).max(axis=1)
         certified[~refuted] = margin[~refuted] <= 0
-    return certified, refuted, margin
+    return certified, refuted, margin, lams
 
 
 def _statuses_at(twists: np.ndarray, cone: Cone, support: SupportModel, level: int) -> list[set[str]]:
     """The statuses not ruled out for each rotation of ``twists`` (``K, 3``) with the samples of
     ``level``: the P proofs in one batch, then the I proofs of the others in another."""
-    certified, refuted, _ = _sticking(twists, cone, support, level)
+    certified, refuted, _, _ = _sticking(twists, cone, support, level)
     tol = _tolerance(support)
     value = np.full(len(twists), np.nan)
     impossible = np.zeros(len(twists), dtype=bool)
@@ -241,12 +251,17 @@ def possible_or_not(twists: ArrayLike, cone: Cone, support: SupportModel, refine
     margin = np.full(len(flat), np.nan)
     first = np.minimum(np.broadcast_to(np.asarray(start, dtype=int), v.shape[:-1]).ravel(), refinements)
     open_ = np.array([k for k, verdict in enumerate(known) if verdict is None], dtype=int)
+    lams = np.full((len(flat), len(cone.rows), 2), np.nan)
     for level in range(int(first.min(initial=refinements)), refinements + 1):
         ask = open_[first[open_] <= level]
-        if len(ask):
-            certified, refuted, margin[ask] = _sticking(flat[ask], cone, support, level)
-            proven[ask[certified]] = True
-            disproven[ask[refuted]] = True
+        # Above LP_LEVELS the multipliers of the level below are kept (they barely change, and the
+        # finer cells are what tightens the bound); twists that start there solve their LP.
+        kept = ask[~np.isnan(lams[ask, 0, 0])] if level > LP_LEVELS else ask[:0]
+        for part, given in ((np.setdiff1d(ask, kept), None), (kept, lams[kept])):
+            if len(part):
+                certified, refuted, margin[part], lams[part] = _sticking(flat[part], cone, support, level, given)
+                proven[part[certified]] = True
+                disproven[part[refuted]] = True
         open_ = open_[~proven[open_] & ~disproven[open_]]
     shape = v.shape[:-1]
     return proven.reshape(shape), disproven.reshape(shape), margin.reshape(shape)

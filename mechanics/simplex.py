@@ -13,7 +13,8 @@ __all__ = ["batched_simplex"]
 
 
 def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, basis: np.ndarray,
-                    limit: int = 100, restart: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                    limit: int = 100, restart: np.ndarray | None = None,
+                    restart_limit: int = 100) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Optimal duals of the LPs ``max costs[p] . s`` s.t. ``columns s = rhs``, ``s >= 0``, one per
     row of ``costs``, which LPs are unbounded, and the final bases.
 
@@ -32,7 +33,7 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
         Most pivots before the LPs still open go to HiGHS.
     restart : (P, m) int ndarray, optional
         Other feasible bases: an LP still open after ``limit`` pivots starts again from its own
-        (``limit`` more) before it goes to HiGHS. A warm start (``basis`` the optimum of a similar
+        (``restart_limit`` more) before it goes to HiGHS. A warm start (``basis`` the optimum of a similar
         LP) can lead into a degenerate vertex that the cold start avoids.
 
     Returns
@@ -100,7 +101,7 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
     open_, handed = _pivots(costs, columns, rhs, basis, duals, unbounded, tol, np.arange(problems), limit)
     if restart is not None and len(open_):
         basis[open_] = restart[open_]
-        open_, more = _pivots(costs, columns, rhs, basis, duals, unbounded, tol, open_, limit)
+        open_, more = _pivots(costs, columns, rhs, basis, duals, unbounded, tol, open_, restart_limit)
         handed += more
     basis[handed] = start[handed]
     if not len(open_) and not handed:

@@ -272,6 +272,7 @@ class SupportModel:
         self._lp: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._triangle: dict[int, np.ndarray] = {}
         self._warm: dict[tuple[int, bytes], tuple[np.ndarray, np.ndarray]] = {}
+        self._lift: dict[int, np.ndarray] = {}
 
     def __repr__(self) -> str:
         extra = f", cf_radius={self.cf_radius:g}" if self.cf_radius else ""
@@ -365,15 +366,38 @@ class SupportModel:
         """Starting bases (``K, R, m``) for the LPs of :meth:`LoadBatch.sample_support` at ``level``,
         directions ``ys`` (``R, 3``) and ``twists`` (``K, 3``): the optimal bases of the nearest
         twist (by direction, moments in units of :attr:`radius`) :meth:`remember` kept for these
-        directions, else :meth:`envelope_lp`'s start. Any basis of these LPs is feasible for all of
-        them (the constraints do not depend on the twist), and neighbouring twists' optima are a
-        pivot or two apart: a search along a ray pivots little."""
+        directions at this level or the one below (whose samples are among this level's), else
+        :meth:`envelope_lp`'s start. Any basis of these LPs is feasible for all of them (the
+        constraints do not depend on the twist), and neighbouring twists' optima are a pivot or
+        two apart: a search along a ray pivots little, and so does a twist refined a level."""
         start = self.envelope_lp(level)[2]
-        kept = self._warm.get((level, ys.tobytes()))
-        if kept is None:
-            return np.broadcast_to(start, (len(twists), len(ys), len(start)))
-        keys, bases = kept
-        return bases[np.argmax(self._twist_keys(twists) @ keys.T, axis=1)]
+        out = np.array(np.broadcast_to(start, (len(twists), len(ys), len(start))))
+        near = np.full(len(twists), -np.inf)
+        probe = self._twist_keys(twists)
+        for source in (level - 1, level):  # this level wins ties: its bases need no lifting
+            kept = self._warm.get((source, ys.tobytes()))
+            if kept is None:
+                continue
+            keys, bases = kept
+            closeness = probe @ keys.T
+            best = np.argmax(closeness, axis=1)
+            bases = bases[best] if source == level else self._lifted(level)[bases[best]]
+            take = (closeness[np.arange(len(twists)), best] >= near)[:, None] & np.all(bases >= 0, axis=2)
+            out = np.where(take[..., None], bases, out)
+            near = np.maximum(near, closeness[np.arange(len(twists)), best])
+        return out
+
+    def _lifted(self, level: int) -> np.ndarray:
+        """The column of ``level``'s LP (:meth:`envelope_lp`) of each column of the level below
+        (-1 if it has none: the grids nest, so a sample always has one, and so does a centre),
+        matched by coordinates to a billionth of :attr:`radius`."""
+        if level not in self._lift:
+            below, here = self.cells(level - 1).points, self.cells(level).points
+            at = {key: j for j, key in enumerate(map(tuple, np.round(here / (1e-9 * self.radius)).tolist()))}
+            match = np.array([at.get(key, -1) for key in map(tuple, np.round(below / (1e-9 * self.radius)).tolist())])
+            extra = self.envelope_lp(level)[0].shape[1] - len(here)  # the centre's columns, after the samples
+            self._lift[level] = np.r_[match, len(here) + np.arange(extra)]
+        return self._lift[level]
 
     def remember(self, level: int, ys: np.ndarray, twists: np.ndarray, bases: np.ndarray) -> None:
         """Keep the optimal ``bases`` (``K, R, m``) of ``twists`` for :meth:`warm_bases`, the last
