@@ -101,7 +101,7 @@ _REACH = 8.0
 #: to the end of the search: a bracket of the boundary before the secant search.
 _SPREAD = np.array([1 / 16, 1 / 8, 1 / 4, 1 / 2, 1.0])
 #: Most pieces a round of the search cuts a ray's bracket into.
-_SECTIONS = 4
+_SECTIONS = 8
 #: How far (in steps of the resolution) a new ray's boundary may lie from the chord of its
 #: neighbours and end the refinement there.
 _CHORD = 4.0
@@ -361,10 +361,14 @@ def exact_region(
                 near: np.ndarray | bool) -> tuple[np.ndarray, ...]:
         """Each ray's bracket from the points ``reach`` (``k, j``, increasing) along it, certified
         in one batch: ``(lo, hi, margin at lo, margin at hi, nearest proven unstable)``, ``lo`` the
-        last certified point before the first that is not (one crossing per ray is assumed)."""
+        last certified point before the first that is not (one crossing per ray is assumed).
+        Points not beyond ``base`` (certified already, or inside STABLE's region: a row's unused
+        places) are not certified again."""
         k, j = reach.shape
-        ok, no, margin = (v.reshape(k, j) for v in settled((centre + reach[..., None] * e[:, None]).reshape(-1, 2),
-                                                           np.broadcast_to(near, (k, j)).ravel()))
+        ok, no, margin = np.ones((k, j), dtype=bool), np.zeros((k, j), dtype=bool), np.full((k, j), np.nan)
+        new = reach > base[:, None]
+        ok[new], no[new], margin[new] = settled((centre + reach[..., None] * e[:, None])[new],
+                                                np.broadcast_to(near, (k, j))[new])
         first = np.where(ok.all(axis=1), j, np.argmin(ok, axis=1))
         rows = np.arange(k)
         below, above = np.maximum(first - 1, 0), np.minimum(first, j - 1)
@@ -379,23 +383,25 @@ def exact_region(
                out: np.ndarray) -> None:
         """Narrow each ray's bracket (``lo`` certified, ``hi`` not) to ``step``, side by side, one
         batch per round; ``out`` keeps the nearest point proven unstable. A round certifies points
-        evenly spaced in each bracket (up to ``_SECTIONS - 1``, fewer once the widest bracket has
-        fewer steps) and, where both margins are known, two points a step apart about the
-        secant's root instead of two of them: the margin is close to linear near the boundary, so
-        the secant often ends the search at once, and where it misses, the even points cut the
-        bracket into many pieces (a batch costs far more than a twist in it)."""
+        evenly spaced in each bracket (as many as it has steps, up to ``_SECTIONS - 1``) and,
+        where both margins are known, two points a step apart about the secant's root: the margin
+        is close to linear near the boundary, so the secant often ends the search at once, and
+        where it misses, the even points cut the bracket into many pieces (a batch costs far more
+        than a twist in it)."""
         while len(open_ := np.flatnonzero(hi - lo > step)):
             a, b, fa, fb = lo[open_], hi[open_], f_lo[open_], f_hi[open_]
             width = b - a
             with np.errstate(divide="ignore", invalid="ignore"):
                 root = a + width * fa / (fa - fb)
             secant = np.isfinite(root) & (width > 2 * step)
-            n = int(np.clip(np.ceil(np.max(width) / step), 1, _SECTIONS - 1))
-            even = a[:, None] + width[:, None] * (np.arange(1, n + 3) / (n + 3))
+            count = np.clip(np.ceil(width / step).astype(int) - 1, 1, _SECTIONS - 1)
+            places = np.arange(1, count.max() + 1)
+            # A row's unused places repeat its certified end, which bracket() skips.
+            even = np.where(places <= count[:, None], a[:, None] + width[:, None] * places / (count[:, None] + 1),
+                            a[:, None])
             x = np.clip(root, a + step / 2, b - step / 2)[:, None]
-            guided = np.sort(np.c_[a[:, None] + width[:, None] * (np.arange(1, n + 1) / (n + 1)),
-                                   x - step / 2, x + step / 2], axis=1)
-            new = bracket(e[open_], a, b, np.where(secant[:, None], guided, even), (width <= 16 * step)[:, None])
+            pair = np.where(secant[:, None], np.c_[x - step / 2, x + step / 2], a[:, None])
+            new = bracket(e[open_], a, b, np.sort(np.c_[even, pair], axis=1), (width <= 16 * step)[:, None])
             lo[open_], hi[open_], out[open_] = new[0], new[1], np.minimum(out[open_], new[4])
             f_lo[open_] = np.where(new[0] > a, new[2], fa)
             f_hi[open_] = np.where(new[1] < b, new[3], fb)

@@ -77,32 +77,38 @@ def _tolerance(support: SupportModel) -> float:
     return 1e-9 * (1.0 + float(np.linalg.norm(support.cf)) + support.radius)
 
 
-def _sticking(twists: np.ndarray, cone: Cone, support: SupportModel, level: int,
-              lams: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``(certified, refuted, margin, lams)`` per rotation of ``twists`` (``K, 3``) with the samples
-    of ``level``: every row's support value certified ``<= 0`` (P proven), or some sample
+def _sticking(twists: np.ndarray, cone: Cone, support: SupportModel, level: int, lams: np.ndarray | None = None,
+              coarse: np.ndarray | None = None) -> tuple[np.ndarray, ...]:
+    """``(certified, refuted, margin, lams, cells)`` per rotation of ``twists`` (``K, 3``) with the
+    samples of ``level``: every row's support value certified ``<= 0`` (P proven), or some sample
     distribution's load violating a row (P disproven); ``margin`` is the largest row's certified
     bound (the largest sample value where refuted): ``<= 0`` exactly where certified; ``lams`` the
-    multipliers of the certificate (``K, R, 2``). Given ``lams`` (a coarser level's), no LP is
-    solved: this level's cells bound the continuum for them (nothing is refuted)."""
+    multipliers of the certificate (``K, R, 2``), ``cells`` its bounds per cell (``K, R, C``; NaN
+    where refuted). Given ``lams`` (the level below's, with its ``coarse`` cell bounds if known) no
+    LP is solved and nothing is refuted: this level's cells refine the level below's where its
+    bound could be positive (:meth:`~.support.LoadBatch.refined_bound`; ``cells`` is then NaN)."""
     batch = support.batch(twists, level)
-    if lams is None:
-        values, lams = batch.sample_support(-cone.rows)
-        margin = values.max(axis=1)
-        refuted = margin > _tolerance(support)
-    else:
-        margin, refuted = np.full(len(twists), np.nan), np.zeros(len(twists), dtype=bool)
+    rows = -cone.rows
+    if lams is not None:
+        margin = batch.refined_bound(rows, lams, coarse).max(axis=1)
+        return margin <= 0, np.zeros(len(twists), dtype=bool), margin, lams, None
+    values, lams = batch.sample_support(rows)
+    margin = values.max(axis=1)
+    refuted = margin > _tolerance(support)
     certified = np.zeros(len(twists), dtype=bool)
+    cells = np.full((len(twists), len(rows), len(batch.cells.cells)), np.nan)
     if not refuted.all():  # bounding the cells costs more than the LPs: only where it can help
-        margin[~refuted] = batch[~refuted].upper_bound(-cone.rows, lams[~refuted]).max(axis=1)
+        cells[~refuted] = batch[~refuted].cell_bounds(rows, lams[~refuted])[0]
+        margin[~refuted] = (cells[~refuted].max(axis=-1)
+                            + support.cf_radius * np.linalg.norm(lams[~refuted], axis=-1)).max(axis=1)
         certified[~refuted] = margin[~refuted] <= 0
-    return certified, refuted, margin, lams
+    return certified, refuted, margin, lams, cells
 
 
 def _statuses_at(twists: np.ndarray, cone: Cone, support: SupportModel, level: int) -> list[set[str]]:
     """The statuses not ruled out for each rotation of ``twists`` (``K, 3``) with the samples of
     ``level``: the P proofs in one batch, then the I proofs of the others in another."""
-    certified, refuted, _, _ = _sticking(twists, cone, support, level)
+    certified, refuted, *_ = _sticking(twists, cone, support, level)
     tol = _tolerance(support)
     value = np.full(len(twists), np.nan)
     impossible = np.zeros(len(twists), dtype=bool)
@@ -252,16 +258,24 @@ def possible_or_not(twists: ArrayLike, cone: Cone, support: SupportModel, refine
     first = np.minimum(np.broadcast_to(np.asarray(start, dtype=int), v.shape[:-1]).ravel(), refinements)
     open_ = np.array([k for k, verdict in enumerate(known) if verdict is None], dtype=int)
     lams = np.full((len(flat), len(cone.rows), 2), np.nan)
+    cells: dict[int, np.ndarray] = {}  # the cell bounds of the level below, by twist
     for level in range(int(first.min(initial=refinements)), refinements + 1):
         ask = open_[first[open_] <= level]
         # Above LP_LEVELS the multipliers of the level below are kept (they barely change, and the
         # finer cells are what tightens the bound); twists that start there solve their LP.
-        kept = ask[~np.isnan(lams[ask, 0, 0])] if level > LP_LEVELS else ask[:0]
-        for part, given in ((np.setdiff1d(ask, kept), None), (kept, lams[kept])):
+        keep = ~np.isnan(lams[ask, 0, 0]) & (level > LP_LEVELS)
+        kept, solved = ask[keep], ask[~keep]
+        known = all(k in cells for k in kept.tolist())
+        below = np.array([cells[k] for k in kept.tolist()]) if known and len(kept) else None
+        cells = {}
+        for part, given, coarse in ((solved, None, None), (kept, lams[kept], below)):
             if len(part):
-                certified, refuted, margin[part], lams[part] = _sticking(flat[part], cone, support, level, given)
+                certified, refuted, margin[part], lams[part], bounds = _sticking(flat[part], cone, support, level,
+                                                                                 given, coarse)
                 proven[part[certified]] = True
                 disproven[part[refuted]] = True
+                if bounds is not None:
+                    cells.update(zip(part.tolist(), bounds))
         open_ = open_[~proven[open_] & ~disproven[open_]]
     shape = v.shape[:-1]
     return proven.reshape(shape), disproven.reshape(shape), margin.reshape(shape)

@@ -273,6 +273,7 @@ class SupportModel:
         self._triangle: dict[int, np.ndarray] = {}
         self._warm: dict[tuple[int, bytes], tuple[np.ndarray, np.ndarray]] = {}
         self._lift: dict[int, np.ndarray] = {}
+        self._parents: dict[int, np.ndarray] = {}
 
     def __repr__(self) -> str:
         extra = f", cf_radius={self.cf_radius:g}" if self.cf_radius else ""
@@ -415,6 +416,22 @@ class SupportModel:
         scaled = twists * np.array([1.0, 1.0, self.radius])
         return scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
 
+    def parents(self, level: int) -> np.ndarray | None:
+        """For each cell of ``level``, the cell of the level below holding it (-1 if none is
+        found), or ``None`` for the disk (its cells do not nest). The footprint's cells are a grid
+        of squares through the CF clipped to the part, the side halving with each level: a cell's
+        anchor (inside its square) names its square, and the square's parent halves its index."""
+        if self.kind != "footprint" or level < 1:
+            return None
+        if level not in self._parents:
+            def squares(at: int) -> np.ndarray:
+                h = self.radius / (self.resolution * 2**at)
+                return np.floor((self.cells(at).anchors - self.cf) / h).astype(int)
+
+            above = {key: c for c, key in enumerate(map(tuple, squares(level - 1).tolist()))}
+            self._parents[level] = np.array([above.get(key, -1) for key in map(tuple, (squares(level) // 2).tolist())])
+        return self._parents[level]
+
     def cf_triangle(self, level: int = 0) -> np.ndarray:
         """Indices of three samples of ``level`` whose triangle holds the CF as deep inside as can be
         (a feasible start for the LPs over distributions centred at the CF; cached)."""
@@ -546,10 +563,12 @@ class LoadBatch:
         hold the COR ``c`` (``K, C``), and (for those) ``psi``'s envelope ``E`` at ``c`` and its slope
         ``k`` away from it (``K, R``): ``psi <= E + k |x - c|``. A translation has no COR (``E = -inf``).
 
-        A cell's bound is tightened (its exact geometry seen from ``c``) only where it could be the
-        largest or decide a sign: a cell whose cheap bound (second order, with its distance from
-        ``c`` bounded below by its anchor's distance less its reach) lies below both the largest
-        vertex value and 0 keeps that bound, which changes neither the maximum nor any sign.
+        A cell's bound is tightened (its exact geometry seen from ``c``) only where it could decide
+        a sign: a cell whose cheap bound (second order, with its distance from ``c`` bounded below
+        by its anchor's distance less its reach) lies below 0 (less the uncertain CF's term
+        ``cf_radius |lam|`` of :meth:`upper_bound`) keeps that bound. The largest bound is then
+        looser where it is negative, but no sign changes (half the time of tightening every cell
+        that could be the largest, at the sample levels the exact regions use).
         """
         ys, cells = self._directions(ys), self.cells
         lams = np.broadcast_to(np.asarray(lams, dtype=float), (*ys.shape[:2], 2))
@@ -571,7 +590,7 @@ class LoadBatch:
         with np.errstate(divide="ignore", invalid="ignore"):
             curvature = 1.5 * u[..., None] / near[:, None] ** 2 + np.maximum(0.0, -radial)[..., None] / near[:, None]
             cheap = np.where(near[:, None] > 0, vertex_max + curvature / 2 * cells.reach**2, np.inf)
-        floor = np.minimum(vertex_max.max(axis=-1), 0.0)[..., None]
+        floor = -self.model.cf_radius * np.linalg.norm(lams, axis=-1)[..., None]
         k, c = np.nonzero(rotation[:, None] & np.any(cheap >= floor, axis=1))
         bounds = np.where(rotation[:, None, None], cheap, vertex_max)
         envelope = u + np.einsum("krj,kj->kr", lams, self.cor - self.cf)
@@ -610,6 +629,45 @@ class LoadBatch:
         """
         bounds, *_ = self.cell_bounds(ys, lams)
         return bounds.max(axis=-1) + self.model.cf_radius * np.linalg.norm(lams, axis=-1)
+
+    def refined_bound(self, ys: ArrayLike, lams: ArrayLike, coarse: np.ndarray | None = None) -> np.ndarray:
+        """:meth:`upper_bound` with this level's cells only where they can help: the cells of the
+        level below bound ``psi``, and those whose bound could be positive (for any twist and
+        direction of the batch: the uncertain CF's term aside) are replaced by this level's cells
+        inside them, which cover their part of the region (the footprint's grids nest). The same
+        signs as :meth:`upper_bound` where it matters, at a fraction of the cells; a disk's polar
+        cells do not nest and are all bounded. ``coarse``: the level below's :meth:`cell_bounds`
+        for the same ``ys`` and ``lams``, if known.
+
+        >>> from mechanics import cor_to_twist
+        >>> block = SupportModel.footprint([[-1, 0], [1, 0], [1, 1], [-1, 1]], [0.0, 0.5])
+        >>> batch = block.batch(cor_to_twist([[-3.0, 0.5], [-1.2, 0.2]], 1), level=2)
+        >>> ys = [[0.0, 0.0, 1.0], [0.3, -1.0, 0.2]]
+        >>> lams = block.batch(batch.twists, level=1).sample_support(ys)[1]
+        >>> full, refined = batch.upper_bound(ys, lams), batch.refined_bound(ys, lams)
+        >>> bool(np.all(refined >= full - 1e-12) and np.array_equal(refined > 0, full > 0))
+        True
+        """
+        parents = self.model.parents(self.level)
+        if parents is None:
+            return self.upper_bound(ys, lams)
+        if coarse is None:
+            below = copy.copy(self)
+            below.level, below.cells = self.level - 1, self.model.cells(self.level - 1)
+            coarse, *_ = below.cell_bounds(ys, lams)
+        lams = np.broadcast_to(np.asarray(lams, dtype=float), (*coarse.shape[:2], 2))
+        centre = self.model.cf_radius * np.linalg.norm(lams, axis=-1)
+        hot = np.any(coarse + centre[..., None] > 0, axis=(0, 1))
+        fine = np.flatnonzero((parents < 0) | hot[parents])
+        best = np.where(hot, -np.inf, coarse).max(axis=-1)
+        if len(fine):
+            part = copy.copy(self)
+            cells = self.cells
+            used, corners = np.unique(cells.cells[fine], return_inverse=True)  # bound at their own nodes only
+            part.cells = SupportCells(cells.points, cells.nodes[used], corners.reshape(len(fine), -1),
+                                      cells.anchors[fine], cells.reach[fine])
+            best = np.maximum(best, part.cell_bounds(ys, lams)[0].max(axis=-1))
+        return best + centre
 
     def is_negative(self, ys: ArrayLike, lams: ArrayLike, tol: float = 0.0) -> np.ndarray:
         """Whether ``y . L < 0`` is guaranteed for every admissible distribution, one direction
