@@ -14,10 +14,12 @@ Construction, in the push plane (:mod:`.push_plane`), where the set is a bounded
    no stable push at all (Proposition 6).
 2. ``rays`` even rays from ``C``; along each, the boundary is bracketed by certifying a few points
    between ``S``'s boundary and the edge of Theorem 4's strip (or a distance far beyond any stable
-   push) in one batch, then narrowed to ``resolution`` by a bracketed secant search on the
-   certificate's margin (:func:`~.force_status.possible_or_not`): two points a step apart about
-   the root, which usually ends the search at once (bisection where the margin is unknown or the
-   secant does not halve the bracket). Each vertex is the last certified point: no safety margin.
+   push) in one batch, then narrowed to ``resolution`` by a bracketed search on the certificate's
+   margin (:func:`~.force_status.possible_or_not`): each round certifies points evenly spaced in
+   the bracket (up to ``_SECTIONS - 1``) and two points a step apart about the secant's root,
+   which usually ends the search at once; a round costs far more than a point in it, so a few
+   rounds of several points beat many rounds of two. Each vertex is the last certified point: no
+   safety margin.
 3. Adaptively, where the boundary turns or thins: every interval between neighbouring rays gets
    a ray in its middle, searched outwards from the chord of its neighbours; a boundary within
    ``_CHORD`` steps of the chord ends the refinement there, else both halves are refined again
@@ -33,7 +35,10 @@ Construction, in the push plane (:mod:`.push_plane`), where the set is a bounded
 The certificate is refined only near the boundary: each twist starts at the coarsest support
 grid and goes to the next ``refinements`` levels only while neither certified nor refuted, and a
 twist known to lie near the boundary (a new ray's points next to the chord, the checks, the last
-steps of a search) skips the coarsest level, which leaves such twists open.
+steps of a search) skips the coarsest level, which leaves such twists open. Above level 2 no LP
+is solved: the level-2 multipliers are kept and only the level-2 cells whose bound could be
+positive are split (:data:`~.force_status.LP_LEVELS`, :meth:`~.support.LoadBatch.refined_bound`),
+so level 3 costs a fraction of level 2.
 
 **Gap bound.** Along each ray the true boundary lies between the vertex (certified) and the
 nearest point proven unstable (a sample distribution's load leaves the cone, or Theorem 4's strip
@@ -101,7 +106,7 @@ _REACH = 8.0
 #: to the end of the search: a bracket of the boundary before the secant search.
 _SPREAD = np.array([1 / 16, 1 / 8, 1 / 4, 1 / 2, 1.0])
 #: Most pieces a round of the search cuts a ray's bracket into.
-_SECTIONS = 8
+_SECTIONS = 4
 #: How far (in steps of the resolution) a new ray's boundary may lie from the chord of its
 #: neighbours and end the refinement there.
 _CHORD = 4.0
@@ -227,8 +232,8 @@ def exact_region(
     width: float | None = None,
     cf_radius: float = 0.0,
     rays: int = 16,
-    resolution: float = 0.004,
-    refinements: int = 2,
+    resolution: float = 0.002,
+    refinements: int = 3,
     checks: int = 1,
     depth: int = 2,
     deadline: float | None = None,
@@ -260,9 +265,9 @@ def exact_region(
     depth : int
         How many times an interval between rays may be halved where the boundary needs it (also
         for an edge whose checks fail): the finest spacing is ``2**-depth`` of the first, and half
-        that next to a corner. On five test geometries depth 2 covers 0.986 to 0.992 of an
-        independent oracle's stable twists (``resolution=0.002, depth=4``: 0.990 to 0.995, in
-        about twice the time).
+        that next to a corner. On ten test geometries (two each of a triangle, a hexagon, an
+        off-centre-CF rectangle pushed by part of a face, an L, a trapezoid) the defaults cover
+        0.991 to 0.996 of an independent LP oracle's stable twists.
     deadline : float, optional
         A :func:`time.perf_counter` time; past it the construction stops with
         :class:`DeadlineExceeded` (checked before each batch of certifications).
