@@ -43,13 +43,14 @@ from .cones import Cone
 from .support import SupportModel, unit_loads
 from .twist import cor_to_twist
 
+__all__ = ["LP_LEVELS", "Verdict", "force_possible", "force_status", "force_status_regions", "possible_or_not",
+           "ray_twist"]
+
 #: Sample levels whose support LPs are solved in :func:`possible_or_not`; a finer level bounds the
 #: continuum with the last multipliers solved for: the finer cells are what tightens the bound (on
 #: four test parts, of 218 twists on a traced boundary that level 3 certified with its own LP, 201
 #: were certified with level 2's multipliers; level 4's cells with them certified 214).
 LP_LEVELS = 2
-
-__all__ = ["LP_LEVELS", "Verdict", "force_possible", "force_status", "force_status_regions", "possible_or_not", "ray_twist"]
 
 
 @dataclass(frozen=True)
