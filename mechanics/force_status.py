@@ -89,11 +89,11 @@ def _sticking(twists: np.ndarray, cone: Cone, support: SupportModel, level: int,
     where refuted). Given ``lams`` (the level below's, with its ``coarse`` cell bounds if known) no
     LP is solved and nothing is refuted: this level's cells refine the level below's where its
     bound could be positive (:meth:`~.support.LoadBatch.refined_bound`; ``cells`` is then NaN)."""
-    batch = support.batch(twists, level)
     rows = -cone.rows
-    if lams is not None:
-        margin = batch.refined_bound(rows, lams, coarse).max(axis=1)
+    if lams is not None:  # the cells of the level below, split where they could decide
+        margin = support.batch(twists, level - 1).refined_bound(rows, lams, coarse).max(axis=1)
         return margin <= 0, np.zeros(len(twists), dtype=bool), margin, lams, None
+    batch = support.batch(twists, level)
     values, lams = batch.sample_support(rows)
     margin = values.max(axis=1)
     refuted = margin > _tolerance(support)

@@ -220,12 +220,18 @@ def _disk_cells(cf: np.ndarray, radius: float, n: int) -> list[np.ndarray]:
     return out
 
 
-def _footprint_cells(polygon: shapely.Polygon, cf: np.ndarray, h: float) -> list[np.ndarray]:
-    """Squares of side ``h`` (grid through the CF) clipped to the polygon, as convex hulls."""
-    x0, y0, x1, y1 = polygon.bounds
-    i = np.arange(np.floor((x0 - cf[0]) / h), np.ceil((x1 - cf[0]) / h))
-    j = np.arange(np.floor((y0 - cf[1]) / h), np.ceil((y1 - cf[1]) / h))
-    ii, jj = (a.ravel() for a in np.meshgrid(i, j))
+def _footprint_cells(polygon: shapely.Polygon, cf: np.ndarray, h: float,
+                     squares: np.ndarray | None = None) -> list[np.ndarray]:
+    """Squares of side ``h`` (grid through the CF) clipped to the polygon, as convex hulls: all
+    those over the polygon, or the ``squares`` given by their indices ``(i, j)`` (``n, 2``; square
+    ``(i, j)`` has its lower left corner at ``cf + (i, j) h``)."""
+    if squares is None:
+        x0, y0, x1, y1 = polygon.bounds
+        i = np.arange(np.floor((x0 - cf[0]) / h), np.ceil((x1 - cf[0]) / h))
+        j = np.arange(np.floor((y0 - cf[1]) / h), np.ceil((y1 - cf[1]) / h))
+        ii, jj = (a.ravel() for a in np.meshgrid(i, j))
+    else:
+        ii, jj = np.asarray(squares, dtype=float).T
     boxes = shapely.box(cf[0] + ii * h, cf[1] + jj * h, cf[0] + (ii + 1) * h, cf[1] + (jj + 1) * h)
     shapely.prepare(polygon)
     inside = shapely.contains_properly(polygon, boxes)  # whole squares: nothing to clip
@@ -273,7 +279,6 @@ class SupportModel:
         self._triangle: dict[int, np.ndarray] = {}
         self._warm: dict[tuple[int, bytes], tuple[np.ndarray, np.ndarray]] = {}
         self._lift: dict[int, np.ndarray] = {}
-        self._parents: dict[int, np.ndarray] = {}
 
     def __repr__(self) -> str:
         extra = f", cf_radius={self.cf_radius:g}" if self.cf_radius else ""
@@ -416,21 +421,18 @@ class SupportModel:
         scaled = twists * np.array([1.0, 1.0, self.radius])
         return scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
 
-    def parents(self, level: int) -> np.ndarray | None:
-        """For each cell of ``level``, the cell of the level below holding it (-1 if none is
-        found), or ``None`` for the disk (its cells do not nest). The footprint's cells are a grid
-        of squares through the CF clipped to the part, the side halving with each level: a cell's
-        anchor (inside its square) names its square, and the square's parent halves its index."""
+    def children(self, level: int, parents: ArrayLike) -> SupportCells:
+        """The cells of ``level`` inside the given cells of the level below (footprint only), built
+        for them alone. The footprint's cells are a grid of squares through the CF clipped to the
+        part, the side halving with each level: a cell's anchor (inside its square) names its
+        square, whose four quarters are the next level's squares; clipped to the part they cover
+        its piece of it."""
         if self.kind != "footprint" or level < 1:
-            return None
-        if level not in self._parents:
-            def squares(at: int) -> np.ndarray:
-                h = self.radius / (self.resolution * 2**at)
-                return np.floor((self.cells(at).anchors - self.cf) / h).astype(int)
-
-            above = {key: c for c, key in enumerate(map(tuple, squares(level - 1).tolist()))}
-            self._parents[level] = np.array([above.get(key, -1) for key in map(tuple, (squares(level) // 2).tolist())])
-        return self._parents[level]
+            raise ValueError("only a footprint's cells of level 1 and above have parents")
+        h = self.radius / (self.resolution * 2**level)
+        squares = np.floor((self.cells(level - 1).anchors[np.asarray(parents, dtype=int)] - self.cf) / (2 * h))
+        quarters = (2 * squares[:, None] + np.array([[0, 0], [1, 0], [0, 1], [1, 1]])[None]).reshape(-1, 2)
+        return SupportCells.from_polygons(_footprint_cells(self.polygon, self.cf, h, quarters), self.covers)
 
     def cf_triangle(self, level: int = 0) -> np.ndarray:
         """Indices of three samples of ``level`` whose triangle holds the CF as deep inside as can be
@@ -631,42 +633,38 @@ class LoadBatch:
         return bounds.max(axis=-1) + self.model.cf_radius * np.linalg.norm(lams, axis=-1)
 
     def refined_bound(self, ys: ArrayLike, lams: ArrayLike, coarse: np.ndarray | None = None) -> np.ndarray:
-        """:meth:`upper_bound` with this level's cells only where they can help: the cells of the
-        level below bound ``psi``, and those whose bound could be positive (for any twist and
-        direction of the batch: the uncertain CF's term aside) are replaced by this level's cells
-        inside them, which cover their part of the region (the footprint's grids nest). The same
-        signs as :meth:`upper_bound` where it matters, at a fraction of the cells; a disk's polar
-        cells do not nest and are all bounded. ``coarse``: the level below's :meth:`cell_bounds`
-        for the same ``ys`` and ``lams``, if known.
+        """:meth:`upper_bound` one level finer than the batch's, with the finer cells only where
+        they can help: this level's cells bound ``psi``, and those whose bound could be positive
+        (for any twist and direction of the batch: the uncertain CF's term aside) are replaced by
+        the next level's cells inside them (:meth:`SupportModel.children`), built for them alone.
+        The same signs as the finer level's :meth:`upper_bound` where it matters, at a fraction
+        of the cells; a disk's polar cells do not nest, and the next level's are all bounded.
+        ``coarse``: this level's :meth:`cell_bounds` for the same ``ys`` and ``lams``, if known.
 
         >>> from mechanics import cor_to_twist
         >>> block = SupportModel.footprint([[-1, 0], [1, 0], [1, 1], [-1, 1]], [0.0, 0.5])
-        >>> batch = block.batch(cor_to_twist([[-3.0, 0.5], [-1.2, 0.2]], 1), level=2)
+        >>> twists = cor_to_twist([[-3.0, 0.5], [-1.2, 0.2]], 1)
         >>> ys = [[0.0, 0.0, 1.0], [0.3, -1.0, 0.2]]
-        >>> lams = block.batch(batch.twists, level=1).sample_support(ys)[1]
-        >>> full, refined = batch.upper_bound(ys, lams), batch.refined_bound(ys, lams)
+        >>> coarse = block.batch(twists, level=1)
+        >>> lams = coarse.sample_support(ys)[1]
+        >>> full, refined = block.batch(twists, level=2).upper_bound(ys, lams), coarse.refined_bound(ys, lams)
         >>> bool(np.all(refined >= full - 1e-12) and np.array_equal(refined > 0, full > 0))
         True
         """
-        parents = self.model.parents(self.level)
-        if parents is None:
-            return self.upper_bound(ys, lams)
+        finer = copy.copy(self)
+        finer.level = self.level + 1
+        if self.model.kind != "footprint":
+            finer.cells = self.model.cells(finer.level)
+            return finer.upper_bound(ys, lams)
         if coarse is None:
-            below = copy.copy(self)
-            below.level, below.cells = self.level - 1, self.model.cells(self.level - 1)
-            coarse, *_ = below.cell_bounds(ys, lams)
+            coarse, *_ = self.cell_bounds(ys, lams)
         lams = np.broadcast_to(np.asarray(lams, dtype=float), (*coarse.shape[:2], 2))
         centre = self.model.cf_radius * np.linalg.norm(lams, axis=-1)
-        hot = np.any(coarse + centre[..., None] > 0, axis=(0, 1))
-        fine = np.flatnonzero((parents < 0) | hot[parents])
-        best = np.where(hot, -np.inf, coarse).max(axis=-1)
-        if len(fine):
-            part = copy.copy(self)
-            cells = self.cells
-            used, corners = np.unique(cells.cells[fine], return_inverse=True)  # bound at their own nodes only
-            part.cells = SupportCells(cells.points, cells.nodes[used], corners.reshape(len(fine), -1),
-                                      cells.anchors[fine], cells.reach[fine])
-            best = np.maximum(best, part.cell_bounds(ys, lams)[0].max(axis=-1))
+        hot = np.flatnonzero(np.any(coarse + centre[..., None] > 0, axis=(0, 1)))
+        best = np.delete(coarse, hot, axis=-1).max(axis=-1, initial=-np.inf)
+        if len(hot):
+            finer.cells = self.model.children(finer.level, hot)
+            best = np.maximum(best, finer.cell_bounds(ys, lams)[0].max(axis=-1, initial=-np.inf))
         return best + centre
 
     def is_negative(self, ys: ArrayLike, lams: ArrayLike, tol: float = 0.0) -> np.ndarray:
