@@ -637,10 +637,11 @@ class LoadBatch:
         they can help: this level's cells bound ``psi``, and those whose bound could be positive
         (for any twist and direction of the batch: the uncertain CF's term aside) are replaced by
         the next level's cells inside them (:meth:`SupportModel.children`), built for them alone.
-        Every piece of the region is still bounded by a cell holding it, so the bound is valid;
-        it is as tight as the finer level's :meth:`upper_bound` wherever that is positive (where a
-        coarse cell's bound is below a fine one's inside it, it is not tightened), at a fraction
-        of the cells. A disk's polar cells do not nest, and the next level's are all bounded.
+        Every piece of the region is still bounded by a cell holding it, so the bound is valid; a
+        cell whose bound is already negative is not split, so the sign is the finer level's
+        wherever a cell bounds ``psi`` no lower than its quarters do (the usual case: the bounds
+        loosen with a cell's size), at a fraction of the cells. A disk's polar cells do not nest,
+        and the next level's are all bounded.
         ``coarse``: this level's :meth:`cell_bounds` for the same ``ys`` and ``lams``, if known.
 
         >>> from mechanics import cor_to_twist
