@@ -267,8 +267,8 @@ def possible_or_not(twists: ArrayLike, cone: Cone, support: SupportModel, refine
         # finer cells are what tightens the bound); twists that start there solve their LP.
         keep = ~np.isnan(lams[ask, 0, 0]) & (level > LP_LEVELS)
         kept, solved = ask[keep], ask[~keep]
-        known = all(k in cells for k in kept.tolist())
-        below = np.array([cells[k] for k in kept.tolist()]) if known and len(kept) else None
+        have = len(kept) and all(k in cells for k in kept.tolist())
+        below = np.array([cells[k] for k in kept.tolist()]) if have else None
         cells = {}
         for part, given, coarse in ((solved, None, None), (kept, lams[kept], below)):
             if len(part):

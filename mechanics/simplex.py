@@ -33,8 +33,8 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
         Most pivots before the LPs still open go to HiGHS.
     restart : (P, m) int ndarray, optional
         Other feasible bases: an LP still open after ``limit`` pivots starts again from its own
-        (``restart_limit`` more) before it goes to HiGHS. A warm start (``basis`` the optimum of a similar
-        LP) can lead into a degenerate vertex that the cold start avoids.
+        (``restart_limit`` more pivots) before it goes to HiGHS. A warm start (``basis`` the
+        optimum of a similar LP) can lead into a degenerate vertex that the cold start avoids.
 
     Returns
     -------
