@@ -265,9 +265,9 @@ def exact_region(
     depth : int
         How many times an interval between rays may be halved where the boundary needs it (also
         for an edge whose checks fail): the finest spacing is ``2**-depth`` of the first, and half
-        that next to a corner. On ten test geometries (two each of a triangle, a hexagon, an
+        that next to a corner. On fifteen test geometries (three each of a triangle, a hexagon, an
         off-centre-CF rectangle pushed by part of a face, an L, a trapezoid) the defaults cover
-        0.991 to 0.996 of an independent LP oracle's stable twists.
+        0.991 to 0.998 of an independent LP oracle's stable twists (docs/mechanics.md).
     deadline : float, optional
         A :func:`time.perf_counter` time; past it the construction stops with
         :class:`DeadlineExceeded` (checked before each batch of certifications).
