@@ -14,10 +14,12 @@ Construction, in the push plane (:mod:`.push_plane`), where the set is a bounded
    no stable push at all (Proposition 6).
 2. ``rays`` even rays from ``C``; along each, the boundary is bracketed by certifying a few points
    between ``S``'s boundary and the edge of Theorem 4's strip (or a distance far beyond any stable
-   push) in one batch, then narrowed to ``resolution`` by a bracketed secant search on the
-   certificate's margin (:func:`~.force_status.possible_or_not`): two points a step apart about
-   the root, which usually ends the search at once (bisection where the margin is unknown or the
-   secant does not halve the bracket). Each vertex is the last certified point: no safety margin.
+   push) in one batch, then narrowed to ``resolution`` by a bracketed search on the certificate's
+   margin (:func:`~.force_status.possible_or_not`): each round certifies points evenly spaced in
+   the bracket (up to ``_SECTIONS - 1``) and two points a step apart about the secant's root,
+   which usually ends the search at once; a round costs far more than a point in it, so a few
+   rounds of several points beat many rounds of two. Each vertex is the last certified point: no
+   safety margin.
 3. Adaptively, where the boundary turns or thins: every interval between neighbouring rays gets
    a ray in its middle, searched outwards from the chord of its neighbours; a boundary within
    ``_CHORD`` steps of the chord ends the refinement there, else both halves are refined again
@@ -33,7 +35,10 @@ Construction, in the push plane (:mod:`.push_plane`), where the set is a bounded
 The certificate is refined only near the boundary: each twist starts at the coarsest support
 grid and goes to the next ``refinements`` levels only while neither certified nor refuted, and a
 twist known to lie near the boundary (a new ray's points next to the chord, the checks, the last
-steps of a search) skips the coarsest level, which leaves such twists open.
+steps of a search) skips the coarsest level, which leaves such twists open. Above level 2 no LP
+is solved: the level-2 multipliers are kept and only the level-2 cells whose bound could be
+positive are split (:data:`~.force_status.LP_LEVELS`, :meth:`~.support.LoadBatch.refined_bound`),
+so level 3 costs a fraction of level 2.
 
 **Gap bound.** Along each ray the true boundary lies between the vertex (certified) and the
 nearest point proven unstable (a sample distribution's load leaves the cone, or Theorem 4's strip
@@ -100,6 +105,8 @@ _REACH = 8.0
 #: Where the first rays are certified in one batch, as fractions of the way from STABLE's boundary
 #: to the end of the search: a bracket of the boundary before the secant search.
 _SPREAD = np.array([1 / 16, 1 / 8, 1 / 4, 1 / 2, 1.0])
+#: Most pieces a round of the search cuts a ray's bracket into.
+_SECTIONS = 4
 #: How far (in steps of the resolution) a new ray's boundary may lie from the chord of its
 #: neighbours and end the refinement there.
 _CHORD = 4.0
@@ -225,8 +232,8 @@ def exact_region(
     width: float | None = None,
     cf_radius: float = 0.0,
     rays: int = 16,
-    resolution: float = 0.004,
-    refinements: int = 2,
+    resolution: float = 0.002,
+    refinements: int = 3,
     checks: int = 1,
     depth: int = 2,
     deadline: float | None = None,
@@ -258,9 +265,9 @@ def exact_region(
     depth : int
         How many times an interval between rays may be halved where the boundary needs it (also
         for an edge whose checks fail): the finest spacing is ``2**-depth`` of the first, and half
-        that next to a corner. On five test geometries depth 2 covers 0.986 to 0.992 of an
-        independent oracle's stable twists (``resolution=0.002, depth=4``: 0.990 to 0.995, in
-        about twice the time).
+        that next to a corner. On fifteen test geometries (three each of a triangle, a hexagon, an
+        off-centre-CF rectangle pushed by part of a face, an L, a trapezoid) the defaults cover
+        0.991 to 0.998 of an independent LP oracle's stable twists (docs/mechanics.md).
     deadline : float, optional
         A :func:`time.perf_counter` time; past it the construction stops with
         :class:`DeadlineExceeded` (checked before each batch of certifications).
@@ -321,10 +328,9 @@ def exact_region(
         inside = (w_lo < points[:, 1]) & (points[:, 1] < w_hi)
         refuted, margin = ~inside, np.full(len(points), np.nan)
         ask = ~proven & inside
-        near = np.broadcast_to(near, ask.shape)
-        for part, start in ((ask & ~near, 0), (ask & near, 1)):
-            if part.any():
-                proven[part], refuted[part], margin[part] = possible_or_not(twists[part], cone, support, refinements, start)
+        if ask.any():
+            start = np.broadcast_to(near, ask.shape)[ask].astype(int)
+            proven[ask], refuted[ask], margin[ask] = possible_or_not(twists[ask], cone, support, refinements, start)
         return proven, refuted, margin
 
     if not trusted and not settled(centre)[0][0]:
@@ -360,10 +366,14 @@ def exact_region(
                 near: np.ndarray | bool) -> tuple[np.ndarray, ...]:
         """Each ray's bracket from the points ``reach`` (``k, j``, increasing) along it, certified
         in one batch: ``(lo, hi, margin at lo, margin at hi, nearest proven unstable)``, ``lo`` the
-        last certified point before the first that is not (one crossing per ray is assumed)."""
+        last certified point before the first that is not (one crossing per ray is assumed).
+        Points not beyond ``base`` (certified already, or inside STABLE's region: a row's unused
+        places) are not certified again."""
         k, j = reach.shape
-        ok, no, margin = (v.reshape(k, j) for v in settled((centre + reach[..., None] * e[:, None]).reshape(-1, 2),
-                                                           np.broadcast_to(near, (k, j)).ravel()))
+        ok, no, margin = np.ones((k, j), dtype=bool), np.zeros((k, j), dtype=bool), np.full((k, j), np.nan)
+        new = reach > base[:, None]
+        ok[new], no[new], margin[new] = settled((centre + reach[..., None] * e[:, None])[new],
+                                                np.broadcast_to(near, (k, j))[new])
         first = np.where(ok.all(axis=1), j, np.argmin(ok, axis=1))
         rows = np.arange(k)
         below, above = np.maximum(first - 1, 0), np.minimum(first, j - 1)
@@ -377,24 +387,29 @@ def exact_region(
     def search(e: np.ndarray, lo: np.ndarray, hi: np.ndarray, f_lo: np.ndarray, f_hi: np.ndarray,
                out: np.ndarray) -> None:
         """Narrow each ray's bracket (``lo`` certified, ``hi`` not) to ``step``, side by side, one
-        batch per round; ``out`` keeps the nearest point proven unstable. Where both margins are
-        known, a round certifies two points a step apart about the secant's root (the margin is
-        close to linear near the boundary, so one round often ends the search); else, or when the
-        last round did not halve the bracket, the midpoint."""
-        slow = np.zeros(len(lo), dtype=bool)
+        batch per round; ``out`` keeps the nearest point proven unstable. A round certifies points
+        evenly spaced in each bracket (as many as it has steps, up to ``_SECTIONS - 1``) and,
+        where both margins are known, two points a step apart about the secant's root: the margin
+        is close to linear near the boundary, so the secant often ends the search at once, and
+        where it misses, the even points cut the bracket into many pieces (a batch costs far more
+        than a twist in it)."""
         while len(open_ := np.flatnonzero(hi - lo > step)):
             a, b, fa, fb = lo[open_], hi[open_], f_lo[open_], f_hi[open_]
             width = b - a
             with np.errstate(divide="ignore", invalid="ignore"):
                 root = a + width * fa / (fa - fb)
-            secant = np.isfinite(root) & ~slow[open_] & (width > 2 * step)
-            x = np.where(secant, np.clip(root, a + step / 2, b - step / 2), (a + b) / 2)
-            pair = np.c_[np.where(secant, x - step / 2, x), np.where(secant, x + step / 2, x)]
-            new = bracket(e[open_], a, b, pair, (width <= 16 * step)[:, None])
+            secant = np.isfinite(root) & (width > 2 * step)
+            count = np.clip(np.ceil(width / step).astype(int) - 1, 1, _SECTIONS - 1)
+            places = np.arange(1, count.max() + 1)
+            # A row's unused places repeat its certified end, which bracket() skips.
+            even = np.where(places <= count[:, None], a[:, None] + width[:, None] * places / (count[:, None] + 1),
+                            a[:, None])
+            x = np.clip(root, a + step / 2, b - step / 2)[:, None]
+            pair = np.where(secant[:, None], np.c_[x - step / 2, x + step / 2], a[:, None])
+            new = bracket(e[open_], a, b, np.sort(np.c_[even, pair], axis=1), (width <= 16 * step)[:, None])
             lo[open_], hi[open_], out[open_] = new[0], new[1], np.minimum(out[open_], new[4])
             f_lo[open_] = np.where(new[0] > a, new[2], fa)
             f_hi[open_] = np.where(new[1] < b, new[3], fb)
-            slow[open_] = new[1] - new[0] > width / 2
 
     # Per ray angle: [base, reach (certified), nearest point not certified, nearest proven unstable].
     found: dict[float, list[float]] = {}

@@ -13,9 +13,10 @@ __all__ = ["batched_simplex"]
 
 
 def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, basis: np.ndarray,
-                    limit: int = 100) -> tuple[np.ndarray, np.ndarray]:
+                    limit: int = 100, restart: np.ndarray | None = None,
+                    restart_limit: int = 100) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Optimal duals of the LPs ``max costs[p] . s`` s.t. ``columns s = rhs``, ``s >= 0``, one per
-    row of ``costs``, and which LPs are unbounded.
+    row of ``costs``, which LPs are unbounded, and the final bases.
 
     Parameters
     ----------
@@ -30,6 +31,10 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
         ``columns[:, basis] s_B = rhs`` with ``s_B >= 0``.
     limit : int
         Most pivots before the LPs still open go to HiGHS.
+    restart : (P, m) int ndarray, optional
+        Other feasible bases: an LP still open after ``limit`` pivots starts again from its own
+        (``restart_limit`` more pivots) before it goes to HiGHS. A warm start (``basis`` the
+        optimum of a similar LP) can lead into a degenerate vertex that the cold start avoids.
 
     Returns
     -------
@@ -38,6 +43,11 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
         ``pi . rhs`` is the optimum. Meaningless for an unbounded LP.
     unbounded : (P,) bool ndarray
         Which LPs have no finite optimum.
+    basis : (P, m) int ndarray
+        Each LP's last basis: optimal unless the LP is unbounded or went to HiGHS (then its
+        starting basis), and feasible in any case. The constraints do not depend on the costs, so
+        with shared columns it is a feasible start for any other costs: the optimal basis of a
+        similar LP starts the next one a pivot or two from its optimum.
 
     Notes
     -----
@@ -54,7 +64,7 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
     the best of costs 0, 2 and 9 puts 2/3 on 0 and 1/3 on 3, for 3; the duals ``(3, 3)`` are the
     line ``3 + 3 (x - 1)``, on or above every point's cost (0, 3 and 9):
 
-    >>> pi, unbounded = batched_simplex(np.array([[0.0, 2.0, 9.0]]), np.array([[1.0, 1, 1], [-1, 0, 2]]),
+    >>> pi, unbounded, _ = batched_simplex(np.array([[0.0, 2.0, 9.0]]), np.array([[1.0, 1, 1], [-1, 0, 2]]),
     ...                                 np.array([1.0, 0]), np.array([[0, 1]]))
     >>> pi.round(12).tolist(), unbounded.tolist()
     ([[3.0, 3.0]], [False])
@@ -63,7 +73,7 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
     all the weight at 0 (the basis also holds -1, at weight 0). The first pivot brings -2 in at
     weight 0, so the value stays 1; the next finds the optimum, 1/3 on -2 and 2/3 on 1, for 8/3:
 
-    >>> pi, unbounded = batched_simplex(np.array([[0.0, 1.0, 2.0, 3.0]]),
+    >>> pi, unbounded, _ = batched_simplex(np.array([[0.0, 1.0, 2.0, 3.0]]),
     ...                                 np.array([[1.0, 1, 1, 1], [-1, 0, -2, 1]]), np.array([1.0, 0]),
     ...                                 np.array([[0, 1]]))
     >>> (pi @ [1.0, 0]).round(12).tolist(), unbounded.tolist()
@@ -73,7 +83,7 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
     not pivoted from: that LP goes to HiGHS, which finds the optimum 2 (3/4 at the second point 0,
     1/4 at 2, for costs 1 and 5):
 
-    >>> pi, unbounded = batched_simplex(np.array([[0.0, 1.0, 5.0]]), np.array([[1.0, 1, 1], [0, 0, 2]]),
+    >>> pi, unbounded, _ = batched_simplex(np.array([[0.0, 1.0, 5.0]]), np.array([[1.0, 1, 1], [0, 0, 2]]),
     ...                                 np.array([1.0, 0.5]), np.array([[0, 1]]))
     >>> (pi @ [1.0, 0.5]).round(9).tolist(), unbounded.tolist()
     ([2.0], [False])
@@ -84,12 +94,40 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
     array([ True])
     """
     problems, m = basis.shape
-    shared = columns.ndim == 2
-    basis = np.array(basis)
+    start, basis = basis, np.array(basis)
     duals = np.zeros((problems, m))
     unbounded = np.zeros(problems, dtype=bool)
     tol = 1e-12 * (1.0 + np.max(np.abs(np.where(np.isfinite(costs), costs, 0.0)), axis=1))
-    open_ = np.arange(problems)
+    open_, handed = _pivots(costs, columns, rhs, basis, duals, unbounded, tol, np.arange(problems), limit)
+    if restart is not None and len(open_):
+        basis[open_] = restart[open_]
+        open_, more = _pivots(costs, columns, rhs, basis, duals, unbounded, tol, open_, restart_limit)
+        handed += more
+    basis[handed] = start[handed]
+    if not len(open_) and not handed:
+        return duals, unbounded, basis
+    shared = columns.ndim == 2
+    from scipy.optimize import linprog  # rarely needed: scipy.optimize takes a third of a second to import
+
+    for p in [*open_.tolist(), *handed]:
+        a = columns if shared else columns[p]
+        keep = np.isfinite(costs[p])
+        res = linprog(rhs, A_ub=-a[:, keep].T, b_ub=-costs[p, keep], bounds=[(None, None)] * m, method="highs")
+        if res.status == 2:  # no feasible duals: the LP itself is unbounded
+            unbounded[p] = True
+        elif res.status != 0:
+            raise RuntimeError(f"support LP failed: {res.message}")
+        else:
+            duals[p] = res.x
+    return duals, unbounded, basis
+
+
+def _pivots(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, basis: np.ndarray, duals: np.ndarray,
+            unbounded: np.ndarray, tol: np.ndarray, open_: np.ndarray, limit: int) -> tuple[np.ndarray, list[int]]:
+    """Up to ``limit`` pivots of the LPs ``open_`` of :func:`batched_simplex` (``basis``, ``duals`` and
+    ``unbounded`` updated in place): those still open, and those whose basis turned singular."""
+    m = basis.shape[1]
+    shared = columns.ndim == 2
     handed: list[int] = []
     for pivot in range(limit):
         bland = pivot >= limit // 4
@@ -108,8 +146,7 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
         improving = reduced > tol[open_, None]
         going = improving.any(axis=1)
         if not going.any():
-            open_ = np.arange(0)
-            break
+            return np.arange(0), handed
         enter = np.argmax(improving if bland else reduced, axis=1)[going]
         open_, cols = open_[going], cols[going]
         entering = a[:, enter].T if shared else a[going][np.arange(len(open_)), :, enter]
@@ -123,21 +160,7 @@ def batched_simplex(costs: np.ndarray, columns: np.ndarray, rhs: np.ndarray, bas
         if bland:  # of the tied leaving columns, the lowest
             ratio = np.where(ratio <= ratio.min(axis=1, keepdims=True), basis[open_], np.inf)
         basis[open_, np.argmin(ratio, axis=1)] = enter
-    if not len(open_) and not handed:
-        return duals, unbounded
-    from scipy.optimize import linprog  # rarely needed: scipy.optimize takes a third of a second to import
-
-    for p in [*open_.tolist(), *handed]:
-        a = columns if shared else columns[p]
-        keep = np.isfinite(costs[p])
-        res = linprog(rhs, A_ub=-a[:, keep].T, b_ub=-costs[p, keep], bounds=[(None, None)] * m, method="highs")
-        if res.status == 2:  # no feasible duals: the LP itself is unbounded
-            unbounded[p] = True
-        elif res.status != 0:
-            raise RuntimeError(f"support LP failed: {res.message}")
-        else:
-            duals[p] = res.x
-    return duals, unbounded
+    return open_, handed
 
 
 def _solved(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -48,6 +48,7 @@ fallback.
 
 from __future__ import annotations
 
+import copy
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -68,6 +69,13 @@ __all__ = ["LoadBatch", "SupportCells", "SupportLoads", "SupportModel", "effecti
 COR_DIRECTIONS = 32
 #: Corners of the polygon inscribed in the CF's uncertainty disk that sample centres may reach.
 CF_DIRECTIONS = 32
+#: Twists whose optimal bases a support model keeps per level and set of directions, and how many
+#: such sets (:meth:`SupportModel.warm_bases`).
+WARM_TWISTS = 512
+WARM_DIRECTIONS = 16
+#: Pivots of a warm-started support LP before it starts again from the cold start (a warm basis
+#: can lead into a degenerate vertex the cold one avoids: a sample at the CF).
+WARM_LIMIT = 32
 
 
 def unit_loads(twist: ArrayLike, points: ArrayLike) -> np.ndarray:
@@ -212,12 +220,18 @@ def _disk_cells(cf: np.ndarray, radius: float, n: int) -> list[np.ndarray]:
     return out
 
 
-def _footprint_cells(polygon: shapely.Polygon, cf: np.ndarray, h: float) -> list[np.ndarray]:
-    """Squares of side ``h`` (grid through the CF) clipped to the polygon, as convex hulls."""
-    x0, y0, x1, y1 = polygon.bounds
-    i = np.arange(np.floor((x0 - cf[0]) / h), np.ceil((x1 - cf[0]) / h))
-    j = np.arange(np.floor((y0 - cf[1]) / h), np.ceil((y1 - cf[1]) / h))
-    ii, jj = (a.ravel() for a in np.meshgrid(i, j))
+def _footprint_cells(polygon: shapely.Polygon, cf: np.ndarray, h: float,
+                     squares: np.ndarray | None = None) -> list[np.ndarray]:
+    """Squares of side ``h`` (grid through the CF) clipped to the polygon, as convex hulls: all
+    those over the polygon, or the ``squares`` given by their indices ``(i, j)`` (``n, 2``; square
+    ``(i, j)`` has its lower left corner at ``cf + (i, j) h``)."""
+    if squares is None:
+        x0, y0, x1, y1 = polygon.bounds
+        i = np.arange(np.floor((x0 - cf[0]) / h), np.ceil((x1 - cf[0]) / h))
+        j = np.arange(np.floor((y0 - cf[1]) / h), np.ceil((y1 - cf[1]) / h))
+        ii, jj = (a.ravel() for a in np.meshgrid(i, j))
+    else:
+        ii, jj = np.asarray(squares, dtype=float).T
     boxes = shapely.box(cf[0] + ii * h, cf[1] + jj * h, cf[0] + (ii + 1) * h, cf[1] + (jj + 1) * h)
     shapely.prepare(polygon)
     inside = shapely.contains_properly(polygon, boxes)  # whole squares: nothing to clip
@@ -263,6 +277,8 @@ class SupportModel:
         self._cells: dict[int, SupportCells] = {}
         self._lp: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._triangle: dict[int, np.ndarray] = {}
+        self._warm: dict[tuple[int, bytes], tuple[np.ndarray, np.ndarray]] = {}
+        self._lift: dict[int, np.ndarray] = {}
 
     def __repr__(self) -> str:
         extra = f", cf_radius={self.cf_radius:g}" if self.cf_radius else ""
@@ -352,6 +368,72 @@ class SupportModel:
             self._lp[level] = columns, rhs, start
         return self._lp[level]
 
+    def warm_bases(self, level: int, ys: np.ndarray, twists: np.ndarray) -> np.ndarray:
+        """Starting bases (``K, R, m``) for the LPs of :meth:`LoadBatch.sample_support` at ``level``,
+        directions ``ys`` (``R, 3``) and ``twists`` (``K, 3``): the optimal bases of the nearest
+        twist (by direction, moments in units of :attr:`radius`) :meth:`remember` kept for these
+        directions at this level or the one below (whose samples are among this level's), else
+        :meth:`envelope_lp`'s start. Any basis of these LPs is feasible for all of them (the
+        constraints do not depend on the twist), and neighbouring twists' optima are a pivot or
+        two apart: a search along a ray pivots little, and so does a twist refined a level."""
+        start = self.envelope_lp(level)[2]
+        out = np.array(np.broadcast_to(start, (len(twists), len(ys), len(start))))
+        near = np.full(len(twists), -np.inf)
+        probe = self._twist_keys(twists)
+        for source in (level - 1, level):  # this level wins ties: its bases need no lifting
+            kept = self._warm.get((source, ys.tobytes()))
+            if kept is None:
+                continue
+            keys, bases = kept
+            closeness = probe @ keys.T
+            best = np.argmax(closeness, axis=1)
+            bases = bases[best] if source == level else self._lifted(level)[bases[best]]
+            take = (closeness[np.arange(len(twists)), best] >= near)[:, None] & np.all(bases >= 0, axis=2)
+            out = np.where(take[..., None], bases, out)
+            near = np.maximum(near, closeness[np.arange(len(twists)), best])
+        return out
+
+    def _lifted(self, level: int) -> np.ndarray:
+        """The column of ``level``'s LP (:meth:`envelope_lp`) of each column of the level below
+        (-1 if it has none: the grids nest, so a sample always has one, and so does a centre),
+        matched by coordinates to a billionth of :attr:`radius`."""
+        if level not in self._lift:
+            below, here = self.cells(level - 1).points, self.cells(level).points
+            at = {key: j for j, key in enumerate(map(tuple, np.round(here / (1e-9 * self.radius)).tolist()))}
+            match = np.array([at.get(key, -1) for key in map(tuple, np.round(below / (1e-9 * self.radius)).tolist())])
+            extra = self.envelope_lp(level)[0].shape[1] - len(here)  # the centre's columns, after the samples
+            self._lift[level] = np.r_[match, len(here) + np.arange(extra)]
+        return self._lift[level]
+
+    def remember(self, level: int, ys: np.ndarray, twists: np.ndarray, bases: np.ndarray) -> None:
+        """Keep the optimal ``bases`` (``K, R, m``) of ``twists`` for :meth:`warm_bases`, the last
+        ``WARM_TWISTS`` per level and directions (memory bounded whatever the calls)."""
+        key = (level, ys.tobytes())
+        new = self._twist_keys(twists)
+        if key in self._warm:
+            keys, old = self._warm[key]
+            new, bases = np.r_[keys, new], np.concatenate([old, bases])
+        self._warm[key] = new[-WARM_TWISTS:], bases[-WARM_TWISTS:]
+        if len(self._warm) > WARM_DIRECTIONS:  # a caller cycling through many direction sets
+            del self._warm[next(iter(self._warm))]
+
+    def _twist_keys(self, twists: np.ndarray) -> np.ndarray:
+        scaled = twists * np.array([1.0, 1.0, self.radius])
+        return scaled / np.linalg.norm(scaled, axis=1, keepdims=True)
+
+    def children(self, level: int, parents: ArrayLike) -> SupportCells:
+        """The cells of ``level`` inside the given cells of the level below (footprint only), built
+        for them alone. The footprint's cells are a grid of squares through the CF clipped to the
+        part, the side halving with each level: a cell's anchor (inside its square) names its
+        square, whose four quarters are the next level's squares; clipped to the part they cover
+        its piece of it."""
+        if self.kind != "footprint" or level < 1:
+            raise ValueError("only a footprint's cells of level 1 and above have parents")
+        h = self.radius / (self.resolution * 2**level)
+        squares = np.floor((self.cells(level - 1).anchors[np.asarray(parents, dtype=int)] - self.cf) / (2 * h))
+        quarters = (2 * squares[:, None] + np.array([[0, 0], [1, 0], [0, 1], [1, 1]])[None]).reshape(-1, 2)
+        return SupportCells.from_polygons(_footprint_cells(self.polygon, self.cf, h, quarters), self.covers)
+
     def cf_triangle(self, level: int = 0) -> np.ndarray:
         """Indices of three samples of ``level`` whose triangle holds the CF as deep inside as can be
         (a feasible start for the LPs over distributions centred at the CF; cached)."""
@@ -405,6 +487,13 @@ class LoadBatch:
     def __len__(self) -> int:
         return len(self.twists)
 
+    def __getitem__(self, index: ArrayLike) -> LoadBatch:
+        """The batch of some of the twists (an index or mask), without locating their CORs again."""
+        part = copy.copy(self)
+        part.twists, part.sense, part.cor, part.cor_in_region = (
+            self.twists[index], self.sense[index], self.cor[index], self.cor_in_region[index])
+        return part
+
     def _directions(self, ys: ArrayLike) -> np.ndarray:
         """``ys`` as ``(K, R, 3)``: one set for every twist, or a set per twist."""
         ys = np.asarray(ys, dtype=float)
@@ -419,12 +508,21 @@ class LoadBatch:
         """``(values, lams)``: the largest ``y . L`` over sample distributions, shape ``(K, R)``, and
         the LP's duals ``lam`` (``K, R, 2``), with ``value = max over samples of y . g + lam . (x - CF)``
         (plus ``cf_radius`` times the support of ``-lam`` on the 32-gon of centres)."""
+        shared = np.asarray(ys, dtype=float)
         ys = self._directions(ys)
         k, r = ys.shape[:2]
         columns, rhs, start = self.model.envelope_lp(self.level)
         costs = np.einsum("knj,krj->krn", unit_loads(self.twists[:, None, :], self.cells.points[None]), ys)
         # The centre's columns (uncertain CF) cost nothing.
         costs = np.concatenate([costs, np.zeros((k, r, columns.shape[1] - costs.shape[2]))], axis=2)
+        # One set of directions for all twists (the usual case: a cone's rows) warm-starts each LP
+        # from the optimum of the nearest twist solved before; a twist whose COR lies in the region
+        # has a column of its own, and starts from the CF's triangle.
+        warm = shared.ndim == 2 and k > 0
+        basis = np.array(np.broadcast_to(start, (k, r, len(rhs))))
+        plain = ~self.cor_in_region
+        if warm and plain.any():
+            basis[plain] = self.model.warm_bases(self.level, shared, self.twists[plain])
         if self.cor_in_region.any():
             at_cor = np.where(self.cor_in_region[:, None], np.linalg.norm(self._arm(ys), axis=-1), -np.inf)
             costs = np.concatenate([costs, at_cor[..., None]], axis=2)
@@ -432,7 +530,12 @@ class LoadBatch:
             extra[:, :3, 0] = np.c_[np.ones(k), (self.cor - self.cf) / self.model.radius]
             per_twist = np.concatenate([np.broadcast_to(columns, (k, *columns.shape)), extra], axis=2)
             columns = np.broadcast_to(per_twist[:, None], (k, r, *per_twist.shape[1:])).reshape(k * r, len(rhs), -1)
-        duals, _ = batched_simplex(costs.reshape(k * r, -1), columns, rhs, np.broadcast_to(start, (k * r, len(rhs))))
+        cold = np.broadcast_to(start, (k * r, len(rhs)))
+        duals, _, final = (batched_simplex(costs.reshape(k * r, -1), columns, rhs, basis.reshape(k * r, -1),
+                                           WARM_LIMIT, restart=cold) if warm
+                           else batched_simplex(costs.reshape(k * r, -1), columns, rhs, cold))
+        if warm and plain.any():
+            self.model.remember(self.level, shared, self.twists[plain], final.reshape(k, r, -1)[plain])
         return (duals @ rhs).reshape(k, r), (-duals[:, 1:3] / self.model.radius).reshape(k, r, 2)
 
     def _cell_geometry(self, k: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -462,10 +565,12 @@ class LoadBatch:
         hold the COR ``c`` (``K, C``), and (for those) ``psi``'s envelope ``E`` at ``c`` and its slope
         ``k`` away from it (``K, R``): ``psi <= E + k |x - c|``. A translation has no COR (``E = -inf``).
 
-        A cell's bound is tightened (its exact geometry seen from ``c``) only where it could be the
-        largest or decide a sign: a cell whose cheap bound (second order, with its distance from
-        ``c`` bounded below by its anchor's distance less its reach) lies below both the largest
-        vertex value and 0 keeps that bound, which changes neither the maximum nor any sign.
+        A cell's bound is tightened (its exact geometry seen from ``c``) only where it could decide
+        a sign: a cell whose cheap bound (second order, with its distance from ``c`` bounded below
+        by its anchor's distance less its reach) lies below 0 (less the uncertain CF's term
+        ``cf_radius |lam|`` of :meth:`upper_bound`) keeps that bound. The largest bound is then
+        looser where it is negative, but no sign changes (half the time of tightening every cell
+        that could be the largest, at the sample levels the exact regions use).
         """
         ys, cells = self._directions(ys), self.cells
         lams = np.broadcast_to(np.asarray(lams, dtype=float), (*ys.shape[:2], 2))
@@ -487,7 +592,7 @@ class LoadBatch:
         with np.errstate(divide="ignore", invalid="ignore"):
             curvature = 1.5 * u[..., None] / near[:, None] ** 2 + np.maximum(0.0, -radial)[..., None] / near[:, None]
             cheap = np.where(near[:, None] > 0, vertex_max + curvature / 2 * cells.reach**2, np.inf)
-        floor = np.minimum(vertex_max.max(axis=-1), 0.0)[..., None]
+        floor = -self.model.cf_radius * np.linalg.norm(lams, axis=-1)[..., None]
         k, c = np.nonzero(rotation[:, None] & np.any(cheap >= floor, axis=1))
         bounds = np.where(rotation[:, None, None], cheap, vertex_max)
         envelope = u + np.einsum("krj,kj->kr", lams, self.cor - self.cf)
@@ -526,6 +631,44 @@ class LoadBatch:
         """
         bounds, *_ = self.cell_bounds(ys, lams)
         return bounds.max(axis=-1) + self.model.cf_radius * np.linalg.norm(lams, axis=-1)
+
+    def refined_bound(self, ys: ArrayLike, lams: ArrayLike, coarse: np.ndarray | None = None) -> np.ndarray:
+        """:meth:`upper_bound` one level finer than the batch's, with the finer cells only where
+        they can help: this level's cells bound ``psi``, and those whose bound could be positive
+        (for any twist and direction of the batch: the uncertain CF's term aside) are replaced by
+        the next level's cells inside them (:meth:`SupportModel.children`), built for them alone.
+        Every piece of the region is still bounded by a cell holding it, so the bound is valid; a
+        cell whose bound is already negative is not split, so the sign is the finer level's
+        wherever a cell bounds ``psi`` no lower than its quarters do (the usual case: the bounds
+        loosen with a cell's size), at a fraction of the cells. A disk's polar cells do not nest,
+        and the next level's are all bounded.
+        ``coarse``: this level's :meth:`cell_bounds` for the same ``ys`` and ``lams``, if known.
+
+        >>> from mechanics import cor_to_twist
+        >>> block = SupportModel.footprint([[-1, 0], [1, 0], [1, 1], [-1, 1]], [0.0, 0.5])
+        >>> twists = cor_to_twist([[-3.0, 0.5], [-1.2, 0.2]], 1)
+        >>> ys = [[0.0, 0.0, 1.0], [0.3, -1.0, 0.2]]
+        >>> coarse = block.batch(twists, level=1)
+        >>> lams = coarse.sample_support(ys)[1]
+        >>> full, refined = block.batch(twists, level=2).upper_bound(ys, lams), coarse.refined_bound(ys, lams)
+        >>> bool(np.all(refined >= full - 1e-12) and np.array_equal(refined > 0, full > 0))
+        True
+        """
+        finer = copy.copy(self)
+        finer.level = self.level + 1
+        if self.model.kind != "footprint":
+            finer.cells = self.model.cells(finer.level)
+            return finer.upper_bound(ys, lams)
+        if coarse is None:
+            coarse, *_ = self.cell_bounds(ys, lams)
+        lams = np.broadcast_to(np.asarray(lams, dtype=float), (*coarse.shape[:2], 2))
+        centre = self.model.cf_radius * np.linalg.norm(lams, axis=-1)
+        hot = np.flatnonzero(np.any(coarse + centre[..., None] > 0, axis=(0, 1)))
+        best = np.delete(coarse, hot, axis=-1).max(axis=-1, initial=-np.inf)
+        if len(hot):
+            finer.cells = self.model.children(finer.level, hot)
+            best = np.maximum(best, finer.cell_bounds(ys, lams)[0].max(axis=-1, initial=-np.inf))
+        return best + centre
 
     def is_negative(self, ys: ArrayLike, lams: ArrayLike, tol: float = 0.0) -> np.ndarray:
         """Whether ``y . L < 0`` is guaranteed for every admissible distribution, one direction
@@ -594,7 +737,7 @@ class LoadBatch:
         basis = np.c_[np.broadcast_to(triangle, (k, 3)), np.where(values[np.arange(k), least] >= 0, z, z + 1),
                       slacks[slacks != (z + 2 + least)[:, None]].reshape(k, r - 1),
                       np.full((k, int(rho > 0)), a.shape[2] - 1)].astype(int)
-        duals, unbounded = batched_simplex(costs, a, rhs, basis)
+        duals, unbounded, _ = batched_simplex(costs, a, rhs, basis)
         beta, lam, value = -duals[:, :r], -duals[:, r + 1:r + 3] / radius, duals @ rhs
         beta[unbounded], lam[unbounded], value[unbounded] = np.nan, 0.0, np.inf
         return beta, lam, value

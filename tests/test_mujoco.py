@@ -140,3 +140,60 @@ def test_bad_simulation_flags_are_bad_input(tmp_path, capsys, argv, field):
     assert main([BATTERY, "--out", str(tmp_path / "out"), *argv]) == 1
     assert capsys.readouterr().err.startswith(f"plan: error: {field}: ")
     assert not (tmp_path / "out").exists()
+
+
+def test_pushes_inside_the_exact_region_stick_and_pushes_outside_slip_in_mujoco(monkeypatch):
+    """The battery's pushing edge, six vertices of its exact region beyond STABLE's: the twist 5 %
+    closer to the region's centre and the one 10 % farther out, each pushed 6 cm (the part's
+    fastest point) on the simulator's own foot sets and on the distribution the independent LP
+    (tests/oracle.py, no ``mechanics`` code) finds worst for the outside twist, two or three feet
+    on the part's rim. Slip is the pusher face's motion in the part frame over the push, against
+    :data:`SLIP` (five times the soft contact's penetration): every inside run stays under it; on
+    its worst distribution every outside twist slips past it, and by at least twice as far as the
+    inside twist on the same feet (the outside twists do not slip on a grid of feet: only some
+    distributions break them, which is what the region guards against)."""
+    import shapely
+    from scipy.optimize import linprog
+
+    import oracle as O
+    import planner.execution.mujoco_sim as sim
+    from mechanics import exact_region
+    from planner.model.plan_file import Push
+
+    scene = load_scene(BATTERY)
+    slider, pusher = scene.slider, scene.pusher
+    edge = pusher.edges[0]
+    region = exact_region(slider, edge, pusher.mu, pusher.width)
+    polygon, centre = region.section()
+    ring = np.asarray(polygon.exterior.coords)[:-1]
+    beyond = ring[~region.stable.contains(region.plane.twists(ring))]
+    rim = shapely.get_coordinates(shapely.line_interpolate_point(
+        shapely.Polygon(slider.vertices).exterior, np.linspace(0, 1, 96, endpoint=False), normalized=True))
+    lp = O.LPOracle(O.Reference(slider.vertices, slider.cf, edge, pusher.mu, pusher.width),
+                    np.vstack([O.support_samples(slider.vertices, 24), rim]))
+
+    def worst_feet(twist):
+        g = lp.wrenches(twist)
+        runs = [linprog(-(g @ a), A_eq=lp.A_eq, b_eq=lp.b_eq, bounds=(0, None), method="highs") for a in lp.facets]
+        best = min(runs, key=lambda res: res.fun)
+        assert -best.fun > 1e-9  # the LP breaks sticking: this twist is not stable
+        on = best.x > 1e-9
+        return sim.Feet("worst", lp.x[on], best.x[on] / best.x[on].sum(), slider.cf)
+
+    def slips(twist, feet):
+        speed = max(math.hypot(*twist[:2]), abs(twist[2]) * slider.radius)
+        push = Push.along(edge, region.contact, twist, 0.06 / speed, scene.start)
+        one = Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
+                   goal=push.end, segments=[push])
+        monkeypatch.setattr(sim, "feet", lambda *args, **kwargs: feet)
+        return np.array([run.slip for run in sim.simulate(scene, one, n=len(feet)).runs])
+
+    own = sim.feet(scene, 3, seed=1)
+    for vertex in beyond[np.linspace(0, len(beyond), 6, endpoint=False).astype(int)]:
+        inside, outside = region.plane.twists(centre + np.array([[0.95], [1.10]]) * (vertex - centre))
+        assert region.contains(inside) and not region.contains(outside)
+        worst = worst_feet(outside)
+        stuck = slips(inside, [worst, *own])
+        slipped = slips(outside, [worst])[0]
+        assert stuck.max() <= sim.SLIP, (vertex, stuck)
+        assert slipped > sim.SLIP and slipped >= 2 * stuck[0], (vertex, stuck, slipped)

@@ -281,9 +281,57 @@ def test_simplex_on_random_degenerate_lps():
     columns = np.vstack([np.ones(len(x)), x.T])
     costs = rng.integers(-3, 4, size=(200, len(x))).astype(float)
     start = np.array([[i for i, p in enumerate(x.tolist()) if p in ([-2, -2], [2, -2], [0, 2])]] * 200)
-    duals, unbounded = batched_simplex(costs, columns, np.array([1.0, 0.0, 0.0]), start)
+    duals, unbounded, _ = batched_simplex(costs, columns, np.array([1.0, 0.0, 0.0]), start)
     assert not unbounded.any()
     for c, pi in zip(costs, duals):
         res = linprog(-c, A_eq=columns, b_eq=[1.0, 0.0, 0.0], bounds=(0, None), method="highs", options=TIGHT)
         assert pi[0] == pytest.approx(-res.fun, abs=1e-9)
         assert np.all(pi @ columns >= c - 1e-9)
+
+
+@pytest.mark.parametrize("rho", [0.0, 0.05])
+def test_warm_started_support_lps_find_highs_optimum(rho):
+    """A model that has solved some twists starts the LPs of others from the optimal basis of the
+    nearest one it kept, at the same level or lifted from the level below (whose samples are among
+    this level's): the values are still HiGHS's optima of each discrete LP, for twists near and far
+    from those solved before, a level finer too, and a degenerate start (a sample at the CF, where
+    Dantzig's rule can cycle) still ends at the optimum."""
+    rng = np.random.default_rng(33 + int(100 * rho))
+    support = SupportModel.of_slider(TRAPEZOID, "footprint", cf_radius=rho)
+    cone = contact_wrench_cone(ContactConfiguration.slider_edge(TRAPEZOID, 0, 0.6), "ss")
+    ys = -cone.rows
+    first = twists_about(rng, support, 8)
+    support.batch(first, 1).sample_support(ys)  # kept for the warm starts below
+    nearby = first + 0.01 * rng.normal(size=first.shape)
+    for twists, level in ((nearby, 1), (twists_about(rng, support, 4), 1), (nearby, 2)):
+        batch = support.batch(twists, level)
+        values, _ = batch.sample_support(ys)
+        x = support.cells(level).points
+        for k in np.flatnonzero(~batch.cor_in_region):
+            h = B.loads(twists[k], x) @ ys.T
+            assert values[k] == pytest.approx([highs_primal(h[:, r], x, support.cf, rho) for r in range(len(ys))],
+                                              abs=1e-9)
+
+
+def test_a_warm_start_that_stalls_starts_again_cold(monkeypatch):
+    """Points of an integer grid with one at the CF, costs that make the point mass at the CF
+    optimal (a degenerate vertex): from three far corners one pivot does not reach the optimum,
+    and the LP would go to HiGHS (here made to fail); with a restart from three points about the
+    CF it reaches the optimum, 0, with feasible duals, in numpy alone."""
+    import scipy.optimize
+
+    def no_highs(*args, **kwargs):
+        raise AssertionError("went to HiGHS")
+
+    monkeypatch.setattr(scipy.optimize, "linprog", no_highs)
+    x = np.array([(i, j) for i in range(-2, 3) for j in range(-2, 3)], dtype=float)
+    columns = np.vstack([np.ones(len(x)), x.T])
+    costs = -np.abs(x).sum(axis=1)[None]  # concave: all the weight at the CF (0, 0) is best, value 0
+    far = np.array([[i for i, p in enumerate(x.tolist()) if p in ([-2, -2], [2, -2], [0, 2])]])
+    near = np.array([[i for i, p in enumerate(x.tolist()) if p in ([-1, -1], [1, -1], [0, 1])]])
+    rhs = np.array([1.0, 0.0, 0.0])
+    with pytest.raises(AssertionError, match="HiGHS"):
+        batched_simplex(costs, columns, rhs, far, limit=1)
+    duals, _, _ = batched_simplex(costs, columns, rhs, far, limit=1, restart=near)
+    assert duals[0] @ rhs == pytest.approx(0.0, abs=1e-12)
+    assert np.all(duals[0] @ columns >= costs[0] - 1e-9)

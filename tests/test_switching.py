@@ -45,13 +45,15 @@ def test_switch_cost_trades_length_for_switches():
     for seed in range(5, 9):  # seed 7 differs
         free, dear = plan(scene, seed=seed, switch_cost=0.0), plan(scene, seed=seed, switch_cost=10.0)
         assert free.solved and dear.solved
-        if free.to_dict()["segments"] != dear.to_dict()["segments"]:
+        # The switch cost reshapes the whole search, so plans without a switch can differ too
+        # (seed 6 since issue 33's regions); the trade shows where the switches differ.
+        if free.switches != dear.switches:
             differed += 1
             # A dear switch is avoided when one edge does it; a free one is kept if it is shorter.
             assert dear.switches < free.switches
             assert cost(dear, scene, 10.0) <= cost(free, scene, 10.0)
             assert free.path_length(scene.slider.cf) <= dear.path_length(scene.slider.cf)
-    assert differed, "no seed where the switch cost changed the plan: the test shows nothing"
+    assert differed, "no seed where the switch cost changed the switches: the test shows nothing"
 
 
 def test_one_edge_options_never_switch():

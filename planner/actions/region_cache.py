@@ -55,8 +55,8 @@ __all__ = ["MEMORY_SIZE", "RegionCache", "cache_folder", "cache_key", "compute_r
 #: Bump when the exact region's construction (or the recording's analysis) changes, so old cache
 #: files are not used. 3: the support LPs by a batched simplex (its duals can differ where the LP
 #: is degenerate). 4: the adaptive trace without a safety margin (larger regions), and the gap
-#: bound kept with each region.
-_VERSION = 4
+#: bound kept with each region. 5: a finer trace and a third certificate level (larger still).
+_VERSION = 5
 
 #: Items a :class:`RegionCache` keeps in memory unless told otherwise: every region and analysis
 #: of a 200-edged part twice over, a few megabytes. An item dropped is read again from its file.
