@@ -30,7 +30,7 @@ from ..world.validity import CollisionModel, advances
 from .push import free_push
 from .shortcut import farthest_first
 
-__all__ = ["DubinsCurves", "DubinsShortcut", "pieces"]
+__all__ = ["WHOLE_PLAN_CARS", "DubinsCurves", "DubinsShortcut", "pieces"]
 
 #: Starting intervals per turning radius of curve length when cutting a curve into pieces (the
 #: halving finds every joint; this only bounds its depth).
@@ -38,6 +38,9 @@ _SAMPLES_PER_RADIUS = 4
 #: Least relative gain for which a shortcut replaces a stretch of plan: its pieces are pushes
 #: too, and a push is not worth adding for less.
 _GAIN = 0.01
+#: Most edges' cars a curve for a whole plan may take (:meth:`DubinsShortcut.whole_plan_edges`):
+#: more than any shipped part has.
+WHOLE_PLAN_CARS = 16
 
 
 def pieces(curve, length: float, radius: float, tol: float = 1e-12) -> list[tuple[float, float]]:
@@ -253,6 +256,11 @@ class _Cars(Mapping):
             raise KeyError(edge)
         return curves
 
+    @property
+    def edges(self) -> list[int]:
+        """The edges that may have a car (made or not)."""
+        return list(self._controls)
+
     def __iter__(self) -> Iterator[int]:
         return (e for e in self._controls if self._curves(e) is not None)
 
@@ -280,7 +288,7 @@ class DubinsShortcut:
     """
 
     def __init__(self, scene: Scene, controls: list[EdgeControls], model: CollisionModel, margin: float):
-        self.cf = scene.slider.cf
+        self.cf, self._slider = scene.slider.cf, scene.slider
         self.curves = _Cars(scene, controls, model, margin)
 
     def __call__(self, segments: list) -> list:
@@ -305,10 +313,22 @@ class DubinsShortcut:
         travelled = np.concatenate([[0.0], np.cumsum([s.cf_path_length(self.cf) for s in run])])
 
         def curve(i: int, j: int) -> list[Push] | None:
-            edges = list(self.curves) if alone and (i, j) == (0, len(run)) else [run[0].edge]
+            edges = self.whole_plan_edges(run[0].edge) if alone and (i, j) == (0, len(run)) else [run[0].edge]
             return self._curve(waypoints[i], waypoints[j], travelled[j] - travelled[i], edges)
 
         return farthest_first(run, curve)
+
+    def whole_plan_edges(self, edge: int) -> list[int]:
+        """The edges whose cars a curve for a whole plan pushed on ``edge`` may take: that edge and
+        the longest others, :data:`WHOLE_PLAN_CARS` in all (every edge of a part of fewer). A car costs milliseconds to make, and a
+        part of a thousand edges (a circle's outline from CAD) would spend seconds on cars most of
+        which turn no tighter than the rest; a longer edge holds the pusher's contact farther out
+        and so tends to turn tighter."""
+        slider = self._slider
+        others = sorted((e for e in self.curves.edges if e != edge),
+                        key=lambda e: (-float(np.linalg.norm(np.subtract(*slider.edge(e)))), e))
+        chosen = {edge, *others[:WHOLE_PLAN_CARS - 1]}
+        return [e for e in self.curves.edges if e in chosen]  # in the edges' order, as ever: ties go the same way
 
     def _curve(self, start: np.ndarray, end: np.ndarray, longest: float, edges: list[int]) -> list[Push] | None:
         """The shortest free Dubins curve among ``edges``' cars shorter than ``longest``, as pushes."""
