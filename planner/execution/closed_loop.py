@@ -30,7 +30,7 @@ from ..model.plan_file import Plan
 from ..model.scene import Scene
 from ..queries.session import Planner
 from .approach import lead_in_pose
-from .mujoco_sim import SETTLE, TABLE_MU, Feet, World, feet, needs_mujoco, perturbations, write_mjcf
+from .mujoco_sim import SETTLE, TABLE_MU, Feet, Runs, World, feet, needs_mujoco, perturbations, write_mjcf
 from .tracker import Replan, Tracker
 from .trajectory import RATE, Trajectory
 
@@ -96,19 +96,12 @@ def _trigger(replan: Replan) -> str:
 
 
 @dataclass(frozen=True)
-class ClosedLoop:
+class ClosedLoop(Runs):
     """Outcome of :func:`closed_loop`: one :class:`ClosedRun` per foot set."""
 
     runs: tuple[ClosedRun, ...]
     mu: float
     start: np.ndarray  # where the part was placed
-
-    @property
-    def passed(self) -> bool:
-        return all(r.passed for r in self.runs)
-
-    def lines(self) -> list[str]:
-        return [r.line(k, len(self.runs)) for k, r in enumerate(self.runs, 1)]
 
     def summary(self) -> str:
         latencies = [x for r in self.runs for x in r.latencies]

@@ -74,7 +74,7 @@ from ..world.validity import CollisionModel
 from .approach import first_edge, lead_in_pose
 from .trajectory import Trajectory, planned_part, trajectory
 
-__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Simulation", "document", "feet", "mjcf",
+__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Runs", "Simulation", "document", "feet", "mjcf",
            "needs_mujoco", "part_body", "table", "World", "perturbations", "simulate", "support_centre", "write_mjcf"]
 
 #: The one line ``plan --simulate`` prints (after ``plan: error: --simulate: ``) without MuJoCo.
@@ -370,8 +370,22 @@ def _where(by_segment: tuple[float, ...]) -> str:
     return f" (segment {int(np.argmax(by_segment)) + 1})" if len(by_segment) > 1 and max(by_segment) > 0 else ""
 
 
+class Runs:
+    """What every batch of simulated runs reports (``runs``, each with ``passed`` and
+    ``line(k, n)``): whether all passed, and a line per run, numbered from 1."""
+
+    runs: tuple
+
+    @property
+    def passed(self) -> bool:
+        return all(r.passed for r in self.runs)
+
+    def lines(self) -> list[str]:
+        return [r.line(k, len(self.runs)) for k, r in enumerate(self.runs, 1)]
+
+
 @dataclass(frozen=True)
-class Simulation:
+class Simulation(Runs):
     """Outcome of :func:`simulate`: one :class:`Run` per foot set, and the trajectory they followed."""
 
     runs: tuple[Run, ...]
@@ -388,10 +402,6 @@ class Simulation:
         """The run that strays farthest from the planned path (the first of equals)."""
         return max(self.runs, key=lambda r: r.deviation)
 
-    @property
-    def passed(self) -> bool:
-        return all(r.passed for r in self.runs)
-
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:
         """Write the first run's model (:func:`mjcf`) to ``path`` atomically, with keyframes of the
         planned part and the pusher every :attr:`KEY_EVERY` s of the trajectory and at its end
@@ -400,9 +410,6 @@ class Simulation:
         rows = np.unique(np.append(np.searchsorted(m.t, np.arange(0.0, m.duration, self.KEY_EVERY)), len(m.t) - 1))
         keys = np.column_stack([m.t, self.planned, m.x, m.y, m.z, np.unwrap(m.theta)])[rows]
         write_mjcf(path, scene, self.runs[0].feet, self.mu, self.start, keys)
-
-    def lines(self) -> list[str]:
-        return [r.line(k, len(self.runs)) for k, r in enumerate(self.runs, 1)]
 
     def summary(self) -> str:
         worst = max(r.goal_error[0] for r in self.runs)

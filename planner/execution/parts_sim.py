@@ -30,8 +30,8 @@ from ..model.parts import PartsScene
 from ..model.parts_plan import PartsPlan
 from ..model.plan_file import Plan
 from ..world.validity import CollisionModel
-from .mujoco_sim import (SETTLE, SLIP, TABLE_MU, TIMESTEP, Feet, _error, _follower, _lead_in, _numbers, document, feet,
-                         needs_mujoco, part_body, table)
+from .mujoco_sim import (SETTLE, SLIP, TABLE_MU, TIMESTEP, Feet, Runs, _error, _follower, _lead_in, _numbers, document,
+                         feet, needs_mujoco, part_body, table)
 from .trajectory import Trajectory, parts_trajectory
 
 __all__ = ["PartsRun", "PartsSimulation", "parts_mjcf", "simulate_parts"]
@@ -95,19 +95,12 @@ class PartsRun:
 
 
 @dataclass(frozen=True)
-class PartsSimulation:
+class PartsSimulation(Runs):
     """Outcome of :func:`simulate_parts`: a :class:`PartsRun` per foot set."""
 
     runs: tuple[PartsRun, ...]
     mu: float
     motion: Trajectory
-
-    @property
-    def passed(self) -> bool:
-        return all(r.passed for r in self.runs)
-
-    def lines(self) -> list[str]:
-        return [r.line(k, len(self.runs)) for k, r in enumerate(self.runs, 1)]
 
     def summary(self) -> str:
         delivered = min(sum(r.in_goal.values()) for r in self.runs)

@@ -9,6 +9,7 @@ documented in the README.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -115,8 +116,10 @@ class Scene:
         return self.tolerance_position + reach * self.tolerance_angle
 
 
-def load_scene(path: str | Path) -> Scene:
-    """Read and validate a YAML scene file.
+def load_scene(path: str | Path, parse: Callable[..., Any] | None = None) -> Any:
+    """Read and validate a one-part YAML scene file (``planner.load_scene`` reads either kind,
+    :mod:`.scene_file`), with ``parse`` (default: :func:`parse_scene`) given the mapping, the
+    file's stem as the default name and its path.
 
     Raises
     ------
@@ -124,7 +127,7 @@ def load_scene(path: str | Path) -> Scene:
         If the file cannot be read or any field is missing, unknown or invalid.
     """
     path = Path(path)
-    return parse_scene(read_yaml(path, "scene"), default_name=path.stem, path=str(path))
+    return (parse or parse_scene)(read_yaml(path, "scene"), default_name=path.stem, path=str(path))
 
 
 def plain_scene(scene: Scene) -> dict[str, Any]:

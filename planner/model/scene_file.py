@@ -13,7 +13,6 @@ from typing import Any
 
 from . import scene
 from .parts import PartsScene, parse_parts_scene
-from .yaml_file import read_yaml
 
 __all__ = ["load_scene", "parse_scene"]
 
@@ -40,5 +39,4 @@ def load_scene(path: str | Path) -> scene.Scene | PartsScene:
     SceneError
         If the file cannot be read or any field is missing, unknown or invalid.
     """
-    path = Path(path)
-    return parse_scene(read_yaml(path, "scene"), default_name=path.stem, path=str(path))
+    return scene.load_scene(path, parse_scene)
