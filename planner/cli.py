@@ -39,7 +39,8 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -502,7 +503,14 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
     executed = simulation.executed_files(scene.name) if motion is not None and inputs.closed_loop and simulation is not None else []
     executed = executed[:1] + ([f"... {executed[-1]}"] if len(executed) > 1 else [])
     extra = f"{f', {scene.name}.trajectory.csv' if motion else ''}{''.join(f', {f}' for f in executed)}{f', {scene.name}-reach.png' if reach else ''}"
-    lines = [f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}"]
+    return _report(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}", check, simulation, out)
+
+
+def _report(head: str, check, simulation, out: Path) -> int:
+    """Print ``head``, then ``check``'s (a verification's) and ``simulation``'s lines and
+    summaries where given, the last line saying where the files are; the exit code: 3 if either
+    failed, else 0."""
+    lines = [head]
     if check is not None:
         lines += [*check.lines(), f"{check.summary()} in {check.seconds:.1f} s"]
     if simulation is not None:
@@ -542,30 +550,20 @@ def _plan_parts(inputs: Inputs) -> int:
         from .execution.parts_sim import simulate_parts  # MuJoCo is loaded only for --simulate
 
         simulation = simulate_parts(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset)
-    try:
-        with staged_folder(out) as stage:
-            from .outputs.parts_recording import write_parts_recording  # rerun: only now
+    with _writing(out, scene.name) as stage:
+        from .outputs.parts_recording import write_parts_recording  # rerun: only now
 
-            write_parts_recording(stage / f"{scene.name}.rrd", scene, result)
-            if motion is not None:
-                motion.write_csv(stage / f"{scene.name}.trajectory.csv")
-            write_atomic(stage / f"{scene.name}.json", result.to_json())
-    except OSError as err:
-        raise _NotWritten(f"cannot write {shown(str(err.filename or out))}: {err.strerror or err}") from None
+        write_parts_recording(stage / f"{scene.name}.rrd", scene, result)
+        if motion is not None:
+            motion.write_csv(stage / f"{scene.name}.trajectory.csv")
+        write_atomic(stage / f"{scene.name}.json", result.to_json())
     if not result.solved:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
         return 2
     head = (f"loaded {inputs.plan_path}: {result.contents()}" if inputs.given is not None
             else f"solved: {result.headline()}, planning time {result.planning_time_s:.2f} s")
     extra = f", {scene.name}.trajectory.csv" if motion is not None else ""
-    lines = [f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}"]
-    for report in (check, simulation):
-        if report is not None:
-            lines += [*report.lines(), report.summary()]
-    if len(lines) > 1:
-        lines[-1] += f" (outputs in {out})"
-    print("\n".join(lines))
-    return 0 if all(r is None or r.passed for r in (check, simulation)) else 3
+    return _report(f"{head} -> {out}/{scene.name}.json, {scene.name}.rrd{extra}", check, simulation, out)
 
 
 def _export_scene(scene: Scene, inputs: Inputs) -> None:
@@ -617,24 +615,33 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
     loop's runs (``closed``) are drawn in the recording on their own clocks, their re-plans with
     them; with ``motion``, each run's executed pusher path is written beside it,
     ``<name>.executed.csv`` (the first run) and ``<name>.executed-<k>.csv`` (run k >= 2)."""
+    with _writing(out, scene.name) as stage:
+        # An open-loop run is drawn against its plan; a closed loop's runs against their own clocks.
+        write_recording(stage / f"{scene.name}.rrd", scene, result, check, reach, None if closed else simulation,
+                        simulation if closed else None)
+        if reach is not None:
+            from .queries.reachable_set import write_png
+
+            with atomic_path(stage / f"{scene.name}-reach.png") as tmp:
+                write_png(reach, scene, str(tmp))
+        if motion is not None:
+            motion.write_csv(stage / f"{scene.name}.trajectory.csv")
+            if closed and simulation is not None:
+                simulation.write_executed(stage, scene.name)
+        if simulation is not None and mjcf is not None:
+            simulation.write_mjcf(_within(mjcf, out, stage), scene)
+        write_atomic(stage / f"{scene.name}.json", result.to_json())
+
+
+@contextmanager
+def _writing(out: Path, name: str) -> Iterator[Path]:
+    """The folder to write ``out``'s files in (:func:`~planner.model.files.staged_folder`: a new
+    ``out`` appears whole); a file that cannot be written, or a failed recording ``<name>.rrd``,
+    is :class:`_NotWritten` naming the file as the user named it."""
     stage = out
     try:
         with staged_folder(out) as stage:
-            # An open-loop run is drawn against its plan; a closed loop's runs against their own clocks.
-            write_recording(stage / f"{scene.name}.rrd", scene, result, check, reach, None if closed else simulation,
-                            simulation if closed else None)
-            if reach is not None:
-                from .queries.reachable_set import write_png
-
-                with atomic_path(stage / f"{scene.name}-reach.png") as tmp:
-                    write_png(reach, scene, str(tmp))
-            if motion is not None:
-                motion.write_csv(stage / f"{scene.name}.trajectory.csv")
-                if closed and simulation is not None:
-                    simulation.write_executed(stage, scene.name)
-            if simulation is not None and mjcf is not None:
-                simulation.write_mjcf(_within(mjcf, out, stage), scene)
-            write_atomic(stage / f"{scene.name}.json", result.to_json())
+            yield stage
     except OSError as err:
         named = str(err.filename or out)
         if Path(named).parent == out.parent and Path(named).name.startswith(f".{out.name}."):
@@ -642,8 +649,7 @@ def _write_outputs(out: Path, scene: Scene, result: Plan, check: Verification | 
         named = named.replace(str(stage), str(out), 1)  # a file as the user named it
         raise _NotWritten(f"cannot write {shown(named)}: {err.strerror or err}") from None
     except RecordingFailed as err:
-        raise _NotWritten(f"cannot write {shown(str(out / f'{scene.name}.rrd'))}: the recording failed: {err}") from None
-
+        raise _NotWritten(f"cannot write {shown(str(out / f'{name}.rrd'))}: the recording failed: {err}") from None
 
 
 def _check_writable(folder: Path, named: Path) -> None:

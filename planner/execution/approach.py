@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike
 
 from ..actions.transit import TransitPlanner, backed_off, edge_contact_pose, in_plane_moves, path_duration, standoff
 from ..model.bodies import pusher_frame_body, slider_at
-from ..model.plan_file import Plan, Push, Transit
+from ..model.plan_file import Plan, Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
@@ -46,8 +46,7 @@ CLEARANCE = 0.0005
 
 def first_edge(plan: Plan) -> int:
     """The edge the pusher is on when ``plan`` begins."""
-    first = plan.segments[0]
-    return first.edge if isinstance(first, Push) else first.from_edge
+    return plan.segments[0].from_edge
 
 
 def lead_in_pose(scene: Scene, model: CollisionModel, plan: Plan) -> np.ndarray:

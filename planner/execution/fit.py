@@ -225,9 +225,8 @@ def _fit_transfer(scene: PartsScene, transfer: Transfer, poses: dict[str, np.nda
     """Refuse ``transfer`` (segment ``index``) unless it leaves ``before``'s part from its last contact, reaches
     ``after``'s first contact, and its in-plane moves keep clear of the obstacles and walls."""
     name = f"plan.segments[{index}]"
-    last, first = before.segments[-1], after.segments[0]
-    ends = ((transfer.pusher_path[0], before.part, last.edge), (transfer.pusher_path[-1], after.part,
-                                                                  first.edge if first.kind == "push" else first.from_edge))
+    ends = ((transfer.pusher_path[0], before.part, before.segments[-1].edge),
+            (transfer.pusher_path[-1], after.part, after.segments[0].from_edge))
     for pose, part, edge in ends:
         flush = edge_contact_pose(scene.part(part).slider, edge, poses[part])
         if np.abs(pose[:2] - flush[:2]).max() > 1e-9 or abs(float(wrap_angle(pose[2] - flush[2]))) > 1e-9:

@@ -75,7 +75,7 @@ from .approach import first_edge, lead_in_pose
 from .trajectory import Trajectory, planned_part, trajectory
 
 __all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Runs", "Simulation", "document", "feet", "mjcf",
-           "needs_mujoco", "part_body", "table", "World", "perturbations", "simulate", "support_centre", "write_mjcf"]
+           "needs_mujoco", "part_body", "part_pairs", "table", "World", "perturbations", "simulate", "support_centre", "write_mjcf"]
 
 #: The one line ``plan --simulate`` prints (after ``plan: error: --simulate: ``) without MuJoCo.
 MISSING = "needs MuJoCo: pip install 'stablepush[mujoco]'"
@@ -267,6 +267,16 @@ def part_body(name: str, prefix: str, slider: Slider, support: Feet) -> tuple[li
     return assets, body, geoms, pairs
 
 
+def part_pairs(geoms: list[str], blocks: list[str], mu: float) -> list[str]:
+    """The contacts of a part's ``geoms``: with the pusher (friction ``mu``), and with the walls
+    and obstacles (``blocks``; frictionless, there only to be detected)."""
+    pairs = []
+    for g in geoms:
+        pairs.append(f'<pair geom1="pusher" geom2="{g}" condim="3" friction="{mu} {mu} 0 0 0" />')
+        pairs += [f'<pair geom1="{b}" geom2="{g}" condim="1"/>' for b in blocks]
+    return pairs
+
+
 def mjcf(scene: Scene, support: Feet, mu: float | None = None, start: ArrayLike | None = None,
          keys: ArrayLike | None = None) -> str:
     """The MuJoCo model (MJCF XML) of ``scene`` with the part on ``support``'s feet, starting at
@@ -279,9 +289,7 @@ def mjcf(scene: Scene, support: Feet, mu: float | None = None, start: ArrayLike 
     mu = scene.pusher.mu if mu is None else mu
     assets, world, blocks = table(scene)
     part_assets, body, geoms, pairs = part_body("part", "part", scene.slider, support)
-    for g in geoms:
-        pairs.append(f'<pair geom1="pusher" geom2="{g}" condim="3" friction="{mu} {mu} 0 0 0" />')
-        pairs += [f'<pair geom1="{b}" geom2="{g}" condim="1"/>' for b in blocks]
+    pairs += part_pairs(geoms, blocks, mu)
     pose = scene.start if start is None else np.asarray(start, dtype=float)
     return document(scene, assets + part_assets, world, [body], pairs, _keyframes(pose, len(support.points), keys))
 

@@ -31,7 +31,7 @@ from ..model.parts_plan import PartsPlan
 from ..model.plan_file import Plan
 from ..world.validity import CollisionModel
 from .mujoco_sim import (SETTLE, SLIP, TABLE_MU, TIMESTEP, Feet, Runs, _error, _follower, _lead_in, _numbers, document,
-                         feet, needs_mujoco, part_body, table)
+                         feet, needs_mujoco, part_body, part_pairs, table)
 from .trajectory import Trajectory, parts_trajectory
 
 __all__ = ["PartsRun", "PartsSimulation", "parts_mjcf", "simulate_parts"]
@@ -54,11 +54,10 @@ def parts_mjcf(scene: PartsScene, supports: dict[str, Feet], mu: float | None = 
         pairs += feet_pairs
         qpos += [*np.asarray(starts[part.name], dtype=float), *np.zeros(len(supports[part.name].points))]
     for k, own in enumerate(geoms):
-        for g in own:
-            pairs.append(f'<pair geom1="pusher" geom2="{g}" condim="3" friction="{mu} {mu} 0 0 0"/>')
-            pairs += [f'<pair geom1="{b}" geom2="{g}" condim="1"/>' for b in blocks]
-            pairs += [f'<pair geom1="{g}" geom2="{h}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>'
-                      for other in geoms[k + 1:] for h in other]
+        pairs += part_pairs(own, blocks, mu)
+        # Parts against parts, with the table's friction: a part shoved by another moves as it would.
+        pairs += [f'<pair geom1="{g}" geom2="{h}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>'
+                  for g in own for other in geoms[k + 1:] for h in other]
     return document(scene, assets, world, bodies, pairs, [f'<key name="start" qpos="{_numbers([*qpos, 0, 0, 0, 0])}"/>'])
 
 

@@ -265,11 +265,10 @@ def _read_moves(items: list, starts: Mapping[str, np.ndarray]) -> list[Move]:
         if not np.allclose(segment.start, at[part], atol=1e-9):
             raise SceneError(f"{name}.start", f"is not where part {shown(part)} stands then")
         if transfer is not None or not moves:
-            first_edge = segment.edge if kind == "push" else segment.from_edge
-            if transfer is not None and (transfer.to_part != part or transfer.to_edge != first_edge):
+            if transfer is not None and (transfer.to_part != part or transfer.to_edge != segment.from_edge):
                 raise SceneError(f"plan.segments[{i - 1}]", f"the transfer goes to part {shown(transfer.to_part)}'s edge "
                                                             f"{transfer.to_edge}, but the next segment pushes part "
-                                                            f"{shown(part)}'s edge {first_edge}")
+                                                            f"{shown(part)}'s edge {segment.from_edge}")
             moves.append(Move(part, [segment], transfer))
             transfer = None
         elif moves[-1].part != part:

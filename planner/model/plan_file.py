@@ -102,6 +102,11 @@ class Push:
         """The same push begun at ``start``."""
         return Push.along(self.edge, self.contact, self.twist, self.duration, start)
 
+    @property
+    def from_edge(self) -> int:
+        """The edge the pusher is on as the push begins (as a :class:`Transit`'s): its own."""
+        return self.edge
+
     def cf_path_length(self, cf: np.ndarray) -> float:
         """Distance the centre of friction travels: its speed is constant under a constant twist."""
         return float(np.linalg.norm(point_velocity(self.twist, cf)) * self.duration)

@@ -25,10 +25,9 @@ the session that runs this search (``Planner`` of a multi-part scene).
 from __future__ import annotations
 
 import time
-from typing import Protocol
-from collections.abc import Mapping
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import shapely
@@ -41,14 +40,6 @@ from ..model.parts_plan import Move, PartsPlan
 from ..model.plan_file import Plan
 from ..search.transfer import TransferPaths
 
-
-class PartSession(Protocol):
-    """What the search asks of a one-part session (:class:`~planner.queries.session.Planner`)."""
-
-    def certify_unreachable(self, goal: np.ndarray) -> str | None: ...
-
-    def plan(self, *, goal: np.ndarray, seed: int, time_limit: float) -> Plan: ...
-
 __all__ = ["BUFFER_TRIES", "MOVE_SHARE", "PartSession", "plan_parts"]
 
 #: Buffer poses tried for one part in one state, nearest its way first.
@@ -57,6 +48,14 @@ BUFFER_TRIES = 4
 MOVE_SHARE = 0.1
 #: Rounding of poses (metres, radians) by which a state counts as seen.
 _SEEN = 3
+
+
+class PartSession(Protocol):
+    """What the search asks of a one-part session (:class:`~planner.queries.session.Planner`)."""
+
+    def certify_unreachable(self, goal: np.ndarray) -> str | None: ...
+
+    def plan(self, *, goal: np.ndarray, seed: int, time_limit: float) -> Plan: ...
 
 
 @dataclass
@@ -101,6 +100,8 @@ class _Search:
                  paths: TransferPaths, seed: int, deadline: float, limit: float, hopeless: tuple[str, ...] = ()):
         self.scene, self.session_of, self.paths, self.seed, self.deadline = scene, session_of, paths, seed, deadline
         self.hopeless = hopeless
+        #: Each part's outline at its goal (goals do not move; every state asks for them).
+        self.goals = {p.name: scene.body(p.name, p.goal) for p in scene.parts}
         self.per_move = max(1.0, MOVE_SHARE * limit)
         self.seen: set[tuple] = set()
         self.best = _Best([], -1)
@@ -128,14 +129,13 @@ class _Search:
             return None
         self.seen.add(key)
         bodies = {n: scene.body(n, poses[n]) for n in scene.names}
-        free = [n for n in pending if not any(bodies[m].intersects(scene.body(n, scene.part(n).goal))
-                                              for m in scene.names if m != n)]
+        free = [n for n in pending if not any(bodies[m].intersects(self.goals[n]) for m in scene.names if m != n)]
         for name in self._order(free, poses):
             if (found := self._try(poses, moves, buffers, name, scene.part(name).goal)) is not None:
                 return found
         if buffers >= len(scene.names):
             return None
-        for name in self._blockers(pending, poses, bodies):
+        for name in self._blockers(pending, bodies):
             if moves and moves[-1].part == name:  # from one buffer pose to another: nothing gained
                 continue
             for spot in self._buffers(name, poses, bodies, pending):
@@ -170,7 +170,7 @@ class _Search:
         transfer = None
         if moves:
             last = moves[-1]
-            edge = plan.segments[0].edge if plan.segments[0].kind == "push" else plan.segments[0].from_edge
+            edge = plan.segments[0].from_edge
             leave = edge_contact_pose(self.scene.part(last.part).slider, last.segments[-1].edge, last.end)
             reach = edge_contact_pose(self.scene.part(name).slider, edge, plan.start)
             transfer = self.paths.find(poses, last.part, leave, name, edge, reach, self.seed)
@@ -188,17 +188,14 @@ class _Search:
         ways = {n: shapely.LineString([poses[n][:2], scene.part(n).goal[:2]]) for n in names}
 
         def blocking(n: str) -> float:
-            goal = scene.body(n, scene.part(n).goal)
-            near = [goal.distance(ways[m]) for m in names if m != n]
+            near = [self.goals[n].distance(ways[m]) for m in names if m != n]
             return -min(near) if near else 0.0
 
         return sorted(names, key=lambda n: (blocking(n), n))
 
-    def _blockers(self, pending: list[str], poses: Mapping[str, np.ndarray], bodies: dict) -> list[str]:
+    def _blockers(self, pending: list[str], bodies: dict) -> list[str]:
         """The parts to push aside: those standing on a pending part's goal, then the rest pending."""
-        scene = self.scene
-        goals = [scene.body(n, scene.part(n).goal) for n in pending]
-        on_goal = [n for n in pending if any(bodies[n].intersects(g) for m, g in zip(pending, goals) if m != n)]
+        on_goal = [n for n in pending if any(bodies[n].intersects(self.goals[m]) for m in pending if m != n)]
         return on_goal + [n for n in pending if n not in on_goal]
 
     def _buffers(self, name: str, poses: Mapping[str, np.ndarray], bodies: dict, pending: list[str]) -> list[np.ndarray]:
@@ -215,7 +212,7 @@ class _Search:
                              np.arange(ymin + radius, ymax - radius + 1e-12, step))
         spots = np.column_stack([xs.ravel(), ys.ravel(), np.full(xs.size, poses[name][2])])
         taken = [*scene.obstacles, *(b for n, b in bodies.items() if n != name),
-                 *(scene.body(n, scene.part(n).goal) for n in pending)]
+                 *(self.goals[n] for n in pending)]
         keep = shapely.union_all(taken).buffer(room) if taken else shapely.Polygon()
         inside = shapely.box(xmin, ymin, xmax, ymax)
         outlines = [slider_at(part.slider.polygon, s) for s in spots]
