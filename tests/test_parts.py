@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -145,6 +146,9 @@ def test_cli_plans_a_multi_part_scene(tmp_path):
     assert done.returncode == 0, done.stderr
     line = done.stdout.strip()
     assert line.startswith("solved: 2 parts, 3 moves (1 buffer), ") and line.endswith("swap.rrd, swap.trajectory.csv")
+    # The README's "Several parts" shows this line, times left out.
+    [said] = [row for row in Path("README.md").read_text().splitlines() if row.startswith("solved: 2 parts, ")]
+    assert line.split(", planning time")[0] == said.split(", planning time")[0]
     csv = (tmp_path / "out" / "swap.trajectory.csv").read_text().splitlines()
     assert csv[0].endswith(",segment,part") and {row.rsplit(",", 1)[1] for row in csv[1:]} == {"red", "blue"}
     data = json.loads((tmp_path / "out" / "swap.json").read_text())
