@@ -16,8 +16,8 @@ True
 ['reachable', 'unreachable']
 
 :func:`plan` and :func:`reachability` are the same asked once of a fresh session. A scene of
-several parts (``parts:``, a :class:`PartsScene`) gets a :class:`PartsPlanner`, whose plan moves
-every part to its goal in an order it searches for, pushing parts aside where it must:
+several parts (``parts:``) is planned as a whole: the plan moves every part to its goal in an
+order the session searches for, pushing parts aside where it must:
 
 >>> tray = Planner(load_scene("scenes/parts/swap.yaml")).plan()     # two blocks trade places
 >>> tray.solved, [m.part for m in tray.moves]
@@ -45,22 +45,21 @@ if TYPE_CHECKING:
     from .execution.verify import Verification, verify
     from .model.fields import SceneError
     from .model.options import DEFAULT_PLANNER, PlannerOptions
-    from .model.plan_file import Plan, Push, Transit, load_plan
-    from .model.parts import PartsScene
-    from .model.parts_plan import PartsPlan, load_parts_plan
-    from .model.scene import Scene
+    from .model.plan import Move, Plan
+    from .model.plan_file import load_plan
+    from .model.scene import Part, Scene
     from .model.scene_file import load_scene, parse_scene
+    from .model.segments import Push, Transfer, Transit
     from .queries.controllability import SceneControllability, controllability
     from .queries.one_step import OneStep, one_step
     from .queries.reachability import Reach, certify_unreachable
     from .queries.reachable_set import ReachableSet, reachable_set
-    from .queries.session import PartsPlanner, Planner, plan, reachability
+    from .queries.session import Planner, plan, reachability
 
 __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Planner", "PlannerOptions", "Reach", "Scene", "SceneError", "Push", "Transit",
            "certify_unreachable", "load_plan", "load_scene", "one_step", "parse_scene", "plan", "reachability",
            "Verification", "verify", "fit_plan", "SceneControllability", "controllability", "ReachableSet",
-           "reachable_set", "Trajectory", "trajectory", "Simulation", "simulate", "PartsScene", "PartsPlan",
-           "PartsPlanner", "load_parts_plan"]
+           "reachable_set", "Trajectory", "trajectory", "Simulation", "simulate", "Part", "Move", "Transfer"]
 
 #: Every public name is imported on first use, from its module: ``import planner`` itself loads
 #: nothing (the ``plan`` command sets up the process before numpy is loaded, planner.cli), and the
@@ -68,11 +67,10 @@ __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Planner", "PlannerOptions", "R
 #: (tests/test_startup.py).
 _ON_FIRST_USE = {
     "SceneError": ".model.fields", "DEFAULT_PLANNER": ".model.options", "PlannerOptions": ".model.options",
-    "Planner": ".queries.session",
-    "Plan": ".model.plan_file", "Push": ".model.plan_file", "Transit": ".model.plan_file",
-    "load_plan": ".model.plan_file", "Scene": ".model.scene", "load_scene": ".model.scene_file",
-    "parse_scene": ".model.scene_file", "PartsScene": ".model.parts", "PartsPlan": ".model.parts_plan",
-    "load_parts_plan": ".model.parts_plan", "PartsPlanner": ".queries.session", "OneStep": ".queries.one_step", "one_step": ".queries.one_step",
+    "Planner": ".queries.session", "Plan": ".model.plan", "Move": ".model.plan", "Push": ".model.segments",
+    "Transit": ".model.segments", "Transfer": ".model.segments", "load_plan": ".model.plan_file",
+    "Scene": ".model.scene", "Part": ".model.scene", "load_scene": ".model.scene_file",
+    "parse_scene": ".model.scene_file", "OneStep": ".queries.one_step", "one_step": ".queries.one_step",
     "Reach": ".queries.reachability", "certify_unreachable": ".queries.reachability",
     "reachability": ".queries.session", "plan": ".queries.session",
     "SceneControllability": ".queries.controllability", "controllability": ".queries.controllability",

@@ -16,7 +16,7 @@ pushes (:func:`planner.queries.reachable_set.reachable_set`, any heading): ``<na
 output folder and ``/world/reach`` in the recording; with ``--engine`` (and ``--jobs``) its headings
 are computed on the batch executors (:func:`planner.batch.reach.reachable_set_on`). Several scenes,
 or ``--seeds``, make a batch instead (:mod:`planner.batch.command`). ``--export-scene FILE`` also
-writes the scene as planned in the plain schema (:func:`planner.model.scene.write_scene`: CAD
+writes the scene as planned in the plain schema (:func:`planner.model.scene_file.write_scene`: CAD
 files and boxes resolved to vertices, the CF written out).
 
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
@@ -67,16 +67,16 @@ _LOADING = ({s: signal.signal(s, _stop_while_loading) for s in (signal.SIGINT, s
 from .model.fields import SceneError, shown  # noqa: E402 (after the environment is set)
 from .model.extras import have, needs
 from .model.files import atomic_path, staged_folder, write_atomic
-from .model.plan_file import Plan, load_plan
+from .model.plan import Plan
+from .model.plan_file import load_plan
 from .model.stop import Terminated, raise_on_sigterm
 from .queries.reachability import certify_unreachable
 from .outputs.recorder import RecordingFailed, recorder
 from .actions.region_cache import cache_folder
 from .model.options import (DEFAULT_PLANNER, DEFAULT_REGIONS, DEFAULT_SWITCH_COST, DEFAULT_TRANSIT, MAX_OPTIMIZE,
                             MAX_SEED, MAX_TIME_LIMIT, PLANNERS, REGIONS, TRANSITS, PlannerOptions)
-from .model.parts import PartsScene
-from .model.parts_plan import PartsPlan
-from .model.scene import Scene, placement_fault, write_scene
+from .model.scene import Scene
+from .model.scene_file import placement_fault, write_scene
 from .model.scene_file import load_scene
 from .queries.session import plan
 
@@ -204,14 +204,14 @@ def _parser() -> argparse.ArgumentParser:
 class Inputs:
     """A command line, checked: the scene with the flags applied, and what to do with it."""
 
-    scene: Scene | PartsScene  # with --regions and --transit applied
+    scene: Scene  # with --regions and --transit applied
     planner: str
     time_limit: float
     seed: int
     out: Path  # the output folder (not created yet)
     verify: int | None  # --verify N
     plan_path: str | None  # --plan FILE
-    given: Plan | PartsPlan | None  # that file's plan, checked against the scene and run from its start, instead of planning
+    given: Plan | None  # that file's plan, checked against the scene and run from its start, instead of planning
     reach: int | None = None  # --reach N: pushes of the reachable-set map
     engine: tuple[str, int | None, str | None] | None = None  # --engine, --jobs, --address: where the map runs
     trajectory: bool = False  # --trajectory: write the pusher's trajectory
@@ -254,14 +254,13 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--resume" if args.resume else "scene", "several scenes, --seeds or --resume make a batch, "
                                                                "which the plan command runs itself (planner.batch)")
     scene = load_scene(args.scene[0])
-    if isinstance(scene, PartsScene):
+    if len(scene.parts) > 1:
         _check_parts(args)
     if args.sim_cf_offset is not None:
         from .execution.mujoco_sim import support_centre
 
-        for one in ([scene.move_scene(n, scene.starts) for n in scene.names] if isinstance(scene, PartsScene)
-                    else [scene]):
-            support_centre(one, args.sim_cf_offset)
+        for name in scene.names:
+            support_centre(scene.move_scene(name, scene.starts), args.sim_cf_offset)
     if args.sim_start_error is not None:  # found now; the rest (the pusher's lead-in, the bumps) once planned
         moved = scene.start + _radians(args.sim_start_error)
         if (fault := placement_fault(scene.slider, scene.obstacles, scene.workspace, moved)) is not None:
@@ -283,11 +282,9 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     if args.export_scene is not None and os.path.isdir(args.export_scene):
         raise SceneError("--export-scene", f"{shown(args.export_scene)} is a folder")
     given = None
-    if args.plan is not None and isinstance(scene, PartsScene):
+    if args.plan is not None and len(scene.parts) > 1:
         from .execution.fit import fit_parts_plan  # with the re-simulator: only for a plan file
-        from .model.parts_plan import load_parts_plan
-
-        given = fit_parts_plan(scene, load_parts_plan(args.plan))
+        given = fit_parts_plan(scene, load_plan(args.plan))
     elif args.plan is not None:
         from .execution.fit import fit_plan  # with the re-simulator: only for a plan file
 
@@ -373,9 +370,9 @@ def _check_simulation(args: argparse.Namespace) -> None:
     needs_mujoco()
 
 
-#: The flags a multi-part scene does not take: maps, scene export, and the closed loop's perturbations.
-_ONE_PART = ("--reach", "--export-scene", "--sim-start-error", "--sim-bump", "--sim-pose-noise", "--closed-loop",
-             "--mjcf", "--engine", "--jobs", "--address")
+#: The flags a multi-part scene does not take yet: maps and the closed loop's perturbations.
+_ONE_PART = ("--reach", "--sim-start-error", "--sim-bump", "--sim-pose-noise", "--closed-loop", "--engine", "--jobs",
+             "--address")
 
 
 def _check_parts(args: argparse.Namespace) -> None:
@@ -423,7 +420,7 @@ class _NotWritten(Exception):
 def _run(inputs: Inputs) -> int:
     for note in inputs.scene.notes:
         print(f"plan: note: {note}", file=sys.stderr)
-    if isinstance(inputs.scene, PartsScene):
+    if len(inputs.scene.parts) > 1:
         return _plan_parts(inputs)
     with recorder(inputs.scene) as write:  # rerun is imported beside the search, where it can be
         return _plan_and_write(inputs, write)
@@ -442,9 +439,9 @@ def _plan_and_write(inputs: Inputs, write_recording: Callable[..., None]) -> int
         clock = time.perf_counter()
         # The geometric certificates need no stable region: a sealed-off goal is answered at once.
         unreachable = certify_unreachable(scene, regions=False)
-        result = (Plan(scene=scene.path, solved=False, planner=name, seed=seed,
-                       planning_time_s=time.perf_counter() - clock, start=scene.start.copy(),
-                       goal=scene.goal.copy(), reason=unreachable) if unreachable
+        result = (Plan.of_part(scene.part().name, scene.start, scene.goal, [], scene=scene.path, solved=False,
+                               planner=name, seed=seed, planning_time_s=time.perf_counter() - clock,
+                               reason=unreachable) if unreachable
                   else plan(scene, seed=seed, time_limit=limit, planner=name, progress=_progress if tty else None))
         if tty:
             print("\r\033[K", end="", file=sys.stderr, flush=True)  # clear the progress line
@@ -528,13 +525,13 @@ def _plan_parts(inputs: Inputs) -> int:
     if inputs.given is not None:
         result = inputs.given
     else:
-        from .queries.session import PartsPlanner
+        from .queries.session import Planner
 
         tty = sys.stderr.isatty()
         if tty:
             print(f"planning {scene.name}: {len(scene.parts)} parts with {inputs.planner} (seed {seed}, limit "
                   f"{inputs.time_limit:g} s) ...", file=sys.stderr, flush=True)
-        result = PartsPlanner(scene, progress=_progress if tty else None).plan()
+        result = Planner(scene, progress=_progress if tty else None).plan()
         if tty:
             print("\r\033[K", end="", file=sys.stderr, flush=True)
     check = motion = simulation = None
@@ -543,19 +540,23 @@ def _plan_parts(inputs: Inputs) -> int:
 
         check = verify_parts(scene, result, inputs.verify, seed)
     if inputs.trajectory and result.solved:
-        from .execution.trajectory import parts_trajectory  # loads ruckig, only for --trajectory
+        from .execution.trajectory import trajectory  # loads ruckig, only for --trajectory
 
-        motion = parts_trajectory(scene, result)
+        motion = trajectory(scene, result)
     if inputs.simulate and result.solved:
         from .execution.parts_sim import simulate_parts  # MuJoCo is loaded only for --simulate
 
         simulation = simulate_parts(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset)
+    if inputs.export_scene is not None:
+        _export_scene(scene, inputs)
     with _writing(out, scene.name) as stage:
         from .outputs.parts_recording import write_parts_recording  # rerun: only now
 
         write_parts_recording(stage / f"{scene.name}.rrd", scene, result)
         if motion is not None:
             motion.write_csv(stage / f"{scene.name}.trajectory.csv")
+        if simulation is not None and inputs.mjcf is not None:
+            simulation.write_mjcf(_within(inputs.mjcf, out, stage), scene)
         write_atomic(stage / f"{scene.name}.json", result.to_json())
     if not result.solved:
         print(f"plan: not solved: {result.reason} (outputs in {out})", file=sys.stderr)
@@ -578,8 +579,8 @@ def _first_found(result: Plan) -> str:
     """What the first plan cost and when it was found, when improvement rounds found better ones
     (cost against time: the answer only got better), else nothing.
 
-    >>> plan = Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=2.5, start=[0, 0, 0],
-    ...             goal=[0, 0, 0], improvements=[(0.4, 1.2, 0.95), (1.1, 0.8, 0.55)])
+    >>> plan = Plan.of_part("part", [0, 0, 0], [0, 0, 0], [], scene=None, solved=True, planner="rrt", seed=1,
+    ...                     planning_time_s=2.5, improvements=[(0.4, 1.2, 0.95), (1.1, 0.8, 0.55)])
     >>> _first_found(plan)
     ' (first plan: cost 1.200 m at 0.40 s; 1 better, the last at 1.10 s)'
     """

@@ -27,7 +27,7 @@ trimesh = pytest.importorskip("trimesh")
 from planner.cli import main  # noqa: E402 (after the skips)
 from planner.model.cad import MAX_FILE_BYTES  # noqa: E402
 from planner.model.fields import SceneError  # noqa: E402
-from planner.model.scene import load_scene, parse_scene  # noqa: E402
+from planner.model.scene_file import load_scene, parse_scene  # noqa: E402
 from test_cli import assert_nothing_written, error_field  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -455,7 +455,7 @@ def test_a_scene_with_an_stl_part_and_an_svg_fixture_plans_and_verifies(tmp_path
 
 def test_a_plain_scene_round_trips_through_its_export(tmp_path):
     scene = load_scene(ROOT / "scenes" / "nonconvex.yaml")
-    from planner.model.scene import write_scene
+    from planner.model.scene_file import write_scene
 
     write_scene(scene, tmp_path / "again.yaml")
     again = load_scene(tmp_path / "again.yaml")

@@ -31,7 +31,7 @@ from planner.model import files
 from planner.cli import main
 from planner.model.files import write_atomic
 from planner.model.options import DEFAULT_PLANNER
-from planner.model.scene import load_scene
+from planner.model.scene_file import load_scene
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "scenes"

@@ -187,7 +187,7 @@ def test_invariant_under_positive_scaling_and_rotation_of_the_slider_frame():
 # --- scenes: the paper's cases ----------------------------------------------------------------
 
 def test_one_edge_of_a_rectangle_is_controllable_not_stlc(parking):
-    c = controllability(with_pusher(parking, edges=(0,)))
+    c = controllability(parking.with_part(edges=(0,)))
     assert c.controllable and not c.stlc and c.stlc_edges == ()
     assert c.summary() == ("controllable (edge 0); not small-time locally controllable: one edge never is "
                            "(it cannot pull back)")
@@ -196,7 +196,7 @@ def test_one_edge_of_a_rectangle_is_controllable_not_stlc(parking):
 @pytest.mark.parametrize("edges", [(0, 2), (1, 3)])
 def test_two_opposite_edges_of_a_rectangle_are_stlc(parking, edges):
     """The corollary to Thm. 7: a rectangle with the CF inside, pushed on two opposing edges."""
-    c = controllability(with_pusher(parking, edges=edges))
+    c = controllability(parking.with_part(edges=edges))
     assert c.stlc and c.stlc_edges == edges and c.opposite
     assert not any(e.stlc for e in c.per_edge.values())  # it takes both
 
@@ -204,8 +204,8 @@ def test_two_opposite_edges_of_a_rectangle_are_stlc(parking, edges):
 def test_stable_regions_too(parking):
     """Thm. 7 is about procedure STABLE's pushes, inside the exact ones."""
     scene = dataclasses.replace(parking, planner=dataclasses.replace(parking.planner, regions="stable"))
-    assert controllability(with_pusher(scene, edges=(0, 2))).stlc
-    assert not controllability(with_pusher(scene, edges=(0,))).stlc
+    assert controllability(scene.with_part(edges=(0, 2))).stlc
+    assert not controllability(scene.with_part(edges=(0,))).stlc
 
 
 def test_an_edge_with_no_stable_push_is_skipped():
@@ -222,7 +222,7 @@ def test_no_stable_push_at_all_is_not_accessible():
 
 
 def test_refused_method_is_not_reported_as_no_push(parking):
-    scene = dataclasses.replace(parking, cf_uncertainty=0.001,
+    scene = dataclasses.replace(parking.with_part(cf_uncertainty=0.001),
                                 planner=dataclasses.replace(parking.planner, regions="stable"))
     with pytest.raises(SceneError, match="planner.regions"):
         controllability(scene)

@@ -54,6 +54,6 @@ def test_a_shortened_plan_changes_edge_only_by_a_transit(goal):
     edge's car and the rest on the old edge, the pusher jumping between edges unseen. The plan
     must replay: every push on the edge the pusher is on, a transit between edges."""
     scene = load_scene(ROOT / "scenes" / "parking.yaml")
-    found = plan(replace(scene, goal=np.array(goal)), seed=1, time_limit=10.0)
+    found = plan(scene.with_part(goal=goal), seed=1, time_limit=10.0)
     assert found.solved
     replay_plan(yaml.safe_load((ROOT / "scenes" / "parking.yaml").read_text()), found.to_dict(), goal)

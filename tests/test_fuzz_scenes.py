@@ -34,7 +34,8 @@ from hypothesis import strategies as st
 from planner import load_scene
 from planner.cli import read_inputs
 from planner.model.fields import ANGLE, LENGTH, SceneError
-from planner.model.scene import MIN_SIZE, Scene
+from planner.model.scene import Scene
+from planner.model.scene_file import MIN_SIZE
 from test_cli import BATTERY
 from test_hostile_scenes import STAR, alias_bomb
 
@@ -264,7 +265,7 @@ def assert_sane(scene: Scene) -> None:
     """What an accepted scene promises: poses in range, angles wrapped, pushable edges."""
     for pose in (scene.start, scene.goal):
         assert np.all(np.abs(pose[:2]) <= LENGTH.bound) and -math.pi <= pose[2] < math.pi
-    assert scene.pusher.edges and all(scene.slider.is_pushable(e) for e in scene.pusher.edges)
+    assert scene.edges and all(scene.slider.is_pushable(e) for e in scene.edges)
     assert MIN_SIZE <= min(scene.pusher.width, scene.pusher.depth)
 
 

@@ -68,7 +68,7 @@ def test_empty_table_is_the_straight_line_less_the_tolerance():
         for direction in np.linspace(0.0, 2 * math.pi, 36, endpoint=False):
             pose = [0.3 + 0.01 * math.cos(direction), 0.2 + 0.01 * math.sin(direction), math.pi / 2 + angle]
             assert np.hypot(*(cf_at(scene, pose) - start)) >= bound
-    assert geodesic_bound(replace(scene, goal=np.array([0.005, 0.0, 0.0]))) == 0.0  # already within tolerance
+    assert geodesic_bound(scene.with_part(goal=[0.005, 0.0, 0.0])) == 0.0  # already within tolerance
 
 
 def test_box_between_start_and_goal_goes_over_its_grown_top():
@@ -118,7 +118,7 @@ def test_start_outside_the_free_space_falls_back_to_the_straight_line():
     # Not a valid scene (the part overlaps the box at the start), built round the checks: the
     # geodesic has no start to leave from, and the straight line, sound for any path, is kept.
     scene = scene_of([{"box": {"center": [0.0, 0.0], "size": [0.2, 0.2]}}], [-0.35, 0.05, 0.0], [0.35, 0.05, 0.0])
-    inside = replace(scene, start=np.array([-0.12, 0.05, 0.0]))
+    inside = scene.with_part(start=[-0.12, 0.05, 0.0])
     assert geodesic_bound(inside) == pytest.approx(0.47 - 0.01, abs=1e-12)
 
 
@@ -129,10 +129,10 @@ def moved(scene: Scene, scale: float, shift: tuple[float, float]) -> Scene:
     def pose(p):
         return np.array([*(scale * p[:2] + shift), p[2]])
 
-    return replace(scene, slider=Slider(scene.slider.vertices * scale, scene.slider.cf * scale),
-                   obstacles=tuple(shapely.transform(o, lambda xy: scale * xy + shift) for o in scene.obstacles),
+    moved = scene.with_part(slider=Slider(scene.slider.vertices * scale, scene.slider.cf * scale),
+                            start=pose(scene.start), goal=pose(scene.goal))
+    return replace(moved, obstacles=tuple(shapely.transform(o, lambda xy: scale * xy + shift) for o in scene.obstacles),
                    workspace=tuple(scale * np.asarray(scene.workspace) + np.tile(shift, 2)),
-                   start=pose(scene.start), goal=pose(scene.goal),
                    tolerance_position=scene.tolerance_position * scale)
 
 

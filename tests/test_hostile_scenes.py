@@ -20,7 +20,7 @@ import yaml
 
 from planner.cli import main
 from planner.model.fields import SceneError
-from planner.model.scene import _simple_polygon, load_scene
+from planner.model.scene_file import _simple_polygon, load_scene
 from test_cli import BATTERY_TEXT, VERTICES, assert_nothing_written, battery, error_field, nested, run_plan, write
 
 #: An eight-pointed star: its vertices alternate between two radii, so no edge lies on its hull.

@@ -21,7 +21,7 @@ import pytest
 
 from planner import load_scene, plan
 from planner.cli import main
-from planner.model.plan_file import Plan
+from planner.model.plan import Plan
 from test_recording import rrd_rows
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -127,8 +127,8 @@ def test_a_lift_alone_leaves_the_part_where_it_is():
     scene = load_scene(ROOT / "scenes" / "narrow_junction.yaml")
     result = plan(scene, seed=1)
     lift = next(s for s in result.segments if s.kind == "transit" and s.mode == "lift")
-    alone = Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=lift.pose, goal=lift.pose,
-                 segments=[lift])
+    alone = Plan.of_part("part", lift.pose, lift.pose, [lift],
+                         scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0)
     (run,) = simulate(scene, alone, n=1).runs
     assert run.collisions == 0 and run.final_error[0] < 5e-5 and run.final_error[1] < 1e-3
     assert run.deviation < 5e-5
@@ -158,11 +158,11 @@ def test_pushes_inside_the_exact_region_stick_and_pushes_outside_slip_in_mujoco(
     import oracle as O
     import planner.execution.mujoco_sim as sim
     from mechanics import exact_region
-    from planner.model.plan_file import Push
+    from planner.model.segments import Push
 
     scene = load_scene(BATTERY)
     slider, pusher = scene.slider, scene.pusher
-    edge = pusher.edges[0]
+    edge = scene.edges[0]
     region = exact_region(slider, edge, pusher.mu, pusher.width)
     polygon, centre = region.section()
     ring = np.asarray(polygon.exterior.coords)[:-1]
@@ -183,8 +183,8 @@ def test_pushes_inside_the_exact_region_stick_and_pushes_outside_slip_in_mujoco(
     def slips(twist, feet):
         speed = max(math.hypot(*twist[:2]), abs(twist[2]) * slider.radius)
         push = Push.along(edge, region.contact, twist, 0.06 / speed, scene.start)
-        one = Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
-                   goal=push.end, segments=[push])
+        one = Plan.of_part("part", scene.start, push.end, [push],
+                           scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0)
         monkeypatch.setattr(sim, "feet", lambda *args, **kwargs: feet)
         return np.array([run.slip for run in sim.simulate(scene, one, n=len(feet)).runs])
 

@@ -13,8 +13,9 @@ import yaml
 
 from planner import Planner, load_scene, parse_scene
 from planner.model.fields import SceneError
-from planner.model.parts import PartsScene
-from planner.model.parts_plan import PartsPlan
+from planner.model.scene import Scene
+from planner.model.plan import Plan
+from planner.model.plan_file import read_plan
 from planner.queries import multi_part
 from replay import replay_parts_plan
 
@@ -27,7 +28,7 @@ def spec_of(name: str) -> dict:
 
 
 @pytest.fixture(scope="module")
-def plans() -> dict[str, PartsPlan]:
+def plans() -> dict[str, Plan]:
     return {name: Planner(load_scene(f"scenes/parts/{name}.yaml"), {"seed": 1, "time_limit": 60}).plan()
             for name in ("channel", "swap", "tray")}
 
@@ -61,26 +62,26 @@ def test_channel_far_part_goes_first_even_when_tried_last(monkeypatch):
 
 def test_plan_file_round_trip_and_doctored_files(plans):
     data = plans["swap"].to_dict()
-    again = PartsPlan.from_dict(json.loads(json.dumps(data)))
+    again = read_plan(json.loads(json.dumps(data)))
     assert again.to_dict() == data
     wrong = copy.deepcopy(data)
     wrong["segments"][0]["part"] = "green"
     with pytest.raises(SceneError, match=r"plan.segments\[0\].part"):
-        PartsPlan.from_dict(wrong)
+        read_plan(wrong)
     moved = copy.deepcopy(data)
     push = next(s for s in moved["segments"] if s["kind"] == "push" and s["part"] != data["segments"][0]["part"])
     push["start"][0] += 0.01
     with pytest.raises(SceneError, match="start"):
-        PartsPlan.from_dict(moved)
+        read_plan(moved)
     dear = copy.deepcopy(data)
     dear["cost"] += 0.1
     with pytest.raises(SceneError, match="plan.cost"):
-        PartsPlan.from_dict(dear)
+        read_plan(dear)
     hop = copy.deepcopy(data)
     k = next(i for i, s in enumerate(hop["segments"]) if s["kind"] == "transfer")
     del hop["segments"][k]
     with pytest.raises(SceneError, match="transfer must come first"):
-        PartsPlan.from_dict(hop)
+        read_plan(hop)
 
 
 def test_transfer_cost_is_a_switch_each(plans):
@@ -127,7 +128,7 @@ def test_a_part_that_stays_put_is_an_obstacle_in_the_way():
     """b stands on a's straight way and must stay: a goes round it, b is never pushed."""
     spec = _scene(**{"parts.1.start": [0.15, 0.0, 90], "parts.1.goal": [0.15, 0.0, 90]})
     scene = parse_scene(spec)
-    assert isinstance(scene, PartsScene)
+    assert len(scene.parts) > 1
     plan = Planner(scene, {"seed": 1, "time_limit": 30}).plan()
     assert plan.solved, plan.reason
     assert [m.part for m in plan.moves] == ["a"]
@@ -183,7 +184,7 @@ def test_channel_simulates_with_every_part_delivered(tmp_path):
 def _shove(tmp_path):
     """A scene where b stands on a's straight way and stays put, and a doctored plan that pushes a
     straight through b (the plan of a alone, as if b were not there)."""
-    from planner.model.parts_plan import Move
+    from planner.model.plan import Move
     from planner.queries.session import plan as plan_one
 
     spec = _scene(**{"parts.1.start": [0.15, 0.0, 90], "parts.1.goal": [0.15, 0.0, 90]})
@@ -191,7 +192,7 @@ def _shove(tmp_path):
     alone = plan_one(parse_scene({"slider": {"vertices": BLOCK}, "pusher": spec["pusher"],
                                   "workspace": spec["workspace"], "start": [0, 0, 0], "goal": [0.3, 0, 0]}), seed=1)
     assert alone.solved
-    doctored = PartsPlan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, starts=scene.starts,
+    doctored = Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, starts=scene.starts,
                          goals=scene.goals, moves=[Move("a", alone.segments)], delivered=("a", "b"),
                          switch_cost=0.25, cfs={p.name: p.slider.cf for p in scene.parts})
     (tmp_path / "shove.yaml").write_text(yaml.safe_dump(spec))

@@ -31,7 +31,7 @@ def test_round_trip(written):
 
 
 @pytest.mark.parametrize("edit, field", [
-    (lambda d: d.update(format="stablepush.plan/2"), "plan.format"),
+    (lambda d: d.update(format="stablepush.plan/9"), "plan.format"),
     (lambda d: d.pop("segments"), "plan.segments"),
     (lambda d: d.update(extra=1), "plan.extra"),
     (lambda d: d.update(solved="yes"), "plan.solved"),

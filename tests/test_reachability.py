@@ -196,7 +196,7 @@ def test_no_goal_plan_solves_is_certified_unreachable():
     for goal in np.vstack([anywhere, ringed]):
         reason = certify_unreachable(scene, goal)
         for seed in (1, 2) if reason else (1,):
-            solved = plan(replace(scene, goal=goal), seed=seed, time_limit=0.3).solved
+            solved = plan(scene.with_part(goal=goal), seed=seed, time_limit=0.3).solved
             assert not (solved and reason), f"goal {goal} solved with seed {seed} but certified: {reason}"
         certified += reason is not None
     assert certified >= 8  # the test does test something

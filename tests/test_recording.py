@@ -281,9 +281,9 @@ def test_the_centre_of_a_turn_stays_put_and_lies_in_its_stable_region(turn, stra
 
 def test_an_unsolved_plan_records_the_scene_and_the_tree(tmp_path):
     scene = write_scene(tmp_path, "stuck", [0.12, 0.0, 0.0])
-    plan = planner.Plan(scene=scene.path, solved=False, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
-                        goal=scene.goal, reason="no plan found",
-                        tree=np.array([[[0.0, 0.0], [0.05, 0.01]], [[0.05, 0.01], [0.08, -0.02]]]))
+    plan = planner.Plan.of_part("part", scene.start, scene.goal, [], scene=scene.path, solved=False, planner="rrt",
+                                seed=1, planning_time_s=0.0, reason="no plan found",
+                                tree=np.array([[[0.0, 0.0], [0.05, 0.01]], [[0.05, 0.01], [0.08, -0.02]]]))
     path = tmp_path / "stuck.rrd"
     recording.write_recording(path, scene, plan)
     verify(path)
@@ -313,8 +313,8 @@ def test_a_long_plan_is_capped_and_its_cf_path_thinned(straight, tmp_path):
         end = exp_twist(pose, twist, duration)
         segments.append(planner.Push(3, np.array(SLIDER[3::-3]), np.array(twist), duration, pose, end))
         pose = end
-    plan = planner.Plan(scene=scene.path, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
-                        goal=pose, segments=segments)
+    plan = planner.Plan.of_part("part", scene.start, pose, segments, scene=scene.path, solved=True, planner="rrt",
+                                seed=1, planning_time_s=0.0)
     path = tmp_path / "long.rrd"
     recording.write_recording(path, scene, plan)
     slider = rrd_rows(path, "/world/slider", "LineStrips3D:strips", "step")
@@ -442,7 +442,7 @@ def segment_frames(plan, times: np.ndarray, k: int) -> np.ndarray:
     return np.flatnonzero((times >= start - 1e-9) & (times < start + plan.segments[k].duration - 1e-9))
 
 
-def the_transit(plan) -> tuple[int, planner.model.plan_file.Transit]:
+def the_transit(plan) -> tuple[int, planner.model.segments.Transit]:
     (k,) = [k for k, s in enumerate(plan.segments) if s.kind == "transit"]
     return k, plan.segments[k]
 

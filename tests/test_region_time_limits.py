@@ -64,7 +64,7 @@ def test_a_many_edged_part_computes_what_fits_and_says_so(empty_cache):
     Edges are begun in order, one per core at a time, so those done are among the first ones
     and those still running at the deadline, at most one per core."""
     scene = parse_scene(many_edged(), "ellipse")
-    edges = scene.pusher.edges
+    edges = scene.edges
     assert len(edges) == 200
     start = time.perf_counter()
     with pytest.raises(RegionTimeout) as caught:
@@ -151,7 +151,7 @@ try:
     plan(scene)
 except SceneError as err:
     p = scene.pusher
-    print(json.dumps([err.field, err.problem, [is_cached(scene.slider, e, p.mu, p.width) for e in p.edges]]))
+    print(json.dumps([err.field, err.problem, [is_cached(scene.slider, e, p.mu, p.width) for e in scene.edges]]))
 """
     folder = tmp_path / "cache"
     run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=120,

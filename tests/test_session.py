@@ -87,7 +87,7 @@ def test_a_part_observed_near_a_wall_is_re_planned_with_the_pushes_margin():
     assert session.plan(seed=1).solved
     start = scene.start + [-0.008, 0.009, math.radians(-2)]
     step = scene.slider.radius / 10  # the search's step (planner.actions.controls.step_length)
-    room = {e: session.model.clearance(start, e) for e in scene.pusher.edges}
+    room = {e: session.model.clearance(start, e) for e in scene.edges}
     assert max(room.values()) < step / 2 and sorted(room.values())[-2] > scene.slider.radius / 40
     with pytest.raises(SceneError) as err:
         session.plan(start=start, seed=1)

@@ -28,8 +28,9 @@ from planner.actions.push import connect
 from planner.actions.switch_pose import Grid, SwitchShortcut, runs
 from planner.actions.transit import TransitPlanner
 from planner.model.bodies import cf_poses
-from planner.model.plan_file import Plan, rechain
-from planner.model.scene import load_scene
+from planner.model.plan import Plan
+from planner.model.segments import rechain
+from planner.model.scene_file import load_scene
 from planner.queries.geodesic import geodesic_bound
 from planner import plan as plan_of
 from planner.world.validity import CollisionModel
@@ -115,8 +116,8 @@ def test_a_long_switching_plan_is_brought_within_5_percent_of_the_grid_optimum(j
     assert len(switches) == 1 and [leg[0].edge for leg in legs] == [PUSH_EAST, PUSH_WEST]
     assert _length(scene, better) <= 1.05 * optimum, (_length(scene, better), optimum, pose)
     assert np.allclose(better[0].start, scene.start) and np.allclose(better[-1].end, scene.goal, atol=1e-9)
-    plan = Plan(scene=str(SCENE), solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
-                goal=scene.goal, segments=better)
+    plan = Plan.of_part("part", scene.start, scene.goal, better,
+                        scene=str(SCENE), solved=True, planner="rrt", seed=1, planning_time_s=0.0)
     replay_plan(yaml.safe_load(SCENE.read_text()), plan.to_dict())
 
 
@@ -158,9 +159,10 @@ def test_a_finer_via_grid_finds_a_way_the_plan_did_not_take():
     assert _length(scene, better) < 0.9 * _length(scene, first.segments)
     assert _length(scene, better) >= geodesic_bound(scene) - 1e-9
     assert np.allclose(better[0].start, scene.start) and np.allclose(better[-1].end, first.segments[-1].end)
-    better_plan = Plan(scene=str(path), solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
-                       goal=scene.goal, segments=better)
+    better_plan = Plan.of_part("part", scene.start, scene.goal, better,
+                               scene=str(path), solved=True, planner="rrt", seed=1, planning_time_s=0.0)
     replay_plan(yaml.safe_load(path.read_text()), better_plan.to_dict())
     late = SwitchShortcut(scene, curves, model, None, scene.planner.switch_cost, fine, via=True,
                           deadline=time.perf_counter())
-    assert late(first.segments) is first.segments
+    given = first.segments
+    assert late(given) is given

@@ -59,7 +59,7 @@ def test_switch_cost_trades_length_for_switches():
 def test_one_edge_options_never_switch():
     scene = load_scene(SCENES / "parking.yaml")
     assert all(plan(scene, seed=seed, transit="none").switches == 0 for seed in (1, 2, 5))
-    single = replace(scene, pusher=replace(scene.pusher, edges=(1,)))  # the one edge that parks it
+    single = scene.with_part(edges=(1,))  # the one edge that parks it
     result = plan(single, seed=1)
     assert result.solved and result.switches == 0
 
@@ -76,8 +76,8 @@ def test_the_cheapest_direct_connection_wins():
     # waypoint, but edge 1 (the right face, pushing -x) does it in one straight push of 0.3 m.
     scene = load_scene(SCENES / "parking.yaml")
     start = np.array([0.0, 0.0, 0.0])
-    open_table = replace(scene, obstacles=(), workspace=(-2.0, -2.0, 2.0, 2.0), start=start,
-                         goal=start + [-0.3, 0.0, 0.0])
+    open_table = replace(scene.with_part(start=start, goal=start + [-0.3, 0.0, 0.0]), obstacles=(),
+                         workspace=(-2.0, -2.0, 2.0, 2.0))
     result = plan(open_table, seed=1)
     assert result.solved and result.pushes == 1 and result.segments[0].edge == 1
     assert result.path_length(scene.slider.cf) == pytest.approx(0.3, abs=1e-9)

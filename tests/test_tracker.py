@@ -21,7 +21,7 @@ from planner.actions.transit import edge_contact_pose
 from planner.execution.approach import approach, lead_in_pose
 from planner.execution.tracker import CONFIRM, SETTLE, Tracker, mean_pose
 from planner.model.fields import SceneError
-from planner.model.scene import parse_scene
+from planner.model.scene_file import parse_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 RATE = 10.0  # observations per second
@@ -175,7 +175,7 @@ def test_where_no_plan_starts_the_pusher_goes_on_with_its_plan_then_looks_again(
     plan = session.plan(seed=1)
     tracker = Tracker(session, plan, pusher=lead_in_pose(scene, session.model, plan))
     askew = scene.start + [0.012, 0.006, math.radians(-7)]
-    assert max(session.model.clearance(askew, e) for e in scene.pusher.edges) < scene.slider.radius / 40
+    assert max(session.model.clearance(askew, e) for e in scene.edges) < scene.slider.radius / 40
     kinds = [tracker.observe(k / RATE, askew).kind for k in range(CONFIRM + SETTLE)]
     assert kinds[-1] == "follow" and tracker.replans == [] and not tracker.reason
     ((when, reason),) = tracker.carried
@@ -199,7 +199,7 @@ def test_where_the_arm_lifts_the_pusher_is_lifted_over_to_a_face_it_cannot_walk_
     clear of the walls, it lands at the standoff in front of that face and moves in flush."""
     scene = load_scene(ROOT / "scenes" / "narrow_junction.yaml")
     session = Planner(scene)
-    edges = list(scene.pusher.edges)
+    edges = list(scene.edges)
     pushed, opposite = 1, 3  # the block's two ends (its +x and -x faces), across it along the corridor
     at = edge_contact_pose(scene.slider, pushed, scene.start)
     way = approach(scene, session.model, session.world.transits, at, scene.start, opposite, edges)

@@ -20,10 +20,11 @@ from mechanics import exp_twist, relative_pose, wrap_angle
 from planner import load_scene, plan
 from planner.actions.transit import AIRBORNE, edge_contact_pose, transit_poses
 from planner.cli import main
-from planner.execution.trajectory import parts_trajectory, trajectory
-from planner.model.parts import PartsScene
+from planner.execution.trajectory import trajectory
+from planner.model.scene import Scene
 from planner.model.bodies import pusher_frame_body
-from planner.model.plan_file import Plan, Push
+from planner.model.plan import Plan
+from planner.model.segments import Push
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "scenes"
@@ -57,20 +58,18 @@ def runs() -> dict:
         scene = load_scene(SCENES / f"{name}.yaml")
         result = plan(scene, seed=1)
         assert result.solved
-        if isinstance(scene, PartsScene):
-            motion = parts_trajectory(scene, result, SPEED, ACCEL, JERK, RATE)
-            segments = [s for _, s in result.segments]
-            sliders = [scene.part(n).slider for n, _ in result.segments]
+        motion = trajectory(scene, result, SPEED, ACCEL, JERK, RATE)
+        segments = result.segments
+        sliders = [scene.part(n).slider for n, _ in result.steps]
+        if len(scene.parts) > 1:
             assert any(s.kind == "transfer" for s in segments) and any(s.kind == "transit" for s in segments)
         else:
-            motion = trajectory(scene, result, SPEED, ACCEL, JERK, RATE)
-            segments, sliders = result.segments, [scene.slider] * len(result.segments)
             assert result.switches
         text = motion.to_csv()
         header = text.splitlines()[0]
-        assert header == HEADER + (",part" if isinstance(scene, PartsScene) else "")
+        assert header == HEADER + (",part" if len(scene.parts) > 1 else "")
         parts = [line.rsplit(",", 1)[1] for line in text.splitlines()[1:]] if "part" in header else []
-        owners = [n for n, _ in result.segments] if isinstance(scene, PartsScene) else []
+        owners = [n for n, _ in result.steps] if len(scene.parts) > 1 else []
         out[name] = Run(scene, segments, sliders, np.loadtxt(io.StringIO(text), delimiter=",", skiprows=1,
                                                              usecols=range(10)), motion, parts, owners)
     return out
@@ -276,8 +275,8 @@ def test_a_straight_push_takes_the_time_optimal_time(length, jerk, case):
     push = Push.along(0, np.array(scene.slider.edge(0)), [0.0, 1.0, 0.0], length, scene.start)  # 1 m/s per unit s
     found, expected = _rest_to_rest_time(length, SPEED, ACCEL, jerk)
     assert found == case
-    run = trajectory(scene, Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0, start=scene.start,
-                                 goal=scene.goal, segments=[push]), SPEED, ACCEL, jerk)
+    run = trajectory(scene, Plan.of_part("part", scene.start, scene.goal, [push],
+                                         scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0), SPEED, ACCEL, jerk)
     assert run.duration == pytest.approx(expected, rel=0.05)
 
 

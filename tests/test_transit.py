@@ -33,7 +33,7 @@ def scene(vertices, obstacles=(), transit="plane", start=(0.0, 0.0, 0.3)):
 
 
 def planner_for(sc) -> TransitPlanner:
-    edges = sc.pusher.edges
+    edges = sc.edges
     return TransitPlanner(sc, edges, CollisionModel(sc, edges), sc.slider.radius / 40)
 
 
@@ -84,7 +84,7 @@ def test_walks_round_the_part_between_every_pair_of_edges(vertices):
     sc = scene(vertices)
     tp = planner_for(sc)
     part = part_at(vertices, sc.start)
-    for a, b in itertools.permutations(sc.pusher.edges, 2):
+    for a, b in itertools.permutations(sc.edges, 2):
         t = tp.find(sc.start, a, b)
         assert t is not None and t.mode == "plane" and (t.from_edge, t.to_edge) == (a, b)
         path = t.pusher_path

@@ -83,11 +83,11 @@ def test_clearance_matches_shapely_distance_on_random_poses():
     walls = shapely.box(-1, -1, 1, 1).difference(shapely.box(-0.4, -0.4, 0.4, 0.4))
     blocked = shapely.union_all([*s.obstacles, walls])
     rng = np.random.default_rng(7)
-    model = CollisionModel(s, s.pusher.edges)
+    model = CollisionModel(s, s.edges)
     checked = 0
     for _ in range(300):
         q = (*rng.uniform(-0.35, 0.35, 2), rng.uniform(-math.pi, math.pi))
-        edge = int(rng.choice(s.pusher.edges))
+        edge = int(rng.choice(s.edges))
         body = shapely.union_all([place(ell, q), place(pusher_body(ell, edge, 0.05, 0.015), q)])
         expected = body.distance(blocked)
         got = model.clearance(q, edge)

@@ -51,7 +51,7 @@ def one_push(name: str, twist, duration: float = 1.0) -> tuple[planner.Scene, pl
     first = plan.segments[0]
     segment = dataclasses.replace(first, twist=np.asarray(twist, dtype=float), duration=duration,
                                   end=advance(first.start, twist, duration))
-    return scene, dataclasses.replace(plan, segments=[segment])
+    return scene, plan.with_segments([segment])
 
 
 def crossing(inside, steps: int = 60) -> float:
@@ -158,12 +158,12 @@ def test_an_end_moved_by_hand_is_reported_as_the_deviation():
     scene, plan = planned("battery")
     segment = plan.segments[0]
     moved = dataclasses.replace(segment, end=segment.end + [1e-3, 0.0, 2e-3])
-    check = verify(scene, dataclasses.replace(plan, segments=[moved]), n=4)
+    check = verify(scene, plan.with_segments([moved]), n=4)
     np.testing.assert_allclose(check.pushes[0].position_error, _cf_shift(scene, segment.end, moved.end), rtol=1e-9)
     np.testing.assert_allclose(check.pushes[0].angle_error, 2e-3, rtol=1e-9)
     assert all_stick(check) and not check.passed  # sticks, but not where the plan says
     turned = dataclasses.replace(segment, end=segment.end + [0.0, 0.0, 2 * np.pi])  # the same pose
-    assert verify(scene, dataclasses.replace(plan, segments=[turned]), n=4).passed
+    assert verify(scene, plan.with_segments([turned]), n=4).passed
 
 
 def _cf_shift(scene, a, b) -> float:
@@ -181,7 +181,7 @@ def _cf_shift(scene, a, b) -> float:
 ])
 def test_a_plan_that_does_not_fit_the_scene_names_the_field(change, field):
     scene, plan = planned("battery")  # pushes edge 3 only, the face at x = -0.02425
-    bad = dataclasses.replace(plan, segments=[dataclasses.replace(plan.segments[0], **change)])
+    bad = plan.with_segments([dataclasses.replace(plan.segments[0], **change)])
     with pytest.raises(planner.SceneError) as err:
         verify(scene, bad, n=2)
     assert err.value.field == field
@@ -243,14 +243,14 @@ def test_a_transit_that_does_not_join_up_names_the_field(transit, push, fault):
         segments[k + 1] = push(segments[k + 1], segments[k])
     offset, field = fault
     with pytest.raises(planner.SceneError) as err:
-        verify(scene, dataclasses.replace(plan, segments=segments), n=2)
+        verify(scene, plan.with_segments(segments), n=2)
     assert err.value.field == ".".join(filter(None, [f"plan.segments[{k + offset}]", field]))
 
 
 def test_a_change_of_edge_needs_a_transit():
     scene, plan, k = switching("junction")
     with pytest.raises(planner.SceneError) as err:
-        verify(scene, dataclasses.replace(plan, segments=plan.segments[:k] + plan.segments[k + 1:]), n=2)
+        verify(scene, plan.with_segments(plan.segments[:k] + plan.segments[k + 1:]), n=2)
     assert err.value.field == f"plan.segments[{k}].edge" and "needs a transit" in str(err.value)
 
 

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from mechanics import DeadlineExceeded, PushRegion, StableSteering, point_velocity, stable_region
 
 from ..model.bodies import body_outline
-from ..model.plan_file import Push
+from ..model.segments import Push
 from .region_cache import RegionCache, compute_regions, edge_region, is_cached
 from ..model.fields import SceneError
 from ..model.scene import Scene
@@ -114,10 +114,10 @@ def edge_controls(scene: Scene, deadline: float | None = None, progress: Callabl
     """
     p, slider = scene.pusher, scene.slider
     method, rho = scene.planner.regions, scene.cf_uncertainty
-    todo = [e for e in p.edges if not is_cached(slider, e, p.mu, p.width, method, rho, cache)]
+    todo = [e for e in scene.edges if not is_cached(slider, e, p.mu, p.width, method, rho, cache)]
     computed = compute_regions(slider, todo, p.mu, p.width, rho, deadline, progress, cache=cache)
     out, pending = [], []
-    for e in p.edges:
+    for e in scene.edges:
         if e in todo and e not in computed:
             pending.append(e)
             continue
@@ -143,7 +143,7 @@ class NoStablePush(SceneError):
     def __init__(self, scene: Scene):
         p = scene.pusher
         if scene.cf_uncertainty > 0 and any(not stable_region(scene.slider, e, p.mu, p.width).is_empty
-                                            for e in p.edges):
+                                            for e in scene.edges):
             super().__init__("slider.cf_uncertainty", f"is too large: no allowed edge has a push stable for every CF "
                                                       f"within {scene.cf_uncertainty:g} m of the cf, though with the "
                                                       "cf known exactly some have")
@@ -158,7 +158,7 @@ def controls_or_reason(scene: Scene) -> tuple[list[EdgeControls] | None, str | N
 
     A CF beyond the end of edge 0, which no force in the contact's friction cone passes through:
 
-    >>> from planner.model.scene import parse_scene
+    >>> from planner.model.scene_file import parse_scene
     >>> scene = parse_scene({"slider": {"vertices": [[-0.1, 0], [0.05, 0], [0.1, 0], [0.1, 0.1], [-0.1, 0.1]],
     ...                                 "cf": [0.08, 0.05]},
     ...     "pusher": {"width": 0.01, "depth": 0.01, "mu": 0.5, "edges": [0]},

@@ -24,7 +24,7 @@ from mechanics import wrap_angle
 
 from .car import EdgeCar, edge_car
 from .controls import EdgeControls
-from ..model.plan_file import Push, append_push, rechain
+from ..model.segments import Push, append_push, rechain
 from ..model.scene import Scene
 from ..world.validity import CollisionModel, advances
 from .push import free_push
@@ -123,7 +123,7 @@ class DubinsCurves:
 
     >>> from planner.actions.car import edge_car
     >>> from planner.actions.controls import edge_controls
-    >>> from planner.model.scene import load_scene
+    >>> from planner.model.scene_file import load_scene
     >>> scene = load_scene("scenes/battery.yaml")
     >>> car = edge_car(edge_controls(scene)[0], scene.slider.cf)
     >>> round(DubinsCurves(scene, car).between(scene.start, scene.start + [0.2, 0.0, 0.0]), 9)
@@ -157,7 +157,7 @@ class DubinsCurves:
 
         >>> from planner.actions.car import edge_car
         >>> from planner.actions.controls import edge_controls
-        >>> from planner.model.scene import load_scene
+        >>> from planner.model.scene_file import load_scene
         >>> scene = load_scene("scenes/battery.yaml")
         >>> curves = DubinsCurves(scene, edge_car(edge_controls(scene)[0], scene.slider.cf))
         >>> lengths = curves.lengths([[0.0, 0.0, 0.0]], [[0.3, 0.0, 0.0], [0.0, 0.0, 0.0]])

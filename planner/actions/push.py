@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import log_pose
 
-from ..model.plan_file import Push
+from ..model.segments import Push
 from ..world.validity import CollisionModel
 from .controls import EdgeControls
 

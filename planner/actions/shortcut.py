@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Protocol
 
-from ..model.plan_file import Push, Transit
+from ..model.segments import Push, Transit
 from ..world.validity import CollisionModel
 from .controls import EdgeControls
 from .push import connect

@@ -40,7 +40,7 @@ import numpy as np
 import shapely
 
 from ..model.bodies import cf_poses, place
-from ..model.plan_file import Push, Transit, rechain
+from ..model.segments import Push, Transit, rechain
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 from .dubins import DubinsCurves

@@ -2,7 +2,7 @@
 
 Lynch & Mason (1996, §4) switch the pushed edge at any time, with an arm that lifts the pusher
 over everything; how a pusher that stays on the table gets round the part was left open. Here
-each switch carries the pusher's own collision-checked path (:class:`~planner.model.plan_file.Transit`),
+each switch carries the pusher's own collision-checked path (:class:`~planner.model.segments.Transit`),
 in one of two modes:
 
 * ``'lift'``: back straight off the edge (along the pusher's own -x) by the *standoff*, fly to
@@ -35,7 +35,7 @@ from numpy.typing import ArrayLike
 from mechanics import Slider, transform_points, wrap_angle
 
 from ..model.bodies import pusher_frame_body
-from ..model.plan_file import Transit
+from ..model.segments import Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 

@@ -32,8 +32,7 @@ from ..actions.region_cache import default_cache, is_cached, regions_held
 from ..model.fields import SceneError, number, shown
 from ..model.options import (check_optimize, check_planner, check_regions, check_seed, check_switch_cost,
                              check_time_limit, check_transit)
-from ..model.plan_file import Plan
-from ..model.parts import PartsScene
+from ..model.plan import Plan
 from ..model.scene import Scene
 from ..model.scene_file import load_scene
 from ..queries.reachability import certify_unreachable
@@ -74,16 +73,16 @@ class Task:
     overrides: Mapping[str, Any] = field(default_factory=dict)
     digest: str | None = None  # SHA-256 of the scene file's bytes (None for a Scene given as such)
 
-    def planned_scene(self) -> Scene | PartsScene:
+    def planned_scene(self) -> Scene:
         """The scene as planned: the goal and overrides applied (a multi-part scene takes neither
         a goal, its parts have theirs, nor a CF offset, which is a part's)."""
         scene, o = self.scene, self.overrides
-        if isinstance(scene, PartsScene):
+        if len(scene.parts) > 1:
             for name, given in (("goal", self.goal), ("overrides.cf_offset", o.get("cf_offset"))):
                 if given is not None:
                     raise SceneError(name, "is for one-part scenes: a scene with parts has a goal and a CF per part")
         if self.goal is not None:
-            scene = replace(scene, goal=np.asarray(self.goal, dtype=float))
+            scene = scene.with_part(goal=self.goal)
         options = {"name" if key == "planner" else key: o[key] for key in _OPTIONS if key in o}
         scene = scene.with_options(scene.planner.merged({**options, "seed": self.seed}, prefix="overrides."))
         if "mu" in o:
@@ -91,7 +90,7 @@ class Task:
         if "cf_offset" in o:
             slider = scene.slider
             try:
-                scene = replace(scene, slider=Slider(slider.vertices, slider.cf + np.asarray(o["cf_offset"])))
+                scene = scene.with_part(slider=Slider(slider.vertices, slider.cf + np.asarray(o["cf_offset"])))
             except ValueError as err:
                 raise SceneError("overrides.cf_offset", str(err)) from None
         return scene
@@ -260,7 +259,7 @@ def make_tasks(scenes: Iterable[str | Path | Scene], seeds: Sequence[int] | None
     """
     loaded, digests = [], []
     for s in scenes:
-        if isinstance(s, (Scene, PartsScene)):
+        if isinstance(s, Scene):
             loaded.append(s)
             digests.append(None)
             continue
@@ -300,17 +299,15 @@ def _checked(variant: Mapping[str, Any]) -> dict[str, Any]:
     return {key: OVERRIDES[key](value, f"overrides.{key}") for key, value in variant.items()}
 
 
-def _one_part(scene: Scene | PartsScene) -> list[Scene]:
-    """The one-part scenes whose regions ``scene`` plans with: itself, or each of its parts'."""
-    if isinstance(scene, PartsScene):
-        return [scene.move_scene(name, scene.starts) for name in scene.names]
-    return [scene]
+def _one_part(scene: Scene) -> list[Scene]:
+    """The one-part scenes whose regions ``scene`` plans with: each of its parts' moves."""
+    return [scene.move_scene(name, scene.starts) for name in scene.names]
 
 
 def _region_keys(scene: Scene) -> tuple:
     """What a scene's exact regions depend on, to compute them once for all tasks alike."""
     p = scene.pusher
-    return (scene.slider.vertices.tobytes(), scene.slider.cf.tobytes(), tuple(p.edges), p.mu, p.width, scene.cf_uncertainty, scene.planner.regions)
+    return (scene.slider.vertices.tobytes(), scene.slider.cf.tobytes(), tuple(scene.edges), p.mu, p.width, scene.cf_uncertainty, scene.planner.regions)
 
 
 def shared_regions(tasks: Iterable[Task] | TaskList) -> dict[str, Any]:
@@ -330,7 +327,7 @@ def shared_regions(tasks: Iterable[Task] | TaskList) -> dict[str, Any]:
             except SceneError:
                 continue
             p = scene.pusher
-            shared |= regions_held(scene.slider, p.edges, p.mu, p.width, scene.cf_uncertainty)
+            shared |= regions_held(scene.slider, scene.edges, p.mu, p.width, scene.cf_uncertainty)
     return shared
 
 
@@ -346,13 +343,12 @@ def run_task(task: Task, shared: Mapping[str, Any] | None) -> dict[str, Any]:
             cache.put(key, region)
     scene = task.planned_scene()
     missing = sum(not is_cached(one.slider, e, one.pusher.mu, one.pusher.width, one.planner.regions, one.cf_uncertainty)
-                  for one in _one_part(scene) for e in one.pusher.edges)
+                  for one in _one_part(scene) for e in one.edges)
     # A multi-part plan says itself which parts it could not deliver; the certificates are one part's.
-    unreachable = None if isinstance(scene, PartsScene) else certify_unreachable(scene, regions=False)
+    unreachable = None if len(scene.parts) > 1 else certify_unreachable(scene, regions=False)
     if unreachable:
-        result = Plan(scene=scene.path, solved=False, planner=scene.planner.name, seed=task.seed, planning_time_s=0.0,
-                      start=scene.start.copy(), goal=scene.goal.copy(),
-                      reason=unreachable)
+        result = Plan.of_part(scene.part().name, scene.start, scene.goal, [], scene=scene.path, solved=False,
+                              planner=scene.planner.name, seed=task.seed, planning_time_s=0.0, reason=unreachable)
     else:
         result = plan(scene, seed=task.seed)
     status = "solved" if result.solved else "unreachable" if unreachable else "unknown"

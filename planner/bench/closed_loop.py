@@ -30,7 +30,7 @@ import numpy as np
 from ..execution.closed_loop import closed_loop
 from ..execution.mujoco_sim import simulate
 from ..model.fields import SceneError
-from ..model.scene import load_scene
+from ..model.scene_file import load_scene
 from ..queries.session import Planner
 
 __all__ = ["KINDS", "draw", "main"]

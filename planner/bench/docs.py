@@ -30,8 +30,7 @@ from functools import cache
 from pathlib import Path
 
 from ..model.extras import have, needs
-from ..model.plan_file import Plan
-from ..model.parts import PartsScene
+from ..model.plan import Plan
 from ..model.scene import Scene
 from ..model.scene_file import load_scene
 from ..queries.session import plan
@@ -169,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
 
     for name, picture in PICTURES.items():
         scene, result = seed_one(name)
-        (draw_parts_plan if isinstance(scene, PartsScene) else draw_plan)(scene, result, str(ROOT / "docs" / f"{picture}.png"))
+        (draw_parts_plan if len(scene.parts) > 1 else draw_plan)(scene, result, str(ROOT / "docs" / f"{picture}.png"))
     if fresh != text:
         README.write_text(fresh)
     print(f"regenerated: {', '.join(made)}; stale before: {', '.join(stale) or 'none'}")

@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from ..actions.controls import edge_controls
-from ..model.parts import PartsScene
+from ..model.scene import Scene
 from ..model.scene_file import load_scene
-from ..queries.session import PartsPlanner
+from ..queries.session import Planner
 
 __all__ = ["main"]
 
@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> int:
           f"{'transfers':>9} {'cost m':>7}")
     for path in paths:
         scene = load_scene(path)
-        if not isinstance(scene, PartsScene):
+        if len(scene.parts) == 1:
             print(f"{path}: not a multi-part scene", file=sys.stderr)
             return 1
         for part in scene.parts:  # the regions, cached before anything is timed
@@ -46,7 +46,7 @@ def main(argv: list[str] | None = None) -> int:
         times = []
         for seed in range(1, args.seeds + 1):
             clock = time.perf_counter()
-            result = PartsPlanner(scene, {"seed": seed, "time_limit": args.time_limit}).plan()
+            result = Planner(scene, {"seed": seed, "time_limit": args.time_limit}).plan()
             times.append(time.perf_counter() - clock)
             cost = f"{result.cost:7.3f}" if result.solved else f"{'-':>7}"
             print(f"{scene.name:<14} {seed:>4} {str(result.solved):>6} {times[-1]:7.2f} {len(result.moves):>5} "

@@ -23,8 +23,10 @@ from pathlib import Path
 
 from ..batch.engines import map_ordered
 from ..model.files import write_atomic
-from ..model.plan_file import Plan, load_plan
-from ..model.scene import Scene, load_scene
+from ..model.plan import Plan
+from ..model.plan_file import load_plan
+from ..model.scene import Scene
+from ..model.scene_file import load_scene
 from ..queries.geodesic import geodesic_bound
 from ..queries.session import plan
 

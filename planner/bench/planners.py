@@ -24,7 +24,7 @@ import numpy as np
 
 from .ompl_log import Run, log_paths, write_ompl_log
 from ..model.options import PLANNERS, TRANSITS
-from ..model.scene import load_scene
+from ..model.scene_file import load_scene
 from ..batch.engines import ENGINES, map_ordered
 from ..queries.session import plan
 

@@ -38,7 +38,8 @@ from ..actions.dubins import DubinsCurves
 from ..queries.geodesic import geodesic_bound
 from ..actions.controls import edge_controls
 from ..model.bodies import cf_poses
-from ..model.scene import Scene, load_scene
+from ..model.scene import Scene
+from ..model.scene_file import load_scene
 from ..batch.engines import map_ordered
 from ..queries.session import plan
 from .optimality import best_known
@@ -53,9 +54,9 @@ TASKS = {"ahead+90": ((1.0, 0.0), 90.0), "side": ((0.0, 0.5), 0.0), "behind+180"
 def open_task(scene: Scene, task: str) -> Scene:
     """``scene``'s part and pusher on an empty 4 x 4 m table, its CF at the origin, heading 0."""
     target, turn = TASKS[task]
-    return replace(scene, name=f"{scene.name}:{task}", obstacles=(), workspace=(-2.0, -2.0, 2.0, 2.0),
-                   start=cf_poses(scene.slider.cf, [0.0, 0.0], [0.0])[0],
-                   goal=cf_poses(scene.slider.cf, target, [math.radians(turn)])[0], path=None)
+    moved = scene.with_part(start=cf_poses(scene.slider.cf, [0.0, 0.0], [0.0])[0],
+                            goal=cf_poses(scene.slider.cf, target, [math.radians(turn)])[0])
+    return replace(moved, name=f"{scene.name}:{task}", obstacles=(), workspace=(-2.0, -2.0, 2.0, 2.0), path=None)
 
 
 def dubins_length(scene: Scene) -> float:

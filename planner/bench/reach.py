@@ -22,7 +22,8 @@ from collections import Counter
 import numpy as np
 
 from ..actions.controls import edge_controls
-from ..model.scene import Scene, load_scene
+from ..model.scene import Scene
+from ..model.scene_file import load_scene
 from ..queries.session import Planner, reachability
 
 __all__ = ["grid_goals", "main", "sample_goals"]

@@ -19,7 +19,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..actions.controls import edge_controls
-from ..model.scene import load_scene
+from ..model.scene_file import load_scene
 from ..queries.session import Planner, plan
 
 __all__ = ["main", "perturbed_starts"]
@@ -54,7 +54,7 @@ def main(argv: list[str] | None = None) -> int:
     alone, again = [], []
     for k, start in enumerate(perturbed_starts(scene.start, args.starts, args.offset, math.radians(args.turn))):
         clock = time.perf_counter()
-        a = plan(replace(scene, start=start), seed=args.seed)
+        a = plan(scene.with_part(start=start), seed=args.seed)
         alone.append(time.perf_counter() - clock)
         clock = time.perf_counter()
         b = session.plan(start=start)

@@ -16,8 +16,9 @@ import sys
 
 from ..execution.mujoco_sim import Simulation, simulate
 from ..model.extras import have, needs
-from ..model.plan_file import Plan
-from ..model.scene import Scene, load_scene
+from ..model.plan import Plan
+from ..model.scene import Scene
+from ..model.scene_file import load_scene
 from ..queries.session import plan
 
 __all__ = ["HEADER", "main", "row"]

@@ -26,7 +26,8 @@ from numpy.typing import ArrayLike
 
 from ..actions.transit import TransitPlanner, backed_off, edge_contact_pose, in_plane_moves, path_duration, standoff
 from ..model.bodies import pusher_frame_body, slider_at
-from ..model.plan_file import Plan, Transit
+from ..model.plan import Plan
+from ..model.segments import Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..model.plan_file import Plan
+from ..model.plan import Plan
 from ..model.scene import Scene
 from ..queries.session import Planner
 from .approach import lead_in_pose

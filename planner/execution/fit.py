@@ -10,7 +10,7 @@ checked against the scene, each check naming the field that differs:
   edge the scene lets the pusher push with the scene's pusher flush on it, every transit a mode
   the scene allows, and the segments chained (:func:`planner.execution.verify.check_chain`);
 * its start is the scene's start within the scene's tolerance, and run from the scene's start
-  (every segment moved rigidly with it, :func:`planner.model.plan_file.rechain`) it ends within
+  (every segment moved rigidly with it, :func:`planner.model.segments.rechain`) it ends within
   the goal tolerance;
 * every push and every in-plane move of a transit, so run, stays clear of the scene's obstacles
   and workspace walls by the planner's own collision checks (:class:`~planner.world.validity.CollisionModel`,
@@ -38,10 +38,9 @@ from mechanics import point_velocity, wrap_angle
 from ..actions.transit import edge_contact_pose, in_plane_moves
 from ..model.bodies import body_outline
 from ..model.fields import SceneError, pose_text
-from ..model.parts import PartsScene
-from ..model.parts_plan import Move, PartsPlan, Transfer
-from ..model.plan_file import Plan, Push, rechain
 from ..model.scene import Scene
+from ..model.plan import Move, Plan
+from ..model.segments import Push, Transfer, rechain
 from ..world.validity import CollisionModel, advances, pose_along
 from .verify import check_chain
 
@@ -83,8 +82,7 @@ def fit_plan(scene: Scene, plan: Plan) -> Plan:
     >>> solved = plan(scene, seed=1)
     >>> fit_plan(scene, solved).final.round(3).tolist() == solved.final.round(3).tolist()
     True
-    >>> from dataclasses import replace
-    >>> elsewhere = replace(scene, start=scene.start + [0.05, 0.0, 0.0], goal=scene.goal + [0.05, 0.0, 0.0])
+    >>> elsewhere = scene.with_part(start=scene.start + [0.05, 0.0, 0.0], goal=scene.goal + [0.05, 0.0, 0.0])
     >>> fit_plan(elsewhere, solved)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
@@ -110,7 +108,10 @@ def _fit(scene: Scene, plan: Plan) -> Plan:
             travel = body_speed(scene, segment) * segment.duration
             if not travel <= MAX_TRAVEL:
                 raise SceneError(f"plan.segments[{k}]", f"carries the body {travel:.3g} m, more than {MAX_TRAVEL:g} m")
-    moved = replace(plan, start=scene.start.copy(), goal=scene.goal.copy(), segments=rechain(plan.segments, scene.start))
+    part = scene.part().name
+    moved = replace(plan, starts={part: scene.start.copy()}, goals={part: scene.goal.copy()},
+                    moves=[Move(part, rechain(m.segments, scene.start)) for m in plan.moves],
+                    delivered=(part,), cfs={part: c for c in plan.cfs.values()})
     if not scene.within_tolerance(moved.final):
         raise SceneError("plan.final", f"run from the scene's start, it ends at {pose_text(moved.final)}, not at the "
                                        f"scene's goal {pose_text(scene.goal)}: {_miss(scene, moved.final, scene.goal)}")
@@ -162,7 +163,7 @@ def _check_clear(scene: Scene, plan: Plan) -> None:
                                                     f"(from the part at {pose_text(segment.start)})")
 
 
-def fit_parts_plan(scene: PartsScene, plan: PartsPlan) -> PartsPlan:
+def fit_parts_plan(scene: Scene, plan: Plan) -> Plan:
     """``plan`` (a ``stablepush.plan/2``) checked to be a plan for the multi-part ``scene``: solved,
     the scene's parts at the scene's starts, each move a plan of its part that :func:`fit_plan`
     accepts with the scene's obstacles and walls (a buffer move ending where it ends), each
@@ -192,18 +193,18 @@ def fit_parts_plan(scene: PartsScene, plan: PartsPlan) -> PartsPlan:
         if move.transfer is not None:
             _fit_transfer(scene, move.transfer, poses, plan.moves[k - 1], move, offset)
             offset += 1
-        alone = replace(scene.move_scene(move.part, poses), obstacles=scene.obstacles)
-        goal = alone.goal if last_move[move.part] == k else move.end
+        goal = None if last_move[move.part] == k else move.end
+        alone = scene.move_scene(move.part, poses, goal, others=False)
         try:
-            fit_plan(replace(alone, goal=goal), Plan(scene=plan.scene, solved=True, planner=plan.planner, seed=plan.seed,
-                                                 planning_time_s=0.0, start=move.start, goal=goal,
-                                                 segments=move.segments, cf=plan.cfs.get(move.part)))
+            fit_plan(alone, Plan.of_part(move.part, move.start, alone.goal, move.segments, scene=plan.scene,
+                                         solved=True, planner=plan.planner, seed=plan.seed, planning_time_s=0.0,
+                                         cf=plan.cfs.get(move.part)))
         except SceneError as err:
             raise SceneError(_in_plan(err.field, offset, move.part), err.problem) from None
         offset += len(move.segments)
         poses[move.part] = move.end
     for part in scene.parts:
-        if not scene.within_tolerance(part.name, poses[part.name]):
+        if not scene.delivered(part.name, poses[part.name]):
             raise SceneError(f"plan.parts.{part.name}.final", f"is {pose_text(poses[part.name])}, not within tolerance "
                                                               f"of the part's goal {pose_text(part.goal)}")
     return replace(plan, goals=scene.goals)
@@ -220,7 +221,7 @@ def _in_plan(field: str, offset: int, part: str) -> str:
     return f"plan.parts.{part}.{field.removeprefix('plan.')}"
 
 
-def _fit_transfer(scene: PartsScene, transfer: Transfer, poses: dict[str, np.ndarray], before: Move, after: Move,
+def _fit_transfer(scene: Scene, transfer: Transfer, poses: dict[str, np.ndarray], before: Move, after: Move,
                   index: int) -> None:
     """Refuse ``transfer`` (segment ``index``) unless it leaves ``before``'s part from its last contact, reaches
     ``after``'s first contact, and its in-plane moves keep clear of the obstacles and walls."""
@@ -232,7 +233,7 @@ def _fit_transfer(scene: PartsScene, transfer: Transfer, poses: dict[str, np.nda
         if np.abs(pose[:2] - flush[:2]).max() > 1e-9 or abs(float(wrap_angle(pose[2] - flush[2]))) > 1e-9:
             raise SceneError(f"{name}.pusher_path", f"does not {'start' if part == before.part else 'end'} flush on "
                                                     f"part {part}'s edge {edge}")
-    alone = replace(scene.move_scene(after.part, poses), obstacles=scene.obstacles)
+    alone = scene.move_scene(after.part, poses, others=False)
     model = CollisionModel(alone, ())
     margin = CLEARANCE * alone.slider.radius
     if not all(model.pusher_move_is_free(a, b, margin) for a, b in in_plane_moves(transfer)):

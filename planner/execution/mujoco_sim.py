@@ -67,9 +67,10 @@ from ..actions.transit import edge_contact_pose
 from ..model.bodies import convex_pieces, pusher_frame_body, slider_at
 from ..model.fields import SceneError
 from ..model.files import write_atomic
-from ..model.parts import PartsScene
-from ..model.plan_file import Plan, Transit
-from ..model.scene import Scene, placement_fault
+from ..model.scene import Scene
+from ..model.plan import Plan
+from ..model.segments import Transit
+from ..model.scene_file import placement_fault
 from ..world.validity import CollisionModel
 from .approach import first_edge, lead_in_pose
 from .trajectory import Trajectory, planned_part, trajectory
@@ -173,7 +174,7 @@ def _second_moment(pieces: list[np.ndarray], centre: np.ndarray) -> float:
     return total / area
 
 
-def table(scene: Scene | PartsScene) -> tuple[list[str], list[str], list[str]]:
+def table(scene: Scene) -> tuple[list[str], list[str], list[str]]:
     """The MJCF of what stands on the table: mesh assets, world geoms (the workspace walls and the
     obstacles as prisms, non-convex ones as their convex pieces) and the names of those geoms."""
     assets, world = [], []
@@ -196,7 +197,7 @@ def table(scene: Scene | PartsScene) -> tuple[list[str], list[str], list[str]]:
     return assets, world, blocks
 
 
-def document(scene: Scene | PartsScene, assets: list[str], world: list[str], bodies: list[str], pairs: list[str],
+def document(scene: Scene, assets: list[str], world: list[str], bodies: list[str], pairs: list[str],
              keys: list[str]) -> str:
     """The MJCF document of ``scene``: the options, the table plane, ``world``'s geoms, the part
     ``bodies``, the pusher (a prism of its outline on x, y, z and heading joints, last in the
@@ -544,9 +545,8 @@ def _lead_in(scene: Scene, plan: Plan, model: CollisionModel) -> Trajectory:
     contact = edge_contact_pose(scene.slider, edge, plan.start)
     path = np.array([lead_in_pose(scene, model, plan), contact])
     step = float(np.linalg.norm(path[1, :2] - path[0, :2]))
-    return trajectory(scene, Plan(scene=None, solved=True, planner=plan.planner, seed=plan.seed, planning_time_s=0.0,
-                                  start=plan.start, goal=plan.start,
-                                  segments=[Transit(edge, edge, "plane", path, step, np.asarray(plan.start, dtype=float))]))
+    return trajectory(scene, Plan.of_part(scene.part().name, plan.start, plan.start, [Transit(edge, edge, "plane", path, step, np.asarray(plan.start, dtype=float))],
+                                          scene=None, solved=True, planner=plan.planner, seed=plan.seed, planning_time_s=0.0))
 
 
 def perturbations(scene: Scene, plan: Plan, model: CollisionModel, start_error: ArrayLike = (0.0, 0.0, 0.0),
@@ -636,7 +636,7 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
     """
     needs_mujoco()
     supports = feet(scene, n, seed, cf_offset)
-    start, knocks, lead, motion = perturbations(scene, plan, CollisionModel(scene, scene.pusher.edges), start_error,
+    start, knocks, lead, motion = perturbations(scene, plan, CollisionModel(scene, scene.edges), start_error,
                                                 bumps)
     planned = planned_part(scene, plan, motion)
     return Simulation(tuple(_run(scene, plan, motion, planned, s, mu, start, lead, knocks) for s in supports),

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -26,18 +27,18 @@ from numpy.typing import ArrayLike
 from mechanics import relative_pose
 
 from ..model.bodies import convex_pieces
-from ..model.parts import PartsScene
-from ..model.parts_plan import PartsPlan
-from ..model.plan_file import Plan
+from ..model.files import write_atomic
+from ..model.scene import Scene
+from ..model.plan import Plan
 from ..world.validity import CollisionModel
 from .mujoco_sim import (SETTLE, SLIP, TABLE_MU, TIMESTEP, Feet, Runs, _error, _follower, _lead_in, _numbers, document,
                          feet, needs_mujoco, part_body, part_pairs, table)
-from .trajectory import Trajectory, parts_trajectory
+from .trajectory import Trajectory, trajectory
 
 __all__ = ["PartsRun", "PartsSimulation", "parts_mjcf", "simulate_parts"]
 
 
-def parts_mjcf(scene: PartsScene, supports: dict[str, Feet], mu: float | None = None,
+def parts_mjcf(scene: Scene, supports: dict[str, Feet], mu: float | None = None,
                starts: dict[str, ArrayLike] | None = None) -> str:
     """The MuJoCo model of ``scene`` with each part on its ``supports`` feet at ``starts``
     (default: the scene's), pusher-part friction ``mu`` (default: the planned ``pusher.mu``).
@@ -67,11 +68,11 @@ class PartsRun:
     rad), the worst slip of a push (m), and the faults met: contacts that must not happen, as
     ``(first time s, what)``; a fault is reported once, at its first sample."""
 
-    kinds: tuple[str, ...]  # each part's foot set
+    supports: dict[str, Feet]  # each part's feet
     goal_errors: dict[str, tuple[float, float]]
     in_goal: dict[str, bool]
     slip: float
-    slip_segment: int  # where the worst slip was (a segment of PartsPlan.segments, from 0), -1 if none
+    slip_segment: int  # where the worst slip was (a segment of Plan.segments, from 0), -1 if none
     faults: tuple[tuple[float, str], ...]
     seconds: float
     simulated: float
@@ -88,7 +89,7 @@ class PartsRun:
             [f"SLIPS (segment {self.slip_segment + 1})"] if self.slip > SLIP else []) + [
             f"{what} at {t:.1f} s" for t, what in self.faults[:3]] + (
             [f"{len(self.faults) - 3} more faults"] if len(self.faults) > 3 else [])
-        return (f"simulate {k}/{n} ({', '.join(sorted(set(self.kinds)))} feet): worst goal error "
+        return (f"simulate {k}/{n} ({', '.join(sorted({f.kind for f in self.supports.values()}))} feet): worst goal error "
                 f"{self.goal_errors[worst][0]:.2e} m ({worst}); slip {self.slip:.2e} m; {self.seconds:.1f} s for "
                 f"{self.simulated:.1f} s: {'; '.join(faults) if faults else 'ok'}")
 
@@ -101,6 +102,10 @@ class PartsSimulation(Runs):
     mu: float
     motion: Trajectory
 
+    def write_mjcf(self, path: str | Path, scene: Scene) -> None:
+        """Write the first run's model (:func:`parts_mjcf`) to ``path`` atomically."""
+        write_atomic(path, parts_mjcf(scene, self.runs[0].supports, self.mu))
+
     def summary(self) -> str:
         delivered = min(sum(r.in_goal.values()) for r in self.runs)
         parts = len(self.runs[0].in_goal)
@@ -110,7 +115,7 @@ class PartsSimulation(Runs):
                 f"{max(r.slip for r in self.runs):.2e} m, {sum(r.seconds for r in self.runs):.1f} s")
 
 
-def simulate_parts(scene: PartsScene, plan: PartsPlan, n: int = 3, seed: int = 1, mu: float | None = None,
+def simulate_parts(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
                    cf_offset: ArrayLike = (0.0, 0.0)) -> PartsSimulation:
     """Run ``plan`` open-loop in MuJoCo once per foot set (module docstring).
 
@@ -122,16 +127,16 @@ def simulate_parts(scene: PartsScene, plan: PartsPlan, n: int = 3, seed: int = 1
     needs_mujoco()
     first = plan.moves[0]
     lead_scene = scene.move_scene(first.part, scene.starts)
-    lead_plan = Plan(scene=None, solved=True, planner=plan.planner, seed=plan.seed, planning_time_s=0.0,
-                     start=first.start, goal=first.end, segments=first.segments)
-    lead = _lead_in(lead_scene, lead_plan, CollisionModel(lead_scene, lead_scene.pusher.edges))
-    motion = parts_trajectory(scene, plan)
+    lead_plan = Plan.of_part(first.part, first.start, first.end, first.segments,
+                             scene=None, solved=True, planner=plan.planner, seed=plan.seed, planning_time_s=0.0)
+    lead = _lead_in(lead_scene, lead_plan, CollisionModel(lead_scene, lead_scene.edges))
+    motion = trajectory(scene, plan)
     sets = {p.name: feet(scene.move_scene(p.name, scene.starts), n, seed, cf_offset) for p in scene.parts}
     runs = tuple(_run(scene, plan, motion, lead, {name: s[k] for name, s in sets.items()}, mu) for k in range(n))
     return PartsSimulation(runs, scene.pusher.mu if mu is None else mu, motion)
 
 
-def _run(scene: PartsScene, plan: PartsPlan, motion: Trajectory, lead: Trajectory, supports: dict[str, Feet],
+def _run(scene: Scene, plan: Plan, motion: Trajectory, lead: Trajectory, supports: dict[str, Feet],
          mu: float | None) -> PartsRun:
     import mujoco  # only when simulating
 
@@ -148,10 +153,10 @@ def _run(scene: PartsScene, plan: PartsPlan, motion: Trajectory, lead: Trajector
     qpos = model.joint("pusher_x").qposadr[0] + np.arange(4)
     qvel = model.joint("pusher_x").dofadr[0] + np.arange(4)
     led, follow = _follower(lead), _follower(motion)
-    pushed = [name for name, _ in plan.segments]
+    pushed = [name for name, _ in plan.steps]
     # The pusher may touch the part of its segment, and on a transfer the part it leaves: a transit
     # or a transfer begins (and ends) in contact.
-    allowed = [{name, s.from_part} if s.kind == "transfer" else {name} for name, s in plan.segments]
+    allowed = [{name, s.from_part} if s.kind == "transfer" else {name} for name, s in plan.steps]
 
     def step_to(t: float) -> None:
         while data.time < t - TIMESTEP / 2:
@@ -192,7 +197,7 @@ def _run(scene: PartsScene, plan: PartsPlan, motion: Trajectory, lead: Trajector
             slips[k] = max(slips[k], float(np.linalg.norm(face - first)))
     errors = {n: _error(poses[n][-1], scene.part(n).goal) for n in names}
     worst = int(np.argmax(slips)) if len(slips) and slips.max() > 0 else -1
-    return PartsRun(tuple(supports[n].kind for n in names), errors,
-                    {n: scene.within_tolerance(n, poses[n][-1]) for n in names}, float(slips.max(initial=0.0)), worst,
+    return PartsRun(supports, errors,
+                    {n: scene.delivered(n, poses[n][-1]) for n in names}, float(slips.max(initial=0.0)), worst,
                     tuple(faults), time.perf_counter() - clock, float(motion.duration + lead.duration), poses)
 

@@ -16,9 +16,9 @@ import time
 from dataclasses import dataclass, replace
 
 from ..actions.transit import in_plane_moves
-from ..model.parts import PartsScene
-from ..model.parts_plan import Move, PartsPlan
-from ..model.plan_file import Plan
+from ..model.scene import Scene
+from ..model.plan import Move, Plan
+from ..model.plan import Plan
 from ..world.validity import CollisionModel, advances, pose_along
 from .fit import CLEARANCE, body_speed
 from .verify import TOLERANCE, Verification, verify
@@ -56,7 +56,7 @@ class PartsVerification:
                 + (f"parts met: {', '.join(met)}" if met else "every move clear of the other parts"))
 
 
-def verify_parts(scene: PartsScene, plan: PartsPlan, n: int = 200, seed: int = 1,
+def verify_parts(scene: Scene, plan: Plan, n: int = 200, seed: int = 1,
                  tolerance: float = TOLERANCE) -> PartsVerification:
     """Verify every move of ``plan`` (module docstring) under ``n`` support distributions.
 
@@ -69,16 +69,15 @@ def verify_parts(scene: PartsScene, plan: PartsPlan, n: int = 200, seed: int = 1
     poses, out = scene.starts, []
     for move in plan.moves:
         alone = scene.move_scene(move.part, poses, goal=move.end)
-        check = verify(alone, Plan(scene=plan.scene, solved=True, planner=plan.planner, seed=plan.seed,
-                                   planning_time_s=0.0, start=move.start, goal=move.end, segments=move.segments,
-                                   cf=plan.cfs.get(move.part)), n, seed, tolerance)
+        check = verify(alone, Plan.of_part(move.part, move.start, move.end, move.segments,
+                                           scene=plan.scene, solved=True, planner=plan.planner, seed=plan.seed, planning_time_s=0.0, cf=plan.cfs.get(move.part)), n, seed, tolerance)
         met = tuple(other for other in scene.names if other != move.part and _meets(scene, move, poses, other))
         out.append((move.part, check, met))
         poses[move.part] = move.end
     return PartsVerification(tuple(out), time.perf_counter() - clock)
 
 
-def _meets(scene: PartsScene, move: Move, poses: dict, other: str) -> bool:
+def _meets(scene: Scene, move: Move, poses: dict, other: str) -> bool:
     """Whether a push or transit of ``move`` comes within :data:`~planner.execution.fit.CLEARANCE`
     part radii of part ``other`` at its pose in ``poses`` (as :func:`~planner.execution.fit.fit_plan`
     checks obstacles)."""

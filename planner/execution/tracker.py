@@ -73,7 +73,8 @@ from mechanics import wrap_angle
 
 from ..model.bodies import pusher_frame_body, slider_at
 from ..model.fields import SceneError, poses
-from ..model.plan_file import Plan, Transit
+from ..model.plan import Plan
+from ..model.segments import Transit
 from ..queries.session import Planner
 from .approach import approach, first_edge
 from .trajectory import Trajectory, planned_part, trajectory
@@ -237,7 +238,7 @@ class Tracker:
                 return "no free approach from the pusher to the plan's first contact"
             segments.insert(0, way)
         self.plan, self._segments = plan, segments
-        led = replace(plan, segments=segments)
+        led = plan.with_segments(segments)
         self.motion: Trajectory = trajectory(self.scene, led)
         self.expected = planned_part(self.scene, led, self.motion)
         self._theta = np.unwrap(self.motion.theta)

@@ -1,6 +1,6 @@
 """Time-parameterised pusher trajectories: the plan's pusher path with a jerk-limited time law.
 
-A plan (:class:`~planner.model.plan_file.Plan`) says where the pusher goes, not when. Here the
+A plan (:class:`~planner.model.plan.Plan`) says where the pusher goes, not when. Here the
 pusher frame (:func:`planner.model.bodies.pusher_frame_body`: origin at the middle of the face,
 x along the push) follows the planned path *exactly* and a time law ``s(t)`` says how fast:
 
@@ -63,13 +63,14 @@ from mechanics import Slider, exp_twist, point_velocity, transform_points, wrap_
 from ..actions.transit import AIRBORNE, edge_contact_pose, piece_times
 from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
-from ..model.parts import PartsScene
-from ..model.parts_plan import PartsPlan, Transfer
-from ..model.plan_file import Plan, Push, Transit
+from ..model.scene import Scene
+from ..model.plan import Plan
+from ..model.segments import Transfer
+from ..model.segments import Push, Transit
 from ..model.scene import Pusher, Scene
 
 __all__ = ["COLUMNS", "LIFT_HEIGHT", "MAX_ACCEL", "MAX_JERK", "MAX_SPEED", "RATE", "Trajectory", "path_limits",
-           "parts_trajectory", "planned_part", "trajectory"]
+           "planned_part", "trajectory"]
 
 #: Default limits for every point of the pusher body: m/s, m/s^2, m/s^3 (quasi-static, above).
 MAX_SPEED, MAX_ACCEL, MAX_JERK = 0.05, 0.5, 5.0
@@ -108,7 +109,7 @@ class Trajectory:
     contact: np.ndarray
     segment: np.ndarray
     plan_time: np.ndarray | None = field(default=None, compare=False, repr=False)
-    #: Of a multi-part plan (:func:`parts_trajectory`): the part each sample's segment moves, a CSV column.
+    #: Of a plan of several parts: the part each sample's segment moves, a CSV column.
     part: np.ndarray | None = field(default=None, compare=False, repr=False)
 
     @property
@@ -126,7 +127,7 @@ class Trajectory:
         np.savetxt(text, table, fmt=["%.17g"] * 8 + ["%d"] * 2, delimiter=",", header=header, comments="")
         if self.part is None:
             return text.getvalue()
-        # A part's name is a plain printable name (planner.model.parts), but it may hold a comma or a quote.
+        # A part's name is a plain printable name (planner.model.scene_file), but it may hold a comma or a quote.
         lines = text.getvalue().splitlines()
         rows = io.StringIO()
         csv.writer(rows, lineterminator="\n").writerows([line.split(",") + [name] for line, name in zip(lines[1:], self.part)])
@@ -251,36 +252,30 @@ def trajectory(scene: Scene, plan: Plan, max_speed: float = MAX_SPEED, max_accel
     sample at the end; no point of the pusher body faster than ``max_speed`` (m/s) or accelerating
     more than ``max_accel`` (m/s^2), its tangential jerk at most ``max_jerk`` (m/s^3); at rest at
     the start and end of every segment and of every piece of a transit (module docstring).
-    A plan without segments has no pusher pose: no samples.
-
-    >>> from planner.model.scene import load_scene
-    >>> scene = load_scene("scenes/junction.yaml")
-    >>> push = Push.along(0, np.zeros((2, 2)), [0.0, 1.0, 0.0], 0.3, scene.start)  # 0.3 m straight
-    >>> run = trajectory(scene, Plan(scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0,
-    ...                              start=scene.start, goal=scene.goal, segments=[push]))
-    >>> run.duration, len(run.t), float(run.vy.max()), float(run.vx.max())  # 0.3/0.05 + 0.05/0.5 + 0.5/5
-    (6.2, 621, 0.05, 0.0)
-    """
-    return _timed(scene.pusher, [(scene.slider, s) for s in plan.segments], max_speed, max_accel, max_jerk, rate)
-
-
-def parts_trajectory(scene: PartsScene, plan: PartsPlan, max_speed: float = MAX_SPEED, max_accel: float = MAX_ACCEL,
-                     max_jerk: float = MAX_JERK, rate: float = RATE) -> Trajectory:
-    """:func:`trajectory` of a multi-part plan: the pusher along every move and every transfer in
-    order (a transfer is followed as a transit is, rest to rest on each piece), with the ``part``
-    each sample's segment belongs to (a transfer's: the part it goes to).
+    A plan without segments has no pusher pose: no samples. The pusher follows every move and
+    every transfer in order (a transfer is followed as a transit is, rest to rest on each piece);
+    for a plan of several parts, :attr:`Trajectory.part` names the part each sample's segment
+    belongs to (a transfer's: the part it goes to).
 
     >>> from planner.model.scene_file import load_scene
+    >>> scene = load_scene("scenes/junction.yaml")
+    >>> push = Push.along(0, np.zeros((2, 2)), [0.0, 1.0, 0.0], 0.3, scene.start)  # 0.3 m straight
+    >>> run = trajectory(scene, Plan.of_part("part", scene.start, scene.goal, [push],
+    ...                                      scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0))
+    >>> run.duration, len(run.t), float(run.vy.max()), float(run.vx.max())  # 0.3/0.05 + 0.05/0.5 + 0.5/5
+    (6.2, 621, 0.05, 0.0)
     >>> from planner.queries.session import Planner
-    >>> scene = load_scene("scenes/parts/swap.yaml")
-    >>> run = parts_trajectory(scene, Planner(scene).plan())
+    >>> tray = load_scene("scenes/parts/swap.yaml")
+    >>> run = trajectory(tray, Planner(tray).plan())
     >>> run.to_csv().splitlines()[0], sorted(set(run.part.tolist()))
     ('t,x,y,theta,vx,vy,omega,z,contact,segment,part', ['blue', 'red'])
     """
-    segments = plan.segments
-    motion = _timed(scene.pusher, [(scene.part(name).slider, s) for name, s in segments], max_speed, max_accel,
+    steps = plan.steps
+    motion = _timed(scene.pusher, [(scene.part(name).slider, s) for name, s in steps], max_speed, max_accel,
                     max_jerk, rate)
-    names = np.array([name for name, _ in segments] or [""])
+    if len(plan.names) == 1:
+        return motion
+    names = np.array([name for name, _ in steps] or [""])
     return replace(motion, part=names[motion.segment] if len(motion.t) else np.zeros(0, dtype=str))
 
 

@@ -56,7 +56,8 @@ from mechanics.quasistatic import (DEFAULT_STEPS, Contact, ContactMode, PushResu
                                    tripod_supports)
 
 from ..model.fields import SceneError, pose_text
-from ..model.plan_file import Plan, Push, Transit
+from ..model.plan import Plan
+from ..model.segments import Push, Transit
 from ..model.scene import Scene
 from ..actions.transit import edge_contact_pose
 
@@ -242,9 +243,9 @@ class Verification:
 
 def _allowed_edge(scene: Scene, edge: int, field: str) -> None:
     """Refuse an edge the scene does not let the pusher push (a plan made for another scene)."""
-    if edge not in scene.pusher.edges:
+    if edge not in scene.edges:
         raise SceneError(field, f"edge {edge} is not one the scene lets the pusher push "
-                                f"(allowed: {', '.join(map(str, scene.pusher.edges))})")
+                                f"(allowed: {', '.join(map(str, scene.edges))})")
 
 
 def _off(scene: Scene, pose: ArrayLike, expected: ArrayLike) -> bool:

@@ -1,49 +1,51 @@
-"""Scene files: the part, the pusher, the table and the task, read from YAML and validated.
+"""Scenes: parts on a table among obstacles, each with a start and a goal, and one pusher.
 
-The file is read by the hardened YAML reader of :mod:`.yaml_file`, the ``planner:`` block's options
-are checked by :mod:`.options`. Every problem is reported as a :class:`~planner.model.fields.SceneError`
-naming the offending field, so the command line can print one line and exit 1. The format is
-documented in the README.
+A scene is what its file describes (:mod:`.scene_file` reads and writes it): :class:`Part` s,
+the :class:`Pusher`, the obstacles, the workspace and the goal tolerance. A file with ``slider:``,
+``start:`` and ``goal:`` is a scene of one part, named :data:`ONE_PART`; a file with ``parts:``
+names its own. Everything that plans, checks or draws takes a scene of any number of parts.
+
+Moving one part is a problem of one part: :meth:`Scene.move_scene` is the scene of that move,
+every other part an obstacle where it stands. The search works on such scenes of one part, whose
+:meth:`Scene.part` (and its shorthands :attr:`Scene.slider`, :attr:`Scene.start`,
+:attr:`Scene.goal`, :attr:`Scene.edges`, :attr:`Scene.cf_uncertainty`) is the part moved.
+
+>>> from planner.model.scene_file import parse_scene
+>>> square = [[0, 0], [0.1, 0], [0.1, 0.1], [0, 0.1]]
+>>> tray = parse_scene({"parts": [
+...     {"name": "a", "vertices": square, "start": [0, 0, 0], "goal": [0.5, 0, 0]},
+...     {"name": "b", "vertices": square, "start": [0, 0.3, 0], "goal": [0, 0.3, 0]}],
+...     "pusher": {"width": 0.05, "depth": 0.01, "mu": 0.5}, "workspace": {"min": [-1, -1], "max": [1, 1]}})
+>>> move = tray.move_scene("a", tray.starts)
+>>> tray.names, move.names, [round(o.area, 3) for o in move.obstacles], move.goal.tolist()
+(('a', 'b'), ('a',), [0.01], [0.5, 0.0, 0.0])
+>>> tray.start
+Traceback (most recent call last):
+...
+planner.model.fields.SceneError: part: the scene has 2 parts (a, b): name one
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import shapely
-import yaml
 from numpy.typing import ArrayLike
 
 from mechanics import Slider, wrap_angle
 
 from .bodies import slider_at
-from .files import write_atomic
-from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vector
-from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
-from .yaml_file import read_yaml
+from .fields import SceneError, shown
+from .options import DEFAULT_TRANSIT, PlannerOptions
 
-__all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "PLANNER_KEYS", "Pusher", "Scene", "Table", "load_scene", "parse_scene",
-           "placement_fault", "plain_scene", "read_cf_uncertainty", "read_edges", "read_name", "read_pose", "read_pusher",
-           "read_slider", "read_table", "write_scene"]
+__all__ = ["ONE_PART", "Part", "Pusher", "Scene"]
 
-#: The keys of a scene's ``planner:`` block: the options but ``transit``, which is ``pusher.transit``.
-PLANNER_KEYS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize")
-#: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
-_MAX_NAME_BYTES = 200
-#: The pusher's width and depth and a box's sides, in metres (a micron): thinner is no body.
-MIN_SIZE = 1e-6
-#: Friction coefficients read: from all but frictionless to all but a wall (a cone of 89.94 degrees
-#: each side); far beyond them the cone's arithmetic underflows or overflows.
-MU_RANGE = (1e-3, 1e3)
-#: Least goal tolerance, in metres per metre of the table's extent (and in radians): a hundred times
-#: the rounding a plan's composed poses carry (about 1e-11), so that "within tolerance" is decided
-#: by the plan, not by rounding.
-MIN_TOLERANCE = 1e-9
+#: The name of the part of a scene file with ``slider:`` (a scene of one part).
+ONE_PART = "part"
 
 
 @dataclass(frozen=True)
@@ -55,28 +57,90 @@ class Pusher:
     width: float
     depth: float
     mu: float
-    edges: tuple[int, ...]  # the edges that may be pushed
     mu_high: float | None = None  # top of the friction interval, if one was given
     transit: str = DEFAULT_TRANSIT  # how it moves between edges (TRANSITS)
 
 
 @dataclass(frozen=True)
-class Scene:
-    """A validated scene. Poses are ``(x, y, theta)`` in metres and **radians**."""
+class Part:
+    """One part of a scene. Poses are ``(x, y, theta)`` in metres and radians."""
 
     name: str
     slider: Slider
+    start: np.ndarray
+    goal: np.ndarray
+    edges: tuple[int, ...]  # the edges the pusher may push
+    cf_uncertainty: float = 0.0  # radius of the disk about slider.cf holding the true CF (metres)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene (module docstring). Poses are ``(x, y, theta)`` in metres and **radians**."""
+
+    name: str
+    parts: tuple[Part, ...]
     pusher: Pusher
     obstacles: tuple[shapely.Polygon, ...]
     workspace: tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
-    start: np.ndarray
-    goal: np.ndarray
     tolerance_position: float = 0.01
     tolerance_angle: float = math.radians(2.0)
     planner: PlannerOptions = field(default_factory=PlannerOptions)
     path: str | None = None  # the file it was read from
-    cf_uncertainty: float = 0.0  # radius of the disk about slider.cf holding the true CF (metres)
     notes: tuple[str, ...] = ()  # what was not read from the CAD files it names (text, open chains)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(p.name for p in self.parts)
+
+    @property
+    def starts(self) -> dict[str, np.ndarray]:
+        return {p.name: p.start.copy() for p in self.parts}
+
+    @property
+    def goals(self) -> dict[str, np.ndarray]:
+        return {p.name: p.goal.copy() for p in self.parts}
+
+    def part(self, name: str | None = None) -> Part:
+        """The part named ``name``; without a name, the scene's one part (a scene of several
+        parts must be told which)."""
+        if name is None:
+            if len(self.parts) != 1:
+                raise SceneError("part", f"the scene has {len(self.parts)} parts ({', '.join(self.names)}): name one")
+            return self.parts[0]
+        for p in self.parts:
+            if p.name == name:
+                return p
+        raise SceneError("part", f"no part is named {shown(name)} (the parts: {', '.join(self.names)})")
+
+    @property
+    def slider(self) -> Slider:
+        """The one part's outline and CF."""
+        return self.part().slider
+
+    @property
+    def start(self) -> np.ndarray:
+        return self.part().start
+
+    @property
+    def goal(self) -> np.ndarray:
+        return self.part().goal
+
+    @property
+    def edges(self) -> tuple[int, ...]:
+        """The edges of the one part the pusher may push."""
+        return self.part().edges
+
+    @property
+    def cf_uncertainty(self) -> float:
+        return self.part().cf_uncertainty
+
+    def with_part(self, **changes: Any) -> "Scene":
+        """This scene with its one part's fields changed (``start``, ``goal``, ``slider``,
+        ``edges``, ``cf_uncertainty``); poses are taken as float arrays."""
+        for key in ("start", "goal"):
+            if key in changes:
+                changes[key] = np.asarray(changes[key], dtype=float)
+        return replace(self, parts=(replace(self.part(), **changes),))
 
     def with_options(self, options: PlannerOptions) -> "Scene":
         """This scene as planned with ``options``: its ``planner`` block replaced, and its
@@ -84,11 +148,34 @@ class Scene:
         pusher = self.pusher if options.transit is None else replace(self.pusher, transit=options.transit)
         return replace(self, planner=options, pusher=pusher)
 
+    def body(self, name: str, pose: ArrayLike) -> shapely.Polygon:
+        """Part ``name``'s outline at ``pose`` (world)."""
+        return slider_at(self.part(name).slider.polygon, pose)
+
+    def bodies(self, poses: Mapping[str, ArrayLike], without: tuple[str, ...] = ()) -> tuple[shapely.Polygon, ...]:
+        """The outlines of the parts at ``poses`` but those named in ``without``."""
+        return tuple(self.body(n, poses[n]) for n in self.names if n not in without)
+
+    def move_scene(self, name: str, poses: Mapping[str, ArrayLike], goal: ArrayLike | None = None,
+                   others: bool = True) -> "Scene":
+        """The one-part scene of pushing part ``name`` from ``poses[name]`` to ``goal`` (default:
+        its own), every other part an obstacle at its pose in ``poses`` (with ``others``; without,
+        the obstacles alone). The move scene of a one-part scene's part is the scene itself, but
+        for its start and goal."""
+        part = self.part(name)
+        moved = replace(part, start=np.array(poses[name], dtype=float),
+                        goal=np.array(part.goal if goal is None else goal, dtype=float))
+        if len(self.parts) == 1:
+            return replace(self, parts=(moved,))
+        obstacles = self.obstacles + (self.bodies(poses, (name,)) if others else ())
+        return replace(self, name=f"{self.name}.{name}", parts=(moved,), obstacles=obstacles, path=None)
+
     def within_tolerance(self, pose: ArrayLike, goal: ArrayLike | None = None) -> bool:
         """Whether ``pose`` ends the task: its origin within ``tolerance_position`` of ``goal``'s
-        (default: the scene's goal) and its heading within ``tolerance_angle``. The one test of the
-        tolerance: the search's goal test, the plan decoder and the certificates all use it.
+        (default: the one part's goal) and its heading within ``tolerance_angle``. The one test of
+        the tolerance: the search's goal test, the plan decoder and the certificates all use it.
 
+        >>> from planner.model.scene_file import parse_scene
         >>> scene = parse_scene({"slider": {"vertices": [[0, 0], [0.1, 0], [0.1, 0.1], [0, 0.1]]},
         ...     "pusher": {"width": 0.05, "depth": 0.01, "mu": 0.5}, "workspace": {"min": [-1, -1], "max": [1, 1]},
         ...     "start": [0, 0, 0], "goal": [0.5, 0, 0]})
@@ -101,12 +188,16 @@ class Scene:
         return (math.hypot(pose[0] - g[0], pose[1] - g[1]) <= self.tolerance_position
                 and abs(float(wrap_angle(pose[2] - g[2]))) <= self.tolerance_angle)
 
+    def delivered(self, name: str, pose: ArrayLike) -> bool:
+        """Whether part ``name`` at ``pose`` is within tolerance of its goal."""
+        return self.within_tolerance(pose, self.part(name).goal)
+
     def tolerance_slack(self, reach: float) -> float:
         """How far a point ``reach`` from the slider frame's origin may end from where it is at
         the goal, for a pose within tolerance: ``tolerance_position + reach * tolerance_angle``
         (a turn by ``a`` moves it ``2 reach sin(a / 2) <= reach a``).
 
-        >>> from dataclasses import replace
+        >>> from planner.model.scene_file import parse_scene
         >>> scene = replace(parse_scene({"slider": {"vertices": [[0, 0], [1, 0], [1, 1], [0, 1]]},
         ...     "pusher": {"width": 0.5, "depth": 0.1, "mu": 0.5}, "workspace": {"min": [-3, -3], "max": [3, 3]},
         ...     "start": [0, 0, 0], "goal": [1, 0, 0]}), tolerance_angle=0.1)
@@ -114,327 +205,3 @@ class Scene:
         0.21
         """
         return self.tolerance_position + reach * self.tolerance_angle
-
-
-def load_scene(path: str | Path, parse: Callable[..., Any] | None = None) -> Any:
-    """Read and validate a one-part YAML scene file (``planner.load_scene`` reads either kind,
-    :mod:`.scene_file`), with ``parse`` (default: :func:`parse_scene`) given the mapping, the
-    file's stem as the default name and its path.
-
-    Raises
-    ------
-    SceneError
-        If the file cannot be read or any field is missing, unknown or invalid.
-    """
-    path = Path(path)
-    return (parse or parse_scene)(read_yaml(path, "scene"), default_name=path.stem, path=str(path))
-
-
-def plain_scene(scene: Scene) -> dict[str, Any]:
-    """``scene`` as :func:`parse_scene` reads it back, in the plain schema: every polygon as its
-    vertices in metres (obstacle boxes and CAD files resolved), poses in degrees, the CF and the
-    pushed edges written out.
-
-    >>> scene = load_scene("scenes/battery.yaml")
-    >>> data = plain_scene(scene)
-    >>> data["slider"]["cf"], data["pusher"]["edges"], len(data["obstacles"][0]["polygon"])
-    ([0.0, 0.0], [3], 4)
-    >>> again = parse_scene(data)
-    >>> again.slider.vertices.tolist() == scene.slider.vertices.tolist(), again.obstacles == scene.obstacles
-    (True, True)
-    """
-    pusher = scene.pusher
-    return {
-        "name": scene.name,
-        "slider": {"vertices": scene.slider.vertices.tolist(), "cf": scene.slider.cf.tolist(),
-                   "cf_uncertainty": scene.cf_uncertainty},
-        "pusher": {"width": pusher.width, "depth": pusher.depth,
-                   "mu": pusher.mu if pusher.mu_high is None else [pusher.mu, pusher.mu_high],
-                   "edges": list(pusher.edges), "transit": pusher.transit},
-        "obstacles": [{"polygon": np.asarray(o.exterior.coords)[:-1].tolist()} for o in scene.obstacles],
-        "workspace": {"min": list(scene.workspace[:2]), "max": list(scene.workspace[2:])},
-        "start": [*scene.start[:2].tolist(), _degrees(scene.start[2])],
-        "goal": [*scene.goal[:2].tolist(), _degrees(scene.goal[2])],
-        "tolerance": {"position": scene.tolerance_position, "angle": _degrees(scene.tolerance_angle)},
-        "planner": {key: getattr(scene.planner, key) for key in PLANNER_KEYS},
-    }
-
-
-def _degrees(radians: float) -> float:
-    """``radians`` in degrees, to 1e-10 of a degree (as angles are read, :data:`.fields.ANGLE`), so
-    that the degrees a scene gave come back as given: 30, not 29.999999999999993."""
-    return round(math.degrees(radians), 10) + 0.0  # no -0.0
-
-
-def write_scene(scene: Scene, path: str | Path) -> None:
-    """Write :func:`plain_scene` of ``scene`` to ``path`` as YAML, atomically.
-
-    Raises
-    ------
-    OSError
-        Naming ``path``, if it cannot be written.
-    """
-    source = f" from {scene.path}" if scene.path else ""
-    text = yaml.safe_dump(plain_scene(scene), sort_keys=False, default_flow_style=None, width=120)
-    write_atomic(path, f"# The scene{source} as planned: plan --export-scene writes what the planner used.\n{text}")
-
-
-def _points(value: Any, name: str) -> np.ndarray:
-    if not isinstance(value, (list, tuple)):
-        raise SceneError(name, "must be a list of [x, y] points")
-    if len(value) < 3:
-        raise SceneError(name, f"needs at least 3 vertices, got {len(value)}")
-    return np.array([vector(p, f"{name}[{i}]", 2, LENGTH) for i, p in enumerate(value)])
-
-
-def _polygon(value: Any, name: str) -> shapely.Polygon:
-    return _simple_polygon(_points(value, name), name)
-
-
-def _simple_polygon(pts: np.ndarray, name: str) -> shapely.Polygon:
-    # Area first: the ring of collinear points doubles back on itself, and "self-intersecting"
-    # would send the reader looking for a crossing. The threshold is the one Slider uses,
-    # area <= 1e-12 * max(1, extent) ** 2, compared by square roots so that no square overflows.
-    with np.errstate(over="ignore"):  # an extent beyond a float is inf, and no zero area
-        extent = float(np.ptp(pts))
-    if math.sqrt(shapely.MultiPoint(pts).convex_hull.area) <= 1e-6 * max(1.0, extent):
-        raise SceneError(name, "polygon has zero area (its vertices are collinear or too close together)")
-    if not shapely.LinearRing(pts).is_simple:
-        raise SceneError(name, "polygon is self-intersecting")
-    return shapely.Polygon(pts)
-
-
-def _obstacles(value: Any, name: str, folder: Path, notes: list[str]) -> list[shapely.Polygon]:
-    """The obstacles of one entry of ``obstacles``: a polygon, a box, or those a file draws (each
-    of its bodies, cut where it has holes: :func:`.cad.without_holes`)."""
-    if isinstance(value, dict) and "file" in value:
-        from .cad import FILE_KEYS, FILE_OPTIONS, read_shapes, without_holes
-
-        shapes = read_shapes(keys(value, name, FILE_KEYS, FILE_OPTIONS), name, folder, notes)
-        return [piece for shape in shapes for piece in without_holes(shape.region)]
-    if not isinstance(value, dict) or len(value) != 1 or next(iter(value)) not in ("polygon", "box"):
-        raise SceneError(name, "must be {polygon: [[x, y], ...]}, {box: {center, size, angle}} or {file, units}")
-    if "polygon" in value:
-        return [_polygon(value["polygon"], f"{name}.polygon")]
-    box = keys(value["box"], f"{name}.box", ("center", "size"), ("angle",))
-    cx, cy = vector(box["center"], f"{name}.box.center", 2, LENGTH)
-    w, h = vector(box["size"], f"{name}.box.size", 2, LENGTH)
-    if not (w > 0 and h > 0):
-        raise SceneError(f"{name}.box.size", f"must be positive, got {shown(box['size'])}")
-    _at_least_min_size(min(w, h), f"{name}.box.size", box["size"])
-    angle = math.radians(number(box.get("angle", 0.0), f"{name}.box.angle", limit=ANGLE))
-    corners = np.array([[-w, -h], [w, -h], [w, h], [-w, h]]) / 2
-    rot = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
-    return [shapely.Polygon(corners @ rot.T + [cx, cy])]
-
-
-def read_slider(value: Any, folder: Path, notes: list[str], name: str = "slider",
-                more: tuple[str, ...] = ()) -> Slider:
-    """The part ``value`` describes (its vertices or a CAD file, and its CF), checked; errors
-    name the fields under ``name``, and ``more`` are further keys ``value`` may hold (read by
-    the caller: a multi-part scene's name, start and goal)."""
-    if isinstance(value, dict) and "file" in value:
-        return _slider_from_file(value, folder, notes, name, more)
-    spec = keys(value, name, ("vertices",), ("cf", "cf_uncertainty") + more)
-    vertices = _points(spec["vertices"], f"{name}.vertices")
-    return _checked_slider(vertices, spec, f"{name}.vertices", name)
-
-
-def _slider_from_file(value: dict, folder: Path, notes: list[str], name: str, more: tuple[str, ...]) -> Slider:
-    """The part a file draws: its outline is what the pusher touches, and its default CF the
-    centroid of its footprint, holes left out (a hole carries no weight)."""
-    from .cad import FILE_KEYS, FILE_OPTIONS, read_shapes
-
-    spec = keys(value, name, FILE_KEYS, FILE_OPTIONS + ("cf", "cf_uncertainty") + more)
-    shapes = read_shapes({k: v for k, v in spec.items() if k not in more}, name, folder, notes)
-    if len(shapes) > 1:
-        raise SceneError(f"{name}.file", f"holds {len(shapes)} parts: pick one with layer or name")
-    (shape,) = shapes
-    if shape.footprint.area <= 0:
-        raise SceneError(f"{name}.file", "the part has no footprint on the table")
-    vertices = np.asarray(shape.region.exterior.coords)[:-1]
-    cf = np.asarray(shape.footprint.centroid.coords[0])
-    return _checked_slider(vertices, {"cf": cf.tolist(), **spec}, f"{name}.file", name)
-
-
-def _checked_slider(vertices: np.ndarray, spec: dict, field: str, name: str) -> Slider:
-    """The part of ``vertices`` and ``spec``'s ``cf`` (default: the area centroid), checked;
-    ``field`` is where the vertices came from, ``name`` the part's field."""
-    _simple_polygon(vertices, field)
-    # A repeated vertex makes an edge of no length, with no normal to push along; shapely accepts it.
-    # Nearly repeated is as bad: the edge's direction is rounding noise, or its square underflows to 0.
-    repeated = np.flatnonzero(np.hypot(*(vertices - np.roll(vertices, -1, axis=0)).T) < MIN_SIZE)
-    if len(repeated):
-        k = int(repeated[0])
-        raise SceneError(field, f"vertices {k} and {(k + 1) % len(vertices)} coincide (closer than "
-                                f"{MIN_SIZE:g} m), so edge {k} has no length (do not repeat the first "
-                                "vertex at the end)")
-    try:
-        part = Slider(vertices)
-    except ValueError as err:
-        raise SceneError(field, str(err)) from None
-    if not part.pushable_edges:  # a star: otherwise each edge would be refused later, as unstable
-        raise SceneError(field, "no edge lies on the part's convex hull, so a flat pusher cannot push "
-                                "any (each edge has a vertex beyond its line)")
-    if "cf" not in spec:
-        return part
-    cf = vector(spec["cf"], f"{name}.cf", 2, LENGTH)  # outside the try: a SceneError is a ValueError too
-    try:
-        return Slider(vertices, cf)
-    except ValueError as err:
-        raise SceneError(f"{name}.cf", str(err)) from None
-
-
-def read_pusher(value: Any, slider: Slider | None) -> Pusher:
-    """The pusher ``value`` describes, with the edges it may push of ``slider`` (default: all
-    pushable); a multi-part scene (``slider`` None) gives edges per part (:func:`read_edges`)."""
-    spec = keys(value, "pusher", ("width", "depth", "mu"), ("edges", "transit") if slider is not None else ("transit",))
-    width, depth = (_at_least_min_size(number(spec[key], f"pusher.{key}", positive=True, limit=LENGTH),
-                                       f"pusher.{key}", spec[key]) for key in ("width", "depth"))
-    mu, mu_high = _friction(spec["mu"])
-    transit = check_transit(spec.get("transit", DEFAULT_TRANSIT), "pusher.transit")
-    edges = () if slider is None else read_edges(spec.get("edges"), slider, "pusher.edges")
-    return Pusher(width, depth, mu, edges, mu_high, transit)
-
-
-def read_edges(listed: Any, slider: Slider, name: str) -> tuple[int, ...]:
-    """The edges of ``slider`` listed at ``name`` (None: every pushable edge), checked."""
-    if listed is None:
-        return slider.pushable_edges
-    if not isinstance(listed, (list, tuple)) or not listed:
-        raise SceneError(name, "must be a non-empty list of edge indices")
-    edges = []
-    for i, e in enumerate(listed):
-        e = integer(e, f"{name}[{i}]")
-        if not 0 <= e < slider.n:
-            raise SceneError(name, f"edge {e} does not exist (the part has edges 0..{slider.n - 1})")
-        if not slider.is_pushable(e):
-            raise SceneError(name, f"edge {e} is not on the convex hull, so a flat pusher cannot push it")
-        if e in edges:
-            raise SceneError(name, f"edge {e} is listed twice")
-        edges.append(e)
-    return tuple(edges)
-
-
-def _friction(value: Any) -> tuple[float, float | None]:
-    """``pusher.mu``: a number in :data:`MU_RANGE`, or an interval ``[low, high]`` in it, ``low <= high``."""
-    interval = isinstance(value, (list, tuple))
-    if interval:
-        low, high = vector(value, "pusher.mu", 2)
-        if not 0 < low <= high:
-            raise SceneError("pusher.mu", f"an interval must be [low, high] with 0 < low <= high, got {shown(value)}")
-    else:
-        low = high = number(value, "pusher.mu", positive=True)
-    if not (MU_RANGE[0] <= low and high <= MU_RANGE[1]):
-        raise SceneError("pusher.mu", f"must be from {MU_RANGE[0]:g} to {MU_RANGE[1]:g}, got {shown(value)}")
-    return float(low), float(high) if interval else None
-
-
-def _at_least_min_size(size: float, name: str, given: Any) -> float:
-    """``size``, the least dimension of a body, if it is at least :data:`MIN_SIZE` (``given`` is
-    the field's value, for the message)."""
-    if size < MIN_SIZE:
-        raise SceneError(name, f"must be at least {MIN_SIZE:g} m, got {shown(given)}")
-    return size
-
-
-def read_pose(value: Any, name: str, slider: Slider, obstacles: tuple[shapely.Polygon, ...],
-              workspace: tuple[float, float, float, float]) -> np.ndarray:
-    """A pose ``[x, y, degrees]`` as ``(x, y, radians)`` with the angle in ``[-pi, pi)``, as the
-    plan's segments have theirs; the part there must be in the workspace and clear of obstacles."""
-    x, y, theta = vector(value, name, 3)
-    LENGTH.check(x, f"{name}[0]")
-    LENGTH.check(y, f"{name}[1]")
-    pose = np.array([x, y, float(wrap_angle(math.radians(ANGLE.check(theta, f"{name}[2]"))))])
-    if (fault := placement_fault(slider, obstacles, workspace, pose)) is not None:
-        raise SceneError(name, fault)
-    return pose
-
-
-def placement_fault(slider: Slider, obstacles: tuple[shapely.Polygon, ...],
-                    workspace: tuple[float, float, float, float], pose: ArrayLike) -> str | None:
-    """Why the part cannot be at ``pose`` (outside the workspace, or on an obstacle), or None."""
-    body = slider_at(slider.polygon, pose)
-    if not shapely.box(*workspace).contains(body):
-        return "the part is not inside the workspace"
-    for k, obstacle in enumerate(obstacles):
-        if body.intersects(obstacle):
-            return f"the part collides with obstacle {k}"
-    return None
-
-
-def parse_scene(data: Any, default_name: str = "scene", path: str | None = None) -> Scene:
-    """Validate a one-part scene given as the parsed YAML mapping (see :func:`load_scene`); the
-    files it names are relative to the folder of ``path`` (the working folder if None). Any scene,
-    multi-part ones too, is read by :mod:`.scene_file`."""
-    spec = keys(data, "scene", ("slider", "pusher", "workspace", "start", "goal"),
-                 ("name", "obstacles", "tolerance", "planner"))
-    name = read_name(spec.get("name", default_name))
-    folder, notes = Path(path).parent if path else Path(), []
-    slider = read_slider(spec["slider"], folder, notes)
-    cf_uncertainty = read_cf_uncertainty(spec["slider"], slider, "slider")
-    pusher = read_pusher(spec["pusher"], slider)
-    table = read_table(spec, folder, notes)
-    start = read_pose(spec["start"], "start", slider, table.obstacles, table.workspace)
-    goal = read_pose(spec["goal"], "goal", slider, table.obstacles, table.workspace)
-    return Scene(name, slider, pusher, table.obstacles, table.workspace, start, goal, table.tolerance_position,
-                 table.tolerance_angle, table.planner, path, cf_uncertainty, tuple(notes))
-
-
-@dataclass(frozen=True)
-class Table:
-    """What every scene has besides its parts and pusher: obstacles, workspace, goal tolerance
-    and planner options."""
-
-    obstacles: tuple[shapely.Polygon, ...]
-    workspace: tuple[float, float, float, float]
-    tolerance_position: float
-    tolerance_angle: float
-    planner: PlannerOptions
-
-
-def read_table(spec: dict, folder: Path, notes: list[str]) -> Table:
-    """The :class:`Table` of a scene's mapping ``spec``, checked; CAD files are relative to ``folder``."""
-    obstacles_spec = [] if spec.get("obstacles") is None else spec["obstacles"]  # None: a bare "obstacles:"
-    if not isinstance(obstacles_spec, list):
-        raise SceneError("obstacles", "must be a list")
-    obstacles = tuple(p for k, o in enumerate(obstacles_spec) for p in _obstacles(o, f"obstacles[{k}]", folder, notes))
-    ws = keys(spec["workspace"], "workspace", ("min", "max"))
-    lo, hi = vector(ws["min"], "workspace.min", 2, LENGTH), vector(ws["max"], "workspace.max", 2, LENGTH)
-    if not np.all(hi > lo):
-        raise SceneError("workspace", f"is empty or inverted: max {hi.tolist()} must exceed min {lo.tolist()}")
-    workspace = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
-    tol = keys(spec.get("tolerance", {}), "tolerance", (), ("position", "angle"))
-    tol_pos = number(tol.get("position", 0.01), "tolerance.position", positive=True, limit=LENGTH)
-    tol_ang = math.radians(number(tol.get("angle", 2.0), "tolerance.angle", positive=True, limit=ANGLE))
-    # Plans compose many exponentials: their poses carry rounding of about 1e-11 of the table's size
-    # (and radian). A tolerance below what that resolves could not tell a plan that ends within it.
-    size = max(1.0, float(np.max(np.abs(workspace))))
-    least = float(f"{MIN_TOLERANCE * size:.3g}")  # the limit as the message shows it
-    if tol_pos < least:
-        raise SceneError("tolerance.position", f"must be at least {least:g} m (the rounding of a plan's poses on "
-                                               f"this table is about {1e-11 * size:g} m), got {tol_pos:g}")
-    if tol_ang < MIN_TOLERANCE:
-        raise SceneError("tolerance.angle", f"must be at least {math.degrees(MIN_TOLERANCE):g} degrees (the rounding "
-                                            f"of a plan's headings is about 1e-11 rad), got {math.degrees(tol_ang):g}")
-    opts = keys(spec.get("planner", {}), "planner", (), PLANNER_KEYS)
-    return Table(obstacles, workspace, tol_pos, tol_ang, PlannerOptions().merged(opts, prefix="planner."))
-
-
-def read_cf_uncertainty(spec: dict, slider: Slider, name: str) -> float:
-    """``<name>.cf_uncertainty``: the radius (>= 0, less than the part's radius) of the disk about
-    the CF that holds the true CF."""
-    radius = number(spec.get("cf_uncertainty", 0.0), f"{name}.cf_uncertainty")
-    if not 0 <= radius < slider.radius:
-        raise SceneError(f"{name}.cf_uncertainty", f"must be >= 0 and less than the part's radius "
-                                                  f"{slider.radius:.4g}, got {shown(radius)}")
-    return radius
-
-
-def read_name(value: Any) -> str:
-    # The name names the output files, so it must make a plain file name.
-    if not isinstance(value, str) or not value or not value.isprintable() or any(c in value for c in "/\\"):
-        raise SceneError("name", f"must be a plain non-empty string, got {shown(value)}")
-    if len(value.encode()) > _MAX_NAME_BYTES:
-        raise SceneError("name", f"must be at most {_MAX_NAME_BYTES} bytes long, got {len(value.encode())}")
-    return value

@@ -119,7 +119,7 @@ def prepare(scene: Scene, wait: Callable[[float], bool], cache: RegionCache | No
     :mod:`planner.outputs.recorder` runs this beside the search, which caches the regions of a new
     part first, and then writes the recording with the same cache."""
     p = scene.pusher
-    pending = list(p.edges)
+    pending = list(scene.edges)
     while pending and not wait(0.0):
         ready = [e for e in pending if is_cached(scene.slider, e, p.mu, p.width, "exact", scene.cf_uncertainty, cache)]
         if not ready:

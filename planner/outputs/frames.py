@@ -16,7 +16,8 @@ from mechanics import Slider, exp_twist
 
 from ..actions.transit import edge_contact_pose, transit_poses
 from ..model.bodies import place, pusher_frame_body
-from ..model.plan_file import Plan, Push, Transit
+from ..model.plan import Plan
+from ..model.segments import Push, Transit
 from ..model.scene import Scene
 
 __all__ = ["FRAMES_PER_RADIUS", "MAX_FRAMES", "PATH_POINTS", "Frames", "frames", "history", "pusher_on", "sample"]

@@ -34,8 +34,8 @@ import rerun.blueprint as rrb
 from ..actions.transit import transit_poses
 from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
-from ..model.parts import PartsScene
-from ..model.parts_plan import PartsPlan
+from ..model.scene import Scene
+from ..model.plan import Plan
 from .frames import FRAMES_PER_RADIUS, MAX_FRAMES, sample
 from .recording import (_BOLD, _DARK, _GREY, _LIFTED, _THIN, _closed, _log_pusher_paths, _log_table, _log_text,
                         _top_view, _z)
@@ -47,12 +47,12 @@ PALETTE = ([40, 110, 220], [230, 130, 20], [20, 170, 150], [210, 40, 190], [140,
            [200, 170, 20], [60, 160, 60], [235, 70, 120], [90, 160, 255])
 
 
-def part_colours(scene: PartsScene) -> dict[str, list[int]]:
+def part_colours(scene: Scene) -> dict[str, list[int]]:
     """Each part's colour: :data:`PALETTE` in scene order."""
     return {n: PALETTE[k % len(PALETTE)] for k, n in enumerate(scene.names)}
 
 
-def _summary(scene: PartsScene, plan: PartsPlan) -> list[str]:
+def _summary(scene: Scene, plan: Plan) -> list[str]:
     head = f"{scene.name}: planner {plan.planner}, seed {plan.seed}"
     missing = [n for n in scene.names if n not in plan.delivered]
     delivered = (f"delivered: {len(plan.delivered)} of {len(scene.names)} parts"
@@ -64,12 +64,12 @@ def _summary(scene: PartsScene, plan: PartsPlan) -> list[str]:
             "and per transfer)", delivered]
 
 
-def _frames(scene: PartsScene, plan: PartsPlan) -> tuple[np.ndarray, dict[str, np.ndarray], np.ndarray, np.ndarray]:
+def _frames(scene: Scene, plan: Plan) -> tuple[np.ndarray, dict[str, np.ndarray], np.ndarray, np.ndarray]:
     """Times, each part's pose, the pusher's pose and its being lifted, frame by frame: no body
     point moves more than a twentieth of the smallest part's radius between frames, unless that
     would take more than :data:`~planner.outputs.frames.MAX_FRAMES` frames."""
     body = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
-    segments = plan.segments
+    segments = plan.steps
     durations = np.array([s.duration for _, s in segments])
     step = min(p.slider.radius for p in scene.parts) / FRAMES_PER_RADIUS
     counts = np.maximum(np.ceil(durations / step), 1).astype(int)
@@ -99,7 +99,7 @@ def _frames(scene: PartsScene, plan: PartsPlan) -> tuple[np.ndarray, dict[str, n
             np.concatenate(lifted))
 
 
-def write_parts_recording(path: str | Path, scene: PartsScene, plan: PartsPlan) -> None:
+def write_parts_recording(path: str | Path, scene: Scene, plan: Plan) -> None:
     """Write a rerun recording of ``plan`` for ``scene`` to ``path`` (module docstring), atomically.
 
     Raises

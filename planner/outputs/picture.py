@@ -18,10 +18,9 @@ from mechanics import exp_twist, transform_points
 
 from ..model.bodies import pusher_frame_body, pusher_polygon
 from ..model.extras import have, needs, pyplot
-from ..model.parts import PartsScene
-from ..model.parts_plan import PartsPlan
-from ..model.plan_file import Plan, Transit
 from ..model.scene import Scene
+from ..model.plan import Plan
+from ..model.segments import Transit
 from ..model.scene_file import load_scene
 from ..queries.session import plan
 from ..actions.transit import transit_pieces, transit_poses
@@ -34,7 +33,7 @@ TRANSIT = "#8e44ad"
 
 def draw_plan(scene: Scene, result: Plan, path: str, copies_per_metre: float = 40.0) -> None:
     """Write a PNG of ``result`` for ``scene`` to ``path``, with ``copies_per_metre`` faint
-    copies of the moving body per metre it travels, and the plan's :meth:`~planner.model.plan_file.Plan.headline`
+    copies of the moving body per metre it travels, and the plan's :meth:`~planner.model.plan.Plan.headline`
     as its ``Description`` text."""
     plt = pyplot()  # first: without matplotlib, one line naming the extra
 
@@ -90,7 +89,7 @@ def draw_plan(scene: Scene, result: Plan, path: str, copies_per_metre: float = 4
     plt.close(fig)
 
 
-def draw_parts_plan(scene: PartsScene, result: PartsPlan, path: str) -> None:
+def draw_parts_plan(scene: Scene, result: Plan, path: str) -> None:
     """Write a PNG of the multi-part plan ``result`` for ``scene`` to ``path``: each part in its
     colour (the recording's, :func:`~planner.outputs.parts_recording.part_colours`) at its start
     (thin, grey) and where the plan leaves it (bold), its goal dashed, the path of its centre of
@@ -140,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
     if not have("matplotlib"):  # before the planning, one line
         sys.exit(f"{p.prog}: error: {needs('matplotlib')}")
     scene = load_scene(args.scene)
-    (draw_parts_plan if isinstance(scene, PartsScene) else draw_plan)(scene, plan(scene, seed=args.seed), args.out)
+    (draw_parts_plan if len(scene.parts) > 1 else draw_plan)(scene, plan(scene, seed=args.seed), args.out)
     return 0
 
 

@@ -120,10 +120,10 @@ from ..actions.region_cache import RegionCache
 from ..actions.transit import transit_pieces
 from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
-from ..model.parts import PartsScene
-from ..model.parts_plan import Transfer
-from ..model.plan_file import Plan, Transit
 from ..model.scene import Scene
+from ..model.segments import Transfer
+from ..model.plan import Plan
+from ..model.segments import Transit
 from .analysis import STATUS, analysis
 from .frames import FRAMES_PER_RADIUS, frames, history
 
@@ -202,7 +202,7 @@ def _log_text(rec: rr.RecordingStream, entity: str, lines: list[str], level: str
                      columns=rr.TextLog.columns(text=lines, level=[level] * len(lines)))
 
 
-def _log_table(rec: rr.RecordingStream, scene: Scene | PartsScene) -> None:
+def _log_table(rec: rr.RecordingStream, scene: Scene) -> None:
     """The world's axes, ``/world/workspace`` and ``/world/obstacles``, static."""
     xmin, ymin, xmax, ymax = scene.workspace
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)

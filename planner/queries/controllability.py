@@ -139,7 +139,7 @@ def controllability(scene: Scene) -> SceneControllability:
     stlc_edges = _stlc_edges(twists) if union.stlc else ()
     normals = [scene.slider.inward_normal(e) for e in stlc_edges]
     opposite = len(normals) == 2 and float(normals[0] @ normals[1]) < -1.0 + 1e-9
-    return SceneControllability(per_edge, tuple(e for e in scene.pusher.edges if e not in twists), union,
+    return SceneControllability(per_edge, tuple(e for e in scene.edges if e not in twists), union,
                                 stlc_edges, scene.pusher.transit != "none", opposite)
 
 

@@ -30,7 +30,7 @@ mirror image down. With :data:`~planner.world.free_space.QUAD_SEGS` = 6 the arcs
 sin(pi / 24) + 0.1 - 0.01``; the true geodesic has ``rho pi / 3`` of arcs instead of the chords:
 
 >>> import math
->>> from planner.model.scene import parse_scene
+>>> from planner.model.scene_file import parse_scene
 >>> scene = parse_scene({
 ...     "slider": {"vertices": [[-0.05, -0.05], [0.05, -0.05], [0.05, 0.05], [-0.05, 0.05]]},
 ...     "pusher": {"width": 0.05, "depth": 0.01, "mu": 0.5},

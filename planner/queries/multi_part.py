@@ -2,7 +2,7 @@
 pusher's travel between them.
 
 The search is over orders of *moves*. A move pushes one part, with every other part an obstacle
-where it stands at that moment (:meth:`~planner.model.parts.PartsScene.move_scene`), either to
+where it stands at that moment (:meth:`~planner.model.scene.Scene.move_scene`), either to
 its goal or to a *buffer* pose out of the way, to be fetched later; it is planned by a
 :class:`~planner.queries.session.Planner` session of that part among those obstacles, which
 plans the buffer poses tried from there too. Between two moves the pusher travels from where it
@@ -18,8 +18,8 @@ forced order (a dead end filled from the far end) is found, and a cycle of parts
 next's goal (a swap) is broken by one buffer move. Poses already seen are not searched again.
 
 The time limit bounds everything; if it runs out, the plan is the furthest the search got: the
-most parts delivered, which the plan names. :class:`~planner.queries.session.PartsPlanner` is
-the session that runs this search (``Planner`` of a multi-part scene).
+most parts delivered, which the plan names. A :class:`~planner.queries.session.Planner` of a
+scene of several parts runs this search.
 """
 
 from __future__ import annotations
@@ -35,9 +35,9 @@ import shapely
 from ..actions.controls import NoStablePush
 from ..actions.transit import edge_contact_pose
 from ..model.bodies import slider_at
-from ..model.parts import PartsScene
-from ..model.parts_plan import Move, PartsPlan
-from ..model.plan_file import Plan
+from ..model.scene import Scene
+from ..model.plan import Move, Plan
+from ..model.plan import Plan
 from ..search.transfer import TransferPaths
 
 __all__ = ["BUFFER_TRIES", "MOVE_SHARE", "PartSession", "plan_parts"]
@@ -66,8 +66,8 @@ class _Best:
     delivered: int
 
 
-def plan_parts(scene: PartsScene, session_of: Callable[[str, dict[str, np.ndarray] | None], PartSession],
-               paths: TransferPaths, seed: int, time_limit: float) -> PartsPlan:
+def plan_parts(scene: Scene, session_of: Callable[[str, dict[str, np.ndarray] | None], PartSession],
+               paths: TransferPaths, seed: int, time_limit: float) -> Plan:
     """Plan every part of ``scene`` from its start to its goal (module docstring) within
     ``time_limit`` seconds, each move planned by ``session_of(part, poses)`` (a one-part session
     of the part with the others at ``poses``; with ``poses`` None, among the obstacles alone) and
@@ -77,17 +77,17 @@ def plan_parts(scene: PartsScene, session_of: Callable[[str, dict[str, np.ndarra
     delivered in any order: it is left where it is (an obstacle to the others), the rest are
     planned, and the plan, not solved, says why."""
     clock = time.perf_counter()
-    hopeless = {p.name: reason for p in scene.parts if not scene.within_tolerance(p.name, p.start)
+    hopeless = {p.name: reason for p in scene.parts if not scene.delivered(p.name, p.start)
                 and (reason := session_of(p.name, None).certify_unreachable(p.goal)) is not None}
     search = _Search(scene, session_of, paths, seed, clock + time_limit, time_limit, tuple(hopeless))
     found = search.run(scene.starts)
     moves = found if found is not None else search.best.moves
     finals = scene.starts | {m.part: m.end for m in moves}
-    delivered = tuple(n for n in scene.names if scene.within_tolerance(n, finals[n]))
+    delivered = tuple(n for n in scene.names if scene.delivered(n, finals[n]))
     solved = found is not None and not hopeless
     reason = "" if solved else search.why(delivered) if found is None else "; ".join(
         f"not delivered: {n}: its goal is certified unreachable among the obstacles: {r}" for n, r in hopeless.items())
-    return PartsPlan(scene=scene.path, solved=solved, planner=scene.planner.name, seed=seed,
+    return Plan(scene=scene.path, solved=solved, planner=scene.planner.name, seed=seed,
                      planning_time_s=time.perf_counter() - clock, starts=scene.starts, goals=scene.goals,
                      moves=moves, delivered=delivered, reason=reason,
                      switch_cost=scene.planner.switch_cost, cfs={p.name: p.slider.cf.copy() for p in scene.parts})
@@ -96,7 +96,7 @@ def plan_parts(scene: PartsScene, session_of: Callable[[str, dict[str, np.ndarra
 class _Search:
     """One depth-first search of :func:`plan_parts`."""
 
-    def __init__(self, scene: PartsScene, session_of: Callable[[str, dict[str, np.ndarray] | None], PartSession],
+    def __init__(self, scene: Scene, session_of: Callable[[str, dict[str, np.ndarray] | None], PartSession],
                  paths: TransferPaths, seed: int, deadline: float, limit: float, hopeless: tuple[str, ...] = ()):
         self.scene, self.session_of, self.paths, self.seed, self.deadline = scene, session_of, paths, seed, deadline
         self.hopeless = hopeless
@@ -118,7 +118,7 @@ class _Search:
 
     def _search(self, poses: dict[str, np.ndarray], moves: list[Move], buffers: int) -> list[Move] | None:
         scene = self.scene
-        pending = [n for n in scene.names if not scene.within_tolerance(n, poses[n]) and n not in self.hopeless]
+        pending = [n for n in scene.names if not scene.delivered(n, poses[n]) and n not in self.hopeless]
         delivered = len(scene.names) - len(pending) - len(self.hopeless)
         if delivered > self.best.delivered or (delivered == self.best.delivered and len(moves) < len(self.best.moves)):
             self.best = _Best(list(moves), delivered)

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import GOALS, SupportModel, classify_goal, log_pose
 
-from ..model.plan_file import Push
+from ..model.segments import Push
 from ..actions.controls import clearance_margin, edge_controls
 from ..actions.push import connect
 from ..model.scene import Scene
@@ -71,4 +71,4 @@ def goal_verdicts(scene: Scene, start: ArrayLike, goal: ArrayLike) -> dict[int, 
     if not np.any(total):  # no motion: no COR to classify
         return {}
     p, support = scene.pusher, SupportModel.of_slider(scene.slider, cf_radius=scene.cf_uncertainty)
-    return {e: GOALS[classify_goal(scene.slider, e, p.mu, total, support, p.width)] for e in p.edges}
+    return {e: GOALS[classify_goal(scene.slider, e, p.mu, total, support, p.width)] for e in scene.edges}

@@ -46,7 +46,8 @@ from numpy.typing import ArrayLike
 
 from mechanics import transform_points
 from .one_step import goal_verdicts
-from ..model.plan_file import Plan, Push, Transit
+from ..model.plan import Plan
+from ..model.segments import Push, Transit
 from ..actions.controls import clearance_margin, controls_or_reason
 from ..model.fields import poses
 from ..model.scene import Scene
@@ -104,7 +105,7 @@ class Certificates:
 
     def __init__(self, scene: Scene, model: CollisionModel | None = None):
         self.scene = scene
-        self.model = model or CollisionModel(scene, scene.pusher.edges)
+        self.model = model or CollisionModel(scene, scene.edges)
         self.margin = clearance_margin(scene)
         circle = shapely.maximum_inscribed_circle(scene.slider.polygon)
         self.centre, self.radius = np.asarray(circle.coords[0]), circle.length
@@ -125,7 +126,7 @@ class Certificates:
         start = scene.start if start is None else start
         if scene.within_tolerance(start, goal):
             return None
-        edges = scene.pusher.edges
+        edges = scene.edges
         if not any(model.is_clear(goal, e, self.margin) for e in edges):  # else the goal itself has room
             room = f"with the push margin of {self.margin * 1000:.3g} mm"
             if self._blocked(model.part_pieces, goal):
@@ -183,8 +184,9 @@ def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | N
     open_goals = [i for i, reason in enumerate(reasons) if reason is None]
     plans: dict[int, Plan] = {}
     if context is None:
-        plans = {i: Plan(scene=scene.path, solved=True, planner=scene.planner.name, seed=scene.planner.seed,
-                         planning_time_s=0.0, start=scene.start.copy(), goal=goals[i].copy()) for i in open_goals}
+        plans = {i: Plan.of_part(scene.part().name, scene.start, goals[i], [], scene=scene.path, solved=True,
+                                 planner=scene.planner.name, seed=scene.planner.seed, planning_time_s=0.0)
+                 for i in open_goals}
     elif open_goals:
         plans = dict(zip(open_goals, solve_many(context, goals[open_goals], shorten=False, timings=timings,
                                                           known=known)))

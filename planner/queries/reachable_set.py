@@ -45,7 +45,7 @@ from mechanics import log_pose, wrap_angle
 
 from ..actions.push import connect
 from ..model.extras import pyplot
-from ..model.plan_file import Push
+from ..model.segments import Push
 from ..search.goal_region import GoalRegion
 from ..actions.controls import EdgeControls, clearance_margin, controls_or_reason
 from ..model.scene import Scene

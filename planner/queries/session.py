@@ -41,10 +41,9 @@ from ..actions.controls import NoStablePush, RegionTimeout, clearance_margin
 from ..actions.region_cache import RegionCache
 from ..model.fields import SceneError, integer, poses
 from ..model.options import PlannerOptions, check_planner
-from ..model.parts import PartsScene
-from ..model.parts_plan import PartsPlan
-from ..model.plan_file import Plan, Push, Transit, rechain
 from ..model.scene import Scene
+from ..model.plan import Plan
+from ..model.segments import Push, Transit, rechain
 from ..search import PlanningContext, PlanRequest, SearchWorld, solve
 from ..search.context import cost, plan_result
 from ..search.transfer import TransferPaths
@@ -53,7 +52,7 @@ from .multi_part import plan_parts
 from .reachability import Certificates, Reach, answers
 from .reachable_set import ReachableSet, reachable_set
 
-__all__ = ["JOINED_PLANS", "JOIN_SLACK", "PartsPlanner", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
+__all__ = ["JOINED_PLANS", "JOIN_SLACK", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
            "reachability", "session_options"]
 
 #: Without a time limit, :meth:`Planner.reachability` grows its search for this long plus this
@@ -92,9 +91,9 @@ class Planner:
     progress : callable, optional
         ``progress(k, n)`` before computing the ``k``-th of the ``n`` regions not cached.
 
-    A multi-part scene (:class:`~planner.model.parts.PartsScene`) gets a
-    :class:`~planner.queries.multi_part.PartsPlanner` instead, whose :meth:`plan` plans the whole
-    transfer.
+    A scene of several parts is planned as a whole: :meth:`plan` searches the order of moves
+    (:mod:`planner.queries.multi_part`), each move planned by a session of one part among the
+    others where they stand (made once and kept, :meth:`move_session`).
 
     Setting up computes the regions within half the options' time limit; edges not done by then
     are left out (``note`` says which), and a session with none plans nothing (each plan says why).
@@ -105,12 +104,6 @@ class Planner:
         If an option is invalid, or the pusher has no room at the scene's start.
     """
 
-    def __new__(cls, scene: Scene | PartsScene, *args: Any, **kwargs: Any):
-        # A multi-part scene is planned by its own kind of session, with the same arguments.
-        if cls is Planner and isinstance(scene, PartsScene):
-            return PartsPlanner(scene, *args, **kwargs)
-        return super().__new__(cls)
-
     def __init__(self, scene: Scene, options: PlannerOptions | Mapping[str, Any] | None = None, *,
                  cache: RegionCache | None = None, progress: Callable[[int, int], None] | None = None):
         self.clock = time.perf_counter()
@@ -119,23 +112,33 @@ class Planner:
         self.options = session_options(scene, options)
         #: The scene as planned: its ``planner`` block is these options.
         self.scene = scene.with_options(self.options)
-        self.model = CollisionModel(self.scene, self.scene.pusher.edges)
-        self.certificates = Certificates(self.scene, self.model)
+        self._cache, self._progress = cache, progress
+        self.model: CollisionModel | None = None
+        self.certificates: Certificates | None = None
         self.world: SearchWorld | None = None
         self._no_push: NoStablePush | None = None
         self._timeout = ""
-        try:
-            self.world = SearchWorld.build(self.scene, self.clock + self.options.time_limit / 2, progress, cache,
-                                           self.model)
-        except NoStablePush as err:
-            self._no_push = err
-        except RegionTimeout as timeout:
-            self._timeout = str(timeout)
         self._plans: OrderedDict[tuple[float, ...], list[Plan]] = OrderedDict()
         self._reached: OrderedDict[tuple[float, ...], OrderedDict[tuple[float, ...], list[Push | Transit]]] = OrderedDict()
+        self._moves: OrderedDict[tuple, Planner] = OrderedDict()
+        self.paths: TransferPaths | None = None
         #: Seconds the last :meth:`reachability` spent on the certificates, the direct connections
         #: and the tree's growth.
         self.timings: dict[str, float] = {}
+        if len(self.scene.parts) > 1:
+            # Each move is set up when the search first asks for it: only the transfers' free space now.
+            margin = min(clearance_margin(self.scene.move_scene(n, self.scene.starts)) for n in self.scene.names)
+            self.paths = TransferPaths(self.scene, margin)
+        else:
+            self.model = CollisionModel(self.scene, self.scene.edges)
+            self.certificates = Certificates(self.scene, self.model)
+            try:
+                self.world = SearchWorld.build(self.scene, self.clock + self.options.time_limit / 2, progress, cache,
+                                               self.model)
+            except NoStablePush as err:
+                self._no_push = err
+            except RegionTimeout as timeout:
+                self._timeout = str(timeout)
         #: Seconds setting the session up took (the regions, read or computed, and the rest).
         self.setup_s = time.perf_counter() - self.clock
 
@@ -178,10 +181,12 @@ class Planner:
             allowed edge has a stable push.
         """
         request = self._request(seed, time_limit, optimize, planner)
+        if self.paths is not None:
+            return self._plan_parts(start, goal, request, edges)
         start = self._pose(start, "start", self.scene.start)
         goal = self._pose(goal, "goal", self.scene.goal)
-        if edges is not None and not all(isinstance(e, int) and e in self.scene.pusher.edges for e in edges):
-            raise SceneError("edges", f"must be allowed edges of the pusher {list(self.scene.pusher.edges)}, got {edges}")
+        if edges is not None and not all(isinstance(e, int) and e in self.scene.edges for e in edges):
+            raise SceneError("edges", f"must be allowed edges of the pusher {list(self.scene.edges)}, got {edges}")
         return self._plan(start, goal, request, time.perf_counter(), reuse, edges, observed)
 
     def _plan(self, start: np.ndarray, goal: np.ndarray, request: PlanRequest, clock: float,
@@ -283,7 +288,7 @@ class Planner:
             time_limit = min(self.options.time_limit, REACH_BASE_S + REACH_PER_GOAL_S * reasons.count(None))
         request = self._request(seed, time_limit)
         clock = time.perf_counter()
-        scene = self.scene if np.array_equal(start, self.scene.start) else replace(self.scene, start=start)
+        scene = self.scene if np.array_equal(start, self.scene.start) else self.scene.with_part(start=start)
         if self.world is None and self._no_push is None:  # no region in time: nothing certain but the geometry
             return [Reach("unreachable", None, r, None, scene, g) if r else Reach("unknown", None, self._timeout, None,
                                                                                    scene, g)
@@ -301,6 +306,29 @@ class Planner:
                 if not oldest:
                     self._reached.pop(next(iter(self._reached)))
         return found
+
+    def _plan_parts(self, start: object, goal: object, request: PlanRequest, edges: object) -> Plan:
+        """:meth:`plan` of a scene of several parts: every part from its start to its goal, or as
+        far as the search got (``solved`` False, ``delivered`` naming the parts at their goals)."""
+        for name, value in (("start", start), ("goal", goal), ("edges", edges)):
+            if value is not None:
+                raise SceneError(name, "is for a scene of one part: a scene of several plans from each part's start "
+                                       "to its goal")
+        return plan_parts(self.scene, self.move_session, self.paths, request.seed, request.time_limit)
+
+    def move_session(self, part: str, poses: Mapping[str, np.ndarray] | None) -> "Planner":
+        """The one-part session of moving ``part`` of a scene of several with the others at
+        ``poses``, or (``poses`` None) among the obstacles alone; kept: the
+        :data:`REMEMBERED_PLANS` latest."""
+        key = (part, *(() if poses is None else (tuple(np.round(poses[n], 9).tolist())
+                                                 for n in self.scene.names if n != part)), poses is None)
+        if key not in self._moves:
+            alone = self.scene.move_scene(part, self.scene.starts if poses is None else poses, others=poses is not None)
+            self._moves[key] = Planner(alone, self.options, cache=self._cache, progress=self._progress)
+            while len(self._moves) > REMEMBERED_PLANS:
+                self._moves.popitem(last=False)
+        self._moves.move_to_end(key)
+        return self._moves[key]
 
     def certify_unreachable(self, goal: ArrayLike | None = None, *, start: ArrayLike | None = None) -> str | None:
         """Why ``goal`` (default: the scene's) is certainly unreachable from ``start`` (default:
@@ -323,53 +351,7 @@ class Planner:
                              controls=None if self.world is None else self.world.controls, **kwargs)
 
 
-class PartsPlanner:
-    """A planning session on a multi-part ``scene`` (what :class:`Planner` gives for a
-    :class:`~planner.model.parts.PartsScene`), with ``options``, ``cache`` and ``progress`` as
-    :class:`Planner`'s. Its :meth:`plan` searches the order of moves
-    (:mod:`planner.queries.multi_part`); the one-part session of each part among the others where
-    they stand is made once and kept, so that the buffer poses tried from one place, and later
-    plans, share it.
-
-    >>> from planner import load_scene
-    >>> result = Planner(load_scene("scenes/parts/channel.yaml")).plan()
-    >>> result.solved, [m.part for m in result.moves]     # the far end of the dead end first
-    (True, ['far', 'near'])
-    """
-
-    def __init__(self, scene: PartsScene, options: PlannerOptions | Mapping[str, Any] | None = None, *,
-                 cache: RegionCache | None = None, progress: Callable[[int, int], None] | None = None):
-        self.options = session_options(scene, options)
-        self.scene = scene.with_options(self.options)
-        self._cache, self._progress = cache, progress
-        self._sessions: OrderedDict[tuple, Planner] = OrderedDict()
-        margin = min(clearance_margin(self.scene.move_scene(n, self.scene.starts)) for n in self.scene.names)
-        self.paths = TransferPaths(self.scene, margin)
-
-    def plan(self, *, seed: int | None = None, time_limit: float | None = None) -> PartsPlan:
-        """Every part from its start to its goal, or as far as the search got (``solved`` False,
-        ``delivered`` naming the parts at their goals). ``seed`` and ``time_limit`` (seconds, the
-        whole transfer's) default to the options'."""
-        request = PlanRequest.of(self.options, seed=seed, time_limit=time_limit)
-        return plan_parts(self.scene, self.session, self.paths, request.seed, request.time_limit)
-
-    def session(self, part: str, poses: Mapping[str, np.ndarray] | None) -> Planner:
-        """The one-part session of moving ``part`` with the others at ``poses``, or (``poses``
-        None) among the obstacles alone; kept: the :data:`REMEMBERED_PLANS` latest."""
-        key = (part, *(() if poses is None else (tuple(np.round(poses[n], 9).tolist())
-                                                 for n in self.scene.names if n != part)), poses is None)
-        if key not in self._sessions:
-            alone = self.scene.move_scene(part, self.scene.starts if poses is None else poses)
-            if poses is None:
-                alone = replace(alone, obstacles=self.scene.obstacles)
-            self._sessions[key] = Planner(alone, cache=self._cache, progress=self._progress)
-            while len(self._sessions) > REMEMBERED_PLANS:
-                self._sessions.popitem(last=False)
-        self._sessions.move_to_end(key)
-        return self._sessions[key]
-
-
-def session_options(scene: Scene | PartsScene, options: PlannerOptions | Mapping[str, Any] | None) -> PlannerOptions:
+def session_options(scene: Scene, options: PlannerOptions | Mapping[str, Any] | None) -> PlannerOptions:
     """A session's options: a :class:`PlannerOptions` in place of the scene's (checked as any
     options are: one may be made without its checks), or a mapping of changes to the scene's.
 
@@ -401,10 +383,10 @@ def _anchors(segments: list[Push | Transit]) -> list[tuple[np.ndarray, int, list
     return out
 
 
-def plan(scene: Scene | PartsScene, *, seed: int | None = None, time_limit: float | None = None,
+def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = None,
          planner: str | None = None, regions: str | None = None, transit: str | None = None,
          switch_cost: float | None = None, optimize: int | None = None,
-         progress: Callable[[int, int], None] | None = None) -> Plan | PartsPlan:
+         progress: Callable[[int, int], None] | None = None) -> Plan:
     """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``: a fresh
     :class:`Planner` session asked once.
 
@@ -412,9 +394,9 @@ def plan(scene: Scene | PartsScene, *, seed: int | None = None, time_limit: floa
     ``regions`` is ``'stable'`` (procedure STABLE) or ``'exact'`` (the default); ``transit``
     ``'plane'``, ``'lift'`` or ``'none'``; ``switch_cost`` in metres; ``optimize`` a number of
     improvement rounds. With a given seed, a run that solves within the time limit returns the
-    same plan every time; a multi-part scene gets a :class:`~planner.model.parts_plan.PartsPlan`
-    (:class:`~planner.queries.multi_part.PartsPlanner`). The time limit bounds the stable regions (which may take half of it;
-    edges not done are left out, as ``Plan.note`` says) and the search together.
+    same plan every time; a scene of several parts is planned as a whole (:meth:`Planner.plan`).
+    The time limit bounds the stable regions (which may take half of it; edges not done are left
+    out, as ``Plan.note`` says) and the search together.
 
     Raises
     ------
@@ -425,11 +407,11 @@ def plan(scene: Scene | PartsScene, *, seed: int | None = None, time_limit: floa
     options = {k: v for k, v in (("time_limit", time_limit), ("seed", seed), ("regions", regions),
                                  ("switch_cost", switch_cost), ("optimize", optimize), ("transit", transit))
                if v is not None}
-    if isinstance(scene, PartsScene):
-        if planner is not None:
-            options["name"] = check_planner(planner, "planner")
-        return PartsPlanner(scene, options, progress=progress).plan()
+    if planner is not None:
+        options["name"] = check_planner(planner, "planner")
     session = Planner(scene, options, progress=progress)
+    if session.paths is not None:
+        return session.plan()
     return session._plan(session.scene.start, session.scene.goal, session._request(None, None, None, planner), clock)
 
 

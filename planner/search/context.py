@@ -21,7 +21,8 @@ from ..actions.switch_pose import Grid, SwitchShortcut
 from ..actions.transit import TransitPlanner
 from ..model.fields import SceneError
 from ..model.options import PlannerOptions, check_optimize, check_planner, check_seed, check_time_limit
-from ..model.plan_file import Plan, Push, Transit, path_cost, path_length
+from ..model.plan import Plan
+from ..model.segments import Push, Transit, path_cost, path_length
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 from .goal_region import GoalRegion
@@ -117,9 +118,9 @@ class SearchWorld:
         RegionTimeout
             If no edge's region was computed by ``deadline``.
         """
-        model = model or CollisionModel(scene, scene.pusher.edges)
+        model = model or CollisionModel(scene, scene.edges)
         step = step_length(scene)
-        if not any(model.is_clear(scene.start, e, step / 2) for e in scene.pusher.edges):
+        if not any(model.is_clear(scene.start, e, step / 2) for e in scene.edges):
             raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
         note = ""
         try:
@@ -142,7 +143,7 @@ class SearchWorld:
         room = self.step / 2 if room is None else room
         starts = [k for k, c in enumerate(self.controls) if self.model.is_clear(start, c.edge, room)]
         if not starts:
-            if not any(self.model.is_clear(start, e, room) for e in self.scene.pusher.edges):
+            if not any(self.model.is_clear(start, e, room) for e in self.scene.edges):
                 raise SceneError("start", f"the pusher has no room on any allowed edge (needs {room:.4g} m clearance)")
             raise SceneError("start", "the pusher has room only on edges with no stable push")
         return starts
@@ -246,8 +247,8 @@ def plan_result(scene: Scene, request: PlanRequest, clock: float, start: np.ndar
     elapsed = time.perf_counter() - clock
     if not improvements and not reason:  # a plan found at once: its one improvement is itself
         improvements = [(elapsed, cost(scene, segments), length(scene, segments))]
-    return Plan(scene=scene.path, solved=not reason, planner=request.planner, seed=request.seed,
-                planning_time_s=elapsed, start=np.array(start, dtype=float), goal=np.array(goal, dtype=float),
-                segments=segments, reason=f"{reason}; {note}" if reason and note else reason, note=note,
-                switch_cost=scene.planner.switch_cost, cf=scene.slider.cf, improvements=list(improvements or []),
-                **({} if tree is None else {"tree": tree}))
+    return Plan.of_part(scene.part().name, start, goal, segments, scene=scene.path, solved=not reason,
+                        planner=request.planner, seed=request.seed, planning_time_s=elapsed,
+                        reason=f"{reason}; {note}" if reason and note else reason, note=note,
+                        switch_cost=scene.planner.switch_cost, cf=scene.slider.cf, improvements=list(improvements or []),
+                        **({} if tree is None else {"tree": tree}))

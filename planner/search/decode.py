@@ -1,7 +1,7 @@
 """From an OMPL control path to a plan's segments.
 
 The path's controls are copied out at once (its states live in C++), consecutive equal pushes
-merged into one (:func:`~planner.model.plan_file.append_push`), and a switch control becomes the transit the pusher takes there.
+merged into one (:func:`~planner.model.segments.append_push`), and a switch control becomes the transit the pusher takes there.
 The poses are composed from the start by the exact exponential, so the plan's pushes chain
 exactly; the goal test's connection from the path's last state (:class:`~planner.search.goal.PushGoal`)
 is then re-anchored where the composed path ends, which differs from the tree's state by rounding
@@ -14,7 +14,7 @@ import numpy as np
 
 from ..actions.controls import EdgeControls
 from ..actions.transit import TransitPlanner
-from ..model.plan_file import Push, Transit, append_push, rechain
+from ..model.segments import Push, Transit, append_push, rechain
 from .spaces import pose_of, switch_target
 
 __all__ = ["moves", "segments"]

@@ -16,7 +16,7 @@ from ompl import base as ob
 
 from mechanics import wrap_angle
 
-from ..model.plan_file import Push, Transit
+from ..model.segments import Push, Transit
 from .goal_region import GoalRegion
 from .spaces import pose_of
 

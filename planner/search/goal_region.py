@@ -53,7 +53,7 @@ from mechanics import exp_twist, log_pose, transform_points, wrap_angle
 from ..actions.controls import EdgeControls
 from ..actions.push import connect
 from ..actions.transit import TransitPlanner
-from ..model.plan_file import Push, Transit
+from ..model.segments import Push, Transit
 from ..model.scene import Scene
 from ..world.free_space import Components
 from ..world.validity import CollisionModel

@@ -29,7 +29,9 @@ from ompl import util as ou
 
 from mechanics import wrap_angle
 
-from ..model.plan_file import Plan, Push, Transit, rechain
+from ..model.plan import Plan
+
+from ..model.segments import Push, Transit, rechain
 from ..model.options import MAX_SEED
 from ..model.stop import signals_deferred
 from . import decode

@@ -1,4 +1,4 @@
-"""The pusher's travel between two parts of a multi-part scene: a :class:`~planner.model.parts_plan.Transfer`.
+"""The pusher's travel between two parts of a multi-part scene: a :class:`~planner.model.segments.Transfer`.
 
 The pusher leaves the part it has pushed by backing straight off its contact by the standoff
 (:func:`planner.actions.transit.standoff`), goes to the standoff pose in front of the next part's
@@ -27,8 +27,8 @@ from mechanics import wrap_angle
 
 from ..actions.transit import backed_off, path_duration, standoff
 from ..model.bodies import pusher_frame_body
-from ..model.parts import PartsScene
-from ..model.parts_plan import Transfer
+from ..model.scene import Scene
+from ..model.segments import Transfer
 from ..world.validity import CollisionModel
 from .planning import _seed_ompl
 
@@ -41,7 +41,7 @@ TRANSFER_ITERATIONS = 4000
 class TransferPaths:
     """Transfers of ``scene``'s pusher, keeping ``margin`` of clearance on the table."""
 
-    def __init__(self, scene: PartsScene, margin: float):
+    def __init__(self, scene: Scene, margin: float):
         self.scene, self.margin = scene, margin
         self.reach = float(np.linalg.norm(pusher_frame_body(scene.pusher.width, scene.pusher.depth), axis=1).max())
 

@@ -50,7 +50,7 @@ def disk_free_space(scene: Scene, radius: float) -> shapely.Geometry:
     for a disk of radius 0.025 the table shrinks to 0.95 m square and the inside grows to 0.75 m
     square (but for its rounded corner), leaving an L of ``0.95**2 - 0.75**2 = 0.34`` square metres:
 
-    >>> from planner.model.scene import load_scene
+    >>> from planner.model.scene_file import load_scene
     >>> round(disk_free_space(load_scene("scenes/corridor.yaml"), 0.025).area, 3)
     0.34
     """
