@@ -27,12 +27,15 @@ order the session searches for, pushing parts aside where it must:
 the paper's one-step question, :func:`reachability` answers reachable / unreachable (certified) /
 unknown for many goals, :func:`controllability` says what the stable pushes can reach (1996 §2-3),
 :func:`verify` re-simulates a plan (or one read by :func:`load_plan`, checked against its scene
-by :func:`fit_plan`) under many support distributions. The subpackages, lowest first (each imports only from those
-before it): :mod:`.model` (scene and plan files), :mod:`.world` (collisions, free space),
+by :func:`fit_plan`) under many support distributions, and :func:`run` does all the ``plan``
+command does (certify or plan, verify, simulate, map, write) as one call returning an
+:class:`Outcome`. The subpackages, lowest first (each imports only from those before it):
+:mod:`.model` (scenes, plans and their files), :mod:`.world` (collisions, free space),
 :mod:`.actions` (stable pushes, transits, shortcuts), :mod:`.search` (OMPL), :mod:`.queries`
-(one step, reachability, controllability, bounds), :mod:`.execution` (re-simulation),
-:mod:`.outputs` (recording, pictures), :mod:`.batch` (many tasks on local workers or Ray) and
-:mod:`.bench`; :mod:`.cli` is the ``plan`` command.
+(sessions, one step, reachability, controllability, bounds), :mod:`.execution` (re-simulation,
+trajectories, MuJoCo, the closed loop), :mod:`.outputs` (recording, pictures), :mod:`.pipeline`
+(:func:`run`), :mod:`.batch` (many tasks on local workers or Ray) and :mod:`.bench`;
+:mod:`.cli` is the ``plan`` command, over its flags (:mod:`.flags`).
 """
 
 from importlib import import_module
@@ -55,11 +58,12 @@ if TYPE_CHECKING:
     from .queries.reachability import Reach, certify_unreachable
     from .queries.reachable_set import ReachableSet, reachable_set
     from .queries.session import Planner, plan, reachability
+    from .pipeline import Outcome, RunOptions, run
 
 __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Planner", "PlannerOptions", "Reach", "Scene", "SceneError", "Push", "Transit",
            "certify_unreachable", "load_plan", "load_scene", "one_step", "parse_scene", "plan", "reachability",
            "Verification", "verify", "fit_plan", "SceneControllability", "controllability", "ReachableSet",
-           "reachable_set", "Trajectory", "trajectory", "Simulation", "simulate", "Part", "Move", "Transfer"]
+           "reachable_set", "Trajectory", "trajectory", "Simulation", "simulate", "Part", "Move", "Transfer", "Outcome", "RunOptions", "run"]
 
 #: Every public name is imported on first use, from its module: ``import planner`` itself loads
 #: nothing (the ``plan`` command sets up the process before numpy is loaded, planner.cli), and the
@@ -78,6 +82,7 @@ _ON_FIRST_USE = {
     "ReachableSet": ".queries.reachable_set", "reachable_set": ".queries.reachable_set",
     "Trajectory": ".execution.trajectory", "trajectory": ".execution.trajectory",
     "Simulation": ".execution.mujoco_sim", "simulate": ".execution.mujoco_sim",
+    "Outcome": ".pipeline", "RunOptions": ".pipeline", "run": ".pipeline",
 }
 
 

@@ -614,7 +614,7 @@ def test_an_output_place_that_cannot_be_written_is_refused_before_planning(tmp_p
     pytest.importorskip("mujoco")
     (tmp_path / "file").write_text("a file, not a folder")
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr("planner.cli.plan", lambda *args, **kwargs: pytest.fail("planned before the check"))
+    monkeypatch.setattr("planner.queries.session.Planner.plan", lambda *args, **kwargs: pytest.fail("planned before the check"))
     assert main([str(SCENES / "battery.yaml"), *flags]) == 4
     assert capsys.readouterr().err == f"plan: error: cannot write {named!r}: Not a directory\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]
@@ -625,7 +625,7 @@ def test_every_planner_setting_has_its_flag_and_the_flag_sets_it():
     PlannerOptions has a flag, and giving the flag changes that option alone."""
     import dataclasses
 
-    from planner.cli import FLAGS, options_of, _parser
+    from planner.flags import FLAGS, options_of, parser as _parser
     from planner.model.options import PlannerOptions
 
     assert set(FLAGS) == {f.name for f in dataclasses.fields(PlannerOptions)}

@@ -89,6 +89,19 @@ def test_python_api_example_prints_what_the_readme_says(monkeypatch, capsys):
     assert capsys.readouterr().out == printed
 
 
+def test_the_whole_run_example_prints_what_the_readme_says(tmp_path, monkeypatch, capsys):
+    """The pipeline's example (README, "The whole run"), run in a scratch folder holding the scenes."""
+    section = README[README.index("### The whole run"):]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    printed = re.search(r"```python\n.*?```\n\nIt prints:\n\n```text\n(.*?)```", section, re.S).group(1)
+    (tmp_path / "scenes").symlink_to(ROOT / "scenes")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "README.md", "exec"), {})
+    assert capsys.readouterr().out == printed
+    assert sorted(p.name for p in (tmp_path / "logs" / "api").iterdir()) == ["junction.json", "junction.rrd",
+                                                                             "junction.trajectory.csv"]
+
+
 def test_reachability_example_prints_what_the_readme_says(tmp_path, monkeypatch, capsys):
     """The README's reachability example, run in a scratch folder (it writes a PNG under logs/, as
     every output goes): its output is the text block after it, and the map is a PNG."""

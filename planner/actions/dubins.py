@@ -294,7 +294,7 @@ class DubinsShortcut:
     def __call__(self, segments: list) -> list:
         out, run = [], []
         for s in [*segments, None]:
-            if s is not None and s.kind == "push":
+            if isinstance(s, Push):
                 run += _halves(s)
                 continue
             if run:

@@ -74,7 +74,7 @@ class JoinShortcut:
     def _join(self, segments: list, i: int, j: int) -> list | None:
         """A replacement of segments ``i`` to ``j`` (both included), or None."""
         a, b = segments[i], segments[j]
-        if a.kind != "push" or b.kind != "push":
+        if not (isinstance(a, Push) and isinstance(b, Push)):
             return None
         last = j == len(segments) - 1
         for edge in (a.edge, b.edge) if i == 0 and a.edge != b.edge else (a.edge,):

@@ -118,7 +118,7 @@ def runs(segments: list[Push | Transit]) -> tuple[list[list[Push]], list[Transit
     out: list[list[Push]] = [[]]
     transits: list[Transit] = []
     for s in segments:
-        if s.kind == "transit":
+        if isinstance(s, Transit):
             transits.append(s)
             out.append([])
         else:

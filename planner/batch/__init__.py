@@ -11,7 +11,7 @@ appends each finished task to ``results.jsonl`` and reads it back for ``--resume
 :mod:`.reach` computes reachable-set maps on an executor; :mod:`.command` is the ``plan``
 command's batch mode.
 
-Allowed imports: every package below it (:mod:`planner.model` to :mod:`planner.outputs`) and this one.
+Allowed imports: every package below it (:mod:`planner.model` to :mod:`planner.pipeline`) and this one.
 """
 
 from .engines import ENGINES, executor

@@ -32,11 +32,9 @@ from ..actions.region_cache import default_cache, is_cached, regions_held
 from ..model.fields import SceneError, number, shown
 from ..model.options import (check_optimize, check_planner, check_regions, check_seed, check_switch_cost,
                              check_time_limit, check_transit)
-from ..model.plan import Plan
 from ..model.scene import Scene
 from ..model.scene_file import load_scene
-from ..queries.reachability import certify_unreachable
-from ..queries.session import plan
+from ..pipeline import run
 
 __all__ = ["OVERRIDES", "Task", "TaskList", "make_tasks", "parse_seeds", "planner_version", "run_task", "shared_regions"]
 
@@ -344,14 +342,9 @@ def run_task(task: Task, shared: Mapping[str, Any] | None) -> dict[str, Any]:
     scene = task.planned_scene()
     missing = sum(not is_cached(one.slider, e, one.pusher.mu, one.pusher.width, one.planner.regions, one.cf_uncertainty)
                   for one in _one_part(scene) for e in one.edges)
-    # A multi-part plan says itself which parts it could not deliver; the certificates are one part's.
-    unreachable = None if len(scene.parts) > 1 else certify_unreachable(scene, regions=False)
-    if unreachable:
-        result = Plan.of_part(scene.part().name, scene.start, scene.goal, [], scene=scene.path, solved=False,
-                              planner=scene.planner.name, seed=task.seed, planning_time_s=0.0, reason=unreachable)
-    else:
-        result = plan(scene, seed=task.seed)
-    status = "solved" if result.solved else "unreachable" if unreachable else "unknown"
+    outcome = run(scene)  # the command's pipeline, writing nothing: the certificates, else the plan
+    result = outcome.plan
+    status = "solved" if result.solved else "unreachable" if outcome.unreachable else "unknown"
     return {"status": status, "cost": result.cost if result.solved else None,
             "length": result.length if result.solved else None,
             "pushes": result.pushes, "switches": result.switches, "planning_time_s": result.planning_time_s,

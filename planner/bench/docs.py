@@ -31,6 +31,7 @@ from pathlib import Path
 
 from ..model.extras import have, needs
 from ..model.plan import Plan
+from ..model.segments import Transit
 from ..model.scene import Scene
 from ..model.scene_file import load_scene
 from ..queries.session import plan
@@ -87,7 +88,7 @@ def summary_line() -> str:
 def caption(name: str) -> str:
     """The ``NAME-picture`` block: the picture of the seed-1 plan of ``name`` and its caption."""
     _, result = seed_one(name)
-    moves = sorted({MOVES[t.mode] for t in result.segments if t.kind == "transit"})
+    moves = sorted({MOVES[t.mode] for t in result.segments if isinstance(t, Transit)})
     switch = f"; purple, the pusher's {' and '.join(moves)} where it changes edge" if moves else ""
     text = f"*`scenes/{name}.yaml`, seed 1: {result.headline()}. {STORIES[name][0].upper()}{STORIES[name][1:]}{switch}.*"
     return f"![A plan for scenes/{name}.yaml](docs/{name}.png)\n\n{_wrapped(text)}"

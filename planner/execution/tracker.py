@@ -62,7 +62,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -247,10 +247,8 @@ class Tracker:
         return ""
 
     def _approach(self, pusher: np.ndarray, part: np.ndarray, edge: int) -> Transit | None:
-        world = self.session.world
-        edges = [c.edge for c in world.controls] if world is not None else []
-        return approach(self.scene, self.session.model, world.transits if world is not None else None, pusher, part,
-                        edge, edges)
+        return approach(self.scene, self.session.model, self.session.transits, pusher, part, edge,
+                        list(self.session.stable_edges))
 
     def pusher_at(self, now: float) -> tuple[np.ndarray, float, np.ndarray, bool]:
         """Where the pusher frame should be at ``now``: pose ``(x, y, theta)`` (theta unwrapped along
@@ -323,12 +321,11 @@ class Tracker:
 
     def _lower_friction(self) -> str:
         """Re-plan from now on for less friction (module docstring, "Friction"); what to say of it."""
-        pusher = self.session.scene.pusher
-        mu = pusher.mu * FRICTION_STEP
+        mu = self.session.scene.pusher.mu * FRICTION_STEP
         if mu < FRICTION_FLOOR * self.scene.pusher.mu * (1 - 1e-9):
             return ""
-        lower = Planner(replace(self.session.scene, pusher=replace(pusher, mu=mu)), self.session.options)
-        if lower.world is None:  # no stable push at that friction (or no region in time): plan as before
+        lower = self.session.with_friction(mu)
+        if lower is None:  # no stable push at that friction (or no region in time): plan as before
             return ""
         self.session = lower
         return f"; it slid on the pusher: planned for pusher mu {mu:g}"
@@ -356,8 +353,7 @@ class Tracker:
                 found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge],
                                           observed=True)
             if found is None or not found.solved:
-                world = self.session.world
-                others = [c.edge for c in world.controls if c.edge != self._edge] if world is not None else []
+                others = [e for e in self.session.stable_edges if e != self._edge]
                 reached = [e for e in others if self._approach(pusher, part, e) is not None]
                 if not reached and found is None:
                     return self._carry_on(now, error, "no free approach from the pusher to any edge of the part", clock)

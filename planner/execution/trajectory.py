@@ -65,8 +65,7 @@ from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
 from ..model.scene import Scene
 from ..model.plan import Plan
-from ..model.segments import Transfer
-from ..model.segments import Push, Transit
+from ..model.segments import Push, Transfer, Transit
 from ..model.scene import Pusher, Scene
 
 __all__ = ["COLUMNS", "LIFT_HEIGHT", "MAX_ACCEL", "MAX_JERK", "MAX_SPEED", "RATE", "Trajectory", "path_limits",
@@ -291,7 +290,7 @@ def _timed(pusher: Pusher, segments: list[tuple[Slider, Push | Transit | Transfe
     pieces: list[_Piece] = []
     clock = 0.0
     for i, (slider, segment) in enumerate(segments):
-        pieces += ([_push_piece(slider, i, segment, corners, clock)] if segment.kind == "push"
+        pieces += ([_push_piece(slider, i, segment, corners, clock)] if isinstance(segment, Push)
                    else _transit_pieces(i, segment, reach, clock))
         clock += segment.duration
     laws = [_time_law(p, max_speed, max_accel, max_jerk) for p in pieces]
@@ -332,7 +331,7 @@ def planned_part(scene: Scene, plan: Plan, motion: Trajectory) -> np.ndarray:
     pusher = np.column_stack([motion.x, motion.y, motion.theta])
     for k, segment in enumerate(plan.segments):
         rows = motion.segment == k
-        if segment.kind == "transit":
+        if isinstance(segment, Transit):
             out[rows] = segment.start
             continue
         local = edge_contact_pose(scene.slider, segment.edge, np.zeros(3))  # pusher frame in the slider frame

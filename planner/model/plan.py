@@ -170,12 +170,12 @@ class Plan:
 
     @property
     def pushes(self) -> int:
-        return sum(s.kind == "push" for m in self.moves for s in m.segments)
+        return sum(isinstance(s, Push) for m in self.moves for s in m.segments)
 
     @property
     def switches(self) -> int:
         """How many times the pusher changes edge of a part (transits)."""
-        return sum(s.kind == "transit" for m in self.moves for s in m.segments)
+        return sum(isinstance(s, Transit) for m in self.moves for s in m.segments)
 
     @property
     def transfers(self) -> int:
@@ -275,7 +275,7 @@ def _parts_dict(plan: Plan) -> dict:
     parts = {n: {"start": floats(plan.starts[n]), "goal": floats(plan.goals[n]), "final": floats(finals[n]),
                  "delivered": n in plan.delivered} | ({"cf": floats(plan.cfs[n])} if n in plan.cfs else {})
              for n in plan.names}
-    segments = [s.to_dict() if s.kind == "transfer" else {**s.to_dict(), "part": part} for part, s in plan.steps]
+    segments = [s.to_dict() if isinstance(s, Transfer) else {**s.to_dict(), "part": part} for part, s in plan.steps]
     out = _head(plan, FORMATS[1]) | {"parts": parts, "segments": segments}
     if plan.reason and not plan.solved:
         out["reason"] = plan.reason

@@ -246,7 +246,7 @@ def append_push(segments: list, push: Push) -> None:
     (1, 0.5, [0.5, 0.0, 0.0])
     """
     last = segments[-1] if segments else None
-    if last is not None and last.kind == "push" and last.edge == push.edge and np.array_equal(last.twist, push.twist):
+    if isinstance(last, Push) and last.edge == push.edge and np.array_equal(last.twist, push.twist):
         segments[-1] = Push.along(last.edge, last.contact, last.twist, last.duration + push.duration, last.start)
     else:
         segments.append(push)
@@ -261,7 +261,7 @@ def path_cost(segments: Sequence[Push | Transit], cf: ArrayLike, switch_cost: fl
     """What the planner minimises (Lynch & Mason 1996, §4: a cost per contact change): the centre
     of friction's path length plus ``switch_cost`` per switch (transit). The one definition: a
     plan's :attr:`Plan.cost`, the search's and the benchmarks' all come from it."""
-    return path_length(segments, cf) + switch_cost * sum(s.kind == "transit" for s in segments)
+    return path_length(segments, cf) + switch_cost * sum(isinstance(s, Transit) for s in segments)
 
 
 def rechain(segments: list, start: ArrayLike | None = None) -> list:

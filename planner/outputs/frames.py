@@ -49,7 +49,7 @@ def pusher_on(slider: Slider, edge: int) -> np.ndarray:
 def sample(slider: Slider, body: np.ndarray, segment: Push | Transit,
             t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The part's and the pusher's poses and the pusher's being airborne, ``t`` into ``segment``."""
-    if segment.kind == "transit":
+    if isinstance(segment, Transit):
         pusher, lifted = transit_poses(segment, body, t)
         return np.tile(segment.pose, (len(t), 1)), pusher, lifted
     part = exp_twist(segment.start, segment.twist, t)

@@ -26,8 +26,8 @@ one-shot :func:`plan` (a fresh session) does.
 
 from __future__ import annotations
 
+import itertools
 import time
-from collections import OrderedDict
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, replace
 from typing import Any
@@ -35,24 +35,24 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import exp_twist, transform_points
-
 from ..actions.controls import NoStablePush, RegionTimeout, clearance_margin
 from ..actions.region_cache import RegionCache
+from ..actions.transit import TransitPlanner
 from ..model.fields import SceneError, integer, poses
 from ..model.options import PlannerOptions, check_planner
 from ..model.scene import Scene
 from ..model.plan import Plan
-from ..model.segments import Push, Transit, rechain
 from ..search import PlanningContext, PlanRequest, SearchWorld, solve
-from ..search.context import cost, plan_result
+from ..search.context import plan_result
+from ..search.join import join
 from ..search.transfer import TransferPaths
 from ..world.validity import CollisionModel
+from .memory import Memory
 from .multi_part import plan_parts
 from .reachability import Certificates, Reach, answers
 from .reachable_set import ReachableSet, reachable_set
 
-__all__ = ["JOINED_PLANS", "JOIN_SLACK", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
+__all__ = ["Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
            "reachability", "session_options"]
 
 #: Without a time limit, :meth:`Planner.reachability` grows its search for this long plus this
@@ -60,18 +60,11 @@ __all__ = ["JOINED_PLANS", "JOIN_SLACK", "Planner", "REACH_BASE_S", "REACH_PER_G
 #: scenes nearly every reachable goal of a 200-goal grid is reached well within it
 #: (``python -m planner.bench.reach``).
 REACH_BASE_S, REACH_PER_GOAL_S = 0.5, 0.01
-#: Plans a session keeps for re-planning (the most recent), and how many of the latest for a goal
-#: a new start is joined to.
-REMEMBERED_PLANS, JOINED_PLANS = 16, 2
-#: A join is taken once no pose left could make one cheaper by more than this share: the lower
-#: bound (the straight line) is loose, and each pose tried costs collision checks.
-JOIN_SLACK = 0.05
+#: Plans a session keeps for re-planning (the most recent), and move sessions of a scene of several parts.
+REMEMBERED_PLANS = 16
 #: Goals reached by reachability queries whose plans a session keeps (the most recent), for the
 #: queries after them.
 REMEMBERED_GOALS = 20_000
-#: Poses along a remembered plan that a new start may be joined to: each push's start and these
-#: fractions of it.
-_ALONG = (0.0, 0.25, 0.5, 0.75)
 
 
 class Planner:
@@ -106,6 +99,7 @@ class Planner:
 
     def __init__(self, scene: Scene, options: PlannerOptions | Mapping[str, Any] | None = None, *,
                  cache: RegionCache | None = None, progress: Callable[[int, int], None] | None = None):
+        #: When setting the session up began (``time.perf_counter()``).
         self.clock = time.perf_counter()
         if not isinstance(scene, Scene):
             raise SceneError("scene", f"must be a Scene (planner.load_scene), got {type(scene).__name__}")
@@ -118,9 +112,10 @@ class Planner:
         self.world: SearchWorld | None = None
         self._no_push: NoStablePush | None = None
         self._timeout = ""
-        self._plans: OrderedDict[tuple[float, ...], list[Plan]] = OrderedDict()
-        self._reached: OrderedDict[tuple[float, ...], OrderedDict[tuple[float, ...], list[Push | Transit]]] = OrderedDict()
-        self._moves: OrderedDict[tuple, Planner] = OrderedDict()
+        # What the queries found, for the queries after them: plans per goal, the goals reached per
+        # start (their segments), and the sessions of a scene of several parts' moves.
+        self._plans, self._reached, self._moves = Memory(REMEMBERED_PLANS), Memory(REMEMBERED_GOALS), Memory(REMEMBERED_PLANS)
+        self._filings = itertools.count()
         self.paths: TransferPaths | None = None
         #: Seconds the last :meth:`reachability` spent on the certificates, the direct connections
         #: and the tree's growth.
@@ -143,6 +138,24 @@ class Planner:
         self.setup_s = time.perf_counter() - self.clock
 
     @property
+    def stable_edges(self) -> tuple[int, ...]:
+        """The allowed edges that have a stable push, whose regions the session holds."""
+        return tuple(c.edge for c in self.world.controls) if self.world is not None else ()
+
+    @property
+    def transits(self) -> TransitPlanner | None:
+        """The pusher's checked paths between those edges (None where it cannot switch)."""
+        return self.world.transits if self.world is not None else None
+
+    def with_friction(self, mu: float) -> "Planner | None":
+        """A session of this scene for pusher friction ``mu`` (as a re-plan after a slip asks),
+        with this session's options, cache and progress; None if no edge has a stable push at
+        ``mu`` or no region was done in time."""
+        lower = Planner(replace(self.scene, pusher=replace(self.scene.pusher, mu=mu)), self.options, cache=self._cache,
+                        progress=self._progress)
+        return lower if lower.world is not None else None
+
+    @property
     def note(self) -> str:
         """What the user should know of this session's regions (edges left out at the time limit)."""
         return self.world.note if self.world is not None else self._timeout
@@ -160,7 +173,8 @@ class Planner:
 
     def plan(self, start: ArrayLike | None = None, goal: ArrayLike | None = None, *, seed: int | None = None,
              time_limit: float | None = None, optimize: int | None = None, planner: str | None = None,
-             reuse: bool = True, edges: Sequence[int] | None = None, observed: bool = False) -> Plan:
+             reuse: bool = True, edges: Sequence[int] | None = None, observed: bool = False,
+             since: float | None = None) -> Plan:
         """A plan of guaranteed-stable pushes from ``start`` to ``goal`` (``(x, y, theta)``,
         radians; default: the scene's).
 
@@ -172,7 +186,12 @@ class Planner:
         given, are the only edges the first push may be on (a robot re-planning with its pusher on
         the part keeps it there; the plan may still switch, by a checked transit). ``observed``:
         the part is observed at ``start``, so the pusher needs there only the clearance every push
-        keeps, not the search's (:class:`~planner.search.context.PlanningContext`).
+        keeps, not the search's (:class:`~planner.search.context.PlanningContext`). ``since`` (a
+        ``time.perf_counter()`` reading; default: now) is when the plan's time and time limit
+        start: a session's :attr:`clock` counts its set-up in, as :func:`plan` does.
+
+        A scene of several parts is planned as a whole, every part from its start to its goal:
+        ``start``, ``goal`` and ``edges`` are for a scene of one part.
 
         Raises
         ------
@@ -187,7 +206,7 @@ class Planner:
         goal = self._pose(goal, "goal", self.scene.goal)
         if edges is not None and not all(isinstance(e, int) and e in self.scene.edges for e in edges):
             raise SceneError("edges", f"must be allowed edges of the pusher {list(self.scene.edges)}, got {edges}")
-        return self._plan(start, goal, request, time.perf_counter(), reuse, edges, observed)
+        return self._plan(start, goal, request, time.perf_counter() if since is None else since, reuse, edges, observed)
 
     def _plan(self, start: np.ndarray, goal: np.ndarray, request: PlanRequest, clock: float,
               reuse: bool = False, edges: Sequence[int] | None = None, observed: bool = False) -> Plan:
@@ -203,55 +222,11 @@ class Planner:
                 return plan_result(self.scene, request, clock, start, goal, [],
                                    f"no stable push with room for the pusher at the start on edges {list(edges)}")
         key = tuple(goal.tolist())
-        joined = self._joined(context, goal, self._plans.get(key, [])) if reuse else None
+        joined = join(self.world, context, goal, self._plans.items(key)) if reuse else None
         found = joined or solve(context, goal)
         if found.solved and found.segments:
-            self._plans.setdefault(key, []).insert(0, found)
-            self._plans.move_to_end(key)
-            while sum(map(len, self._plans.values())) > REMEMBERED_PLANS:
-                oldest = next(iter(self._plans))
-                self._plans[oldest].pop()
-                if not self._plans[oldest]:
-                    del self._plans[oldest]
+            self._plans.file(key, next(self._filings), found)
         return found
-
-    def _joined(self, context: PlanningContext, goal: np.ndarray, known: list[Plan]) -> Plan | None:
-        """A plan from ``context.start`` joined by one or two pushes (and a switch where the edges
-        differ) to a pose along one of the :data:`JOINED_PLANS` latest ``known`` plans for
-        ``goal``, the rest of that plan after it: the cheapest found, or None.
-
-        Poses are tried cheapest first by a lower bound (the straight line from the start's CF to
-        theirs, plus the rest of their plan), until no pose left can beat the best join by more
-        than :data:`JOIN_SLACK`."""
-        world, scene = self.world, self.scene
-        anchors = [a for p in known[:JOINED_PLANS] for a in _anchors(p.segments)]
-        if not anchors:
-            return None
-        region = world.goal_region([pose for pose, _, _ in anchors], aim=False)
-        cf = scene.slider.cf
-        here, there = transform_points(cf, context.start), transform_points(cf, np.array([a[0] for a in anchors]))
-        bounds = np.linalg.norm(there - here, axis=1) + [cost(scene, rest) for _, _, rest in anchors]
-        best, best_cost = None, np.inf
-        for a in np.argsort(bounds, kind="stable").tolist():
-            if bounds[a] * (1.0 + JOIN_SLACK) >= best_cost:
-                break
-            pose, edge, rest = anchors[a]
-            for k in context.starts:
-                lead = region.pushes_to(context.start, k, [a]).get(a)
-                if lead is None:
-                    continue
-                joint: list[Push | Transit] = list(lead)
-                if edge != world.controls[k].edge:
-                    transit = world.transits.find(pose, world.controls[k].edge, edge) if world.transits else None
-                    if transit is None:
-                        continue
-                    joint.append(transit)
-                candidate = rechain(joint + rest)
-                if (c := cost(scene, candidate)) < best_cost:
-                    best, best_cost = candidate, c
-        if best is None:
-            return None
-        return context.result(goal, world.shortcut_cheaply(best))
 
     def reachability(self, goals: ArrayLike | None = None, *, start: ArrayLike | None = None,
                      pushes: int | None = None, time_limit: float | None = None,
@@ -294,17 +269,12 @@ class Planner:
                                                                                    scene, g)
                     for g, r in zip(rows, reasons)]
         context = None if self.world is None else PlanningContext(self.world, request, start, clock)
-        reached = self._reached.setdefault(tuple(start.tolist()), OrderedDict()) if reuse else None
-        found = answers(scene, context, reasons, rows, pushes, self.timings, reached)
-        if reached is not None:
+        key = tuple(start.tolist())
+        found = answers(scene, context, reasons, rows, pushes, self.timings, self._reached.filed(key) if reuse else None)
+        if reuse:
             for answer in found:
                 if answer.plan is not None and answer.plan.solved and answer.plan.segments:
-                    reached[tuple(answer.goal.tolist())] = answer.plan.segments
-            while sum(map(len, self._reached.values())) > REMEMBERED_GOALS:
-                oldest = next(iter(self._reached.values()))
-                oldest.popitem(last=False)
-                if not oldest:
-                    self._reached.pop(next(iter(self._reached)))
+                    self._reached.file(key, tuple(answer.goal.tolist()), answer.plan.segments)
         return found
 
     def _plan_parts(self, start: object, goal: object, request: PlanRequest, edges: object) -> Plan:
@@ -322,13 +292,12 @@ class Planner:
         :data:`REMEMBERED_PLANS` latest."""
         key = (part, *(() if poses is None else (tuple(np.round(poses[n], 9).tolist())
                                                  for n in self.scene.names if n != part)), poses is None)
-        if key not in self._moves:
+        session = self._moves.get(key, part)
+        if session is None:
             alone = self.scene.move_scene(part, self.scene.starts if poses is None else poses, others=poses is not None)
-            self._moves[key] = Planner(alone, self.options, cache=self._cache, progress=self._progress)
-            while len(self._moves) > REMEMBERED_PLANS:
-                self._moves.popitem(last=False)
-        self._moves.move_to_end(key)
-        return self._moves[key]
+            session = Planner(alone, self.options, cache=self._cache, progress=self._progress)
+        self._moves.file(key, part, session)  # the latest used, the last dropped
+        return session
 
     def certify_unreachable(self, goal: ArrayLike | None = None, *, start: ArrayLike | None = None) -> str | None:
         """Why ``goal`` (default: the scene's) is certainly unreachable from ``start`` (default:
@@ -366,23 +335,6 @@ def session_options(scene: Scene, options: PlannerOptions | Mapping[str, Any] | 
     raise SceneError("options", f"must be PlannerOptions or a mapping, got {type(options).__name__}")
 
 
-def _anchors(segments: list[Push | Transit]) -> list[tuple[np.ndarray, int, list[Push | Transit]]]:
-    """Poses along a plan that a new start may join: per push, its start and points along it
-    (:data:`_ALONG`), each with the push's edge and the plan's segments from there on."""
-    out = []
-    for i, s in enumerate(segments):
-        if s.kind != "push":
-            continue
-        for f in _ALONG:
-            if f == 0.0:
-                out.append((s.start, s.edge, segments[i:]))
-            else:
-                pose = exp_twist(s.start, s.twist, f * s.duration)
-                rest = Push.along(s.edge, s.contact, s.twist, (1.0 - f) * s.duration, pose)
-                out.append((rest.start, s.edge, [rest, *segments[i + 1:]]))
-    return out
-
-
 def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = None,
          planner: str | None = None, regions: str | None = None, transit: str | None = None,
          switch_cost: float | None = None, optimize: int | None = None,
@@ -403,16 +355,13 @@ def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = No
     SceneError
         Naming the argument at fault, or if no allowed edge can start pushing.
     """
-    clock = time.perf_counter()
     options = {k: v for k, v in (("time_limit", time_limit), ("seed", seed), ("regions", regions),
                                  ("switch_cost", switch_cost), ("optimize", optimize), ("transit", transit))
                if v is not None}
     if planner is not None:
         options["name"] = check_planner(planner, "planner")
     session = Planner(scene, options, progress=progress)
-    if session.paths is not None:
-        return session.plan()
-    return session._plan(session.scene.start, session.scene.goal, session._request(None, None, None, planner), clock)
+    return session.plan(since=session.clock)
 
 
 def reachability(scene: Scene, goals: ArrayLike | None = None, *, pushes: int | None = None,

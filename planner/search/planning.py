@@ -104,7 +104,7 @@ def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
     if segments is None:
         return context.result(goal, [], _RECHECK if tree is None else request.out_of_time, tree)
     segments = context.shortcut(segments)
-    if any(s.kind == "transit" for s in segments):
+    if any(isinstance(s, Transit) for s in segments):
         budget = max(ONE_EDGE_ITERATIONS * iterations, ONE_EDGE_MIN_ITERATIONS)
         plain, _, _ = search.run(region.without_switches(), budget)
         if plain is not None and cost(scene, plain := context.shortcut(plain)) <= cost(scene, segments):
