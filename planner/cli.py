@@ -282,10 +282,7 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     if args.export_scene is not None and os.path.isdir(args.export_scene):
         raise SceneError("--export-scene", f"{shown(args.export_scene)} is a folder")
     given = None
-    if args.plan is not None and len(scene.parts) > 1:
-        from .execution.fit import fit_parts_plan  # with the re-simulator: only for a plan file
-        given = fit_parts_plan(scene, load_plan(args.plan))
-    elif args.plan is not None:
+    if args.plan is not None:
         from .execution.fit import fit_plan  # with the re-simulator: only for a plan file
 
         given = fit_plan(scene, load_plan(args.plan))
@@ -536,9 +533,9 @@ def _plan_parts(inputs: Inputs) -> int:
             print("\r\033[K", end="", file=sys.stderr, flush=True)
     check = motion = simulation = None
     if inputs.verify and result.solved:
-        from .execution.parts_verify import verify_parts
+        from .execution.verify import verify  # the re-simulator, loaded only for --verify
 
-        check = verify_parts(scene, result, inputs.verify, seed)
+        check = verify(scene, result, inputs.verify, seed)
     if inputs.trajectory and result.solved:
         from .execution.trajectory import trajectory  # loads ruckig, only for --trajectory
 
