@@ -5,14 +5,16 @@ naming what differs, exit 1, nothing written; a plan that fits is run from the s
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
+import shapely
 import yaml
 
 from mechanics import exp_twist
-from planner import load_plan, load_scene
+from planner import Push, load_plan, load_scene
 from planner.cli import main
 from planner.execution.fit import fit_plan
 from planner.model.fields import SceneError
@@ -104,3 +106,24 @@ def test_a_start_within_tolerance_is_run_from_the_scenes_start(tmp_path, capsys)
     written = json.loads((tmp_path / "out" / "battery.json").read_text())
     assert written["start"] == pytest.approx([0.001, 0.0, 0.0], abs=1e-12)
     assert written["final"] == pytest.approx(np.add(data["final"], [0.001, 0.0, 0.0]), abs=1e-9)
+
+
+def test_a_multi_part_plan_names_its_parts_fields_and_segments_among_all():
+    """plan/2: a part's final is ``plan.parts.<name>.final``; a push of the last move is numbered
+    among all the plan's segments, the transfers included."""
+    scene = load_scene(ROOT / "scenes" / "parts" / "swap.yaml")
+    plan = load_plan(ROOT / "tests" / "data" / "release_plans" / "swap.json")
+    assert fit_plan(scene, plan).goals.keys() == {"red", "blue"}
+    moved = scene.parts[0].goal + [0.05, 0.0, 0.0]
+    other = replace(scene, parts=(replace(scene.parts[0], goal=moved), *scene.parts[1:]))
+    with pytest.raises(SceneError) as caught:
+        fit_plan(other, plan)
+    assert caught.value.field == f"plan.parts.{scene.parts[0].name}.final"
+    k = len(plan.segments) - len(plan.moves[-1].segments)  # the last move's first push, after two transfers
+    push = plan.segments[k]
+    assert isinstance(push, Push) and plan.transfers == 2
+    middle = exp_twist(push.start, push.twist, push.duration / 2)
+    post = shapely.Point(*middle[:2]).buffer(0.002)
+    with pytest.raises(SceneError) as caught:
+        fit_plan(replace(scene, obstacles=(*scene.obstacles, post)), plan)
+    assert caught.value.field == f"plan.segments[{k}]" and "the push" in caught.value.problem

@@ -11,7 +11,7 @@ import pytest
 import yaml
 
 from planner import load_plan, load_scene, verify
-from planner.execution.fit import fit_parts_plan, fit_plan
+from planner.execution.fit import fit_plan
 from replay import replay_parts_plan, replay_plan
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -28,9 +28,8 @@ def test_a_release_plan_file_loads_fits_verifies_and_replays(name):
     loaded = load_plan(DATA / f"{name}.json")
     assert loaded.names == scene.names and loaded.solved
     assert loaded.to_dict() == data  # what the previous release wrote is what this one writes of it
-    fitted = (fit_plan if len(scene.parts) == 1 else fit_parts_plan)(scene, loaded)
+    fitted = fit_plan(scene, loaded)
     assert fitted.cost == pytest.approx(data["cost"], abs=1e-9)
     spec = yaml.safe_load((ROOT / FILES[name]).read_text())
     (replay_plan if len(scene.parts) == 1 else replay_parts_plan)(spec, data)
-    if len(scene.parts) == 1:
-        assert verify(scene, fitted, n=3).passed
+    assert verify(scene, fitted, n=3).passed

@@ -399,3 +399,44 @@ def test_command_verifies_a_switching_plan_file_and_refuses_a_tampered_transit(t
     assert run.returncode == 1 and run.stdout == ""
     assert error_field(run.stderr) == f"plan.segments[{k}].pusher_path"
     assert not (tmp_path / "bad").exists()
+
+
+# -- plans of several parts and plans not solved ---------------------------------------------------------
+
+def release(name: str) -> tuple[planner.Scene, planner.Plan]:
+    """A multi-part scene and its previous release's plan file (tests/data/release_plans)."""
+    scene = planner.load_scene(ROOT / "scenes" / "parts" / f"{name}.yaml")
+    return scene, planner.load_plan(ROOT / "tests" / "data" / "release_plans" / f"{name}.json")
+
+
+def test_a_multi_part_plan_verifies_move_by_move_with_a_line_per_segment():
+    scene, plan = release("swap")
+    check = verify(scene, plan, n=3)
+    assert check.passed and all_stick(check), "\n".join(check.lines())
+    lines = check.lines()
+    moves = [line for line in lines if line.startswith("move ")]
+    assert moves == [f"move {k}/{len(plan.moves)} ({m.part}): clear of the other parts" for k, m in enumerate(plan.moves, 1)]
+    segments = [line for line in lines if line.startswith("segment ")]
+    assert [line.split()[:3] for line in segments] == [
+        ["segment", f"{n}/{len(plan.segments)}:", s.kind] for n, s in enumerate(plan.segments, 1)]
+    assert [c.segment for c in check.pushes] == [s for s in plan.segments if isinstance(s, planner.Push)]
+    assert check.summary().startswith(f"verify: passed: {plan.pushes} pushes of {len(plan.moves)} moves x 3 ")
+    assert check.summary().endswith("every move clear of the other parts")
+
+
+def test_a_transfer_that_does_not_reach_its_part_names_the_field():
+    scene, plan = release("swap")
+    k = next(k for k, s in enumerate(plan.segments) if isinstance(s, planner.Transfer))
+    move = next(m for m in plan.moves if m.transfer is not None)
+    off = dataclasses.replace(move.transfer, pusher_path=move.transfer.pusher_path + [0.0, 1e-3, 0.0])
+    moves = [dataclasses.replace(m, transfer=off) if m is move else m for m in plan.moves]
+    with pytest.raises(planner.SceneError) as err:
+        verify(scene, dataclasses.replace(plan, moves=moves), n=2)
+    assert err.value.field == f"plan.segments[{k}].pusher_path" and "starts at" in err.value.problem
+
+
+def test_a_plan_not_solved_is_refused():
+    scene, plan = planned("battery")
+    with pytest.raises(planner.SceneError) as err:
+        verify(scene, dataclasses.replace(plan, solved=False), n=2)
+    assert err.value.field == "plan.solved"

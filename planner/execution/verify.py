@@ -2,8 +2,8 @@
 
 Each push of a plan claims the part stays stuck to the pusher *whatever* its support pressure
 distribution. :func:`verify` tries to break that claim: it re-simulates every push, from the
-push's planned start, under ``n`` support distributions over the part's footprint, all with their
-centre at the CF (a uniform grid, random weights on random points, and the extreme two- and
+push's planned start, under ``n`` support distributions over the pushed part's footprint, all with
+their centre at its CF (a uniform grid, random weights on random points, and the extreme two- and
 three-point distributions), and compares each simulated end pose with the planned ``end``.
 
 Deviation is measured by two numbers: the distance between the simulated and planned positions of
@@ -14,56 +14,69 @@ Tolerance. A push that sticks is, in the simulator, one exact SE(2) exponential 
 twist, the same exponential the planner took, so it reproduces the plan to rounding (about
 1e-16 relative). A run that slips for even one of its :data:`~mechanics.quasistatic.DEFAULT_STEPS`
 steps moves the part relative to the pusher by the slip speed times a step. ``tolerance`` (default
-:data:`TOLERANCE`, 1e-6) is relative: positions may deviate by ``tolerance`` slider radii and
-angles by ``tolerance`` radians. It leaves ten orders of magnitude for rounding and still catches
-a slip of a millionth of the part's size (so a plan file must carry full precision, as ``plan``
-writes it; one rounded to micrometres fails). A run
+:data:`TOLERANCE`, 1e-6) is relative: positions may deviate by ``tolerance`` radii of the part
+pushed and angles by ``tolerance`` radians. It leaves ten orders of magnitude for rounding and
+still catches a slip of a millionth of the part's size (so a plan file must carry full precision,
+as ``plan`` writes it; one rounded to micrometres fails). A run
 *slips* when it deviates beyond the tolerance or stops early (the contact separated, a finger slid
 off the edge, or no contact mode was consistent); a push passes when no run slips. Runs that
 show a non-sticking or an ambiguous mode are counted and reported either way.
 
 Chaining. Pushes are judged one by one, each from its planned start, so one bad push does not
-hide or excuse another. The *drift* also reports where the part would end if each push started
-from the previous push's simulated end (the pusher placed on the edge afresh for each push): the
-simulator is invariant under moving the start pose, so this is each distribution's simulated
-relative motions composed, without simulating again.
+hide or excuse another. The *drift* also reports where the part would end its move if each push
+started from the previous push's simulated end (the pusher placed on the edge afresh for each
+push): the simulator is invariant under moving the start pose, so this is each distribution's
+simulated relative motions composed, without simulating again.
 
-Transits. While the pusher moves from one edge to another the part stands still, so there is
-nothing to simulate; but each push is simulated from its own planned start with the pusher on its
-own edge, which would not notice a plan that teleports the part or the pusher between pushes.
-So before simulating, :func:`verify` checks that the plan hangs together: every segment starts
-where the one before it left the part, every push is on the edge the pusher is on, and every
+Transits and transfers. While the pusher moves from one edge to another, or from one part to the
+next, the parts stand still, so there is nothing to simulate; but each push is simulated from its
+own planned start with the pusher on its own edge, which would not notice a plan that teleports a
+part or the pusher between pushes. So before simulating, :func:`verify` checks that the plan
+hangs together (:func:`check_chain`): its parts and their CFs are the scene's, every segment
+starts where the one before it left its part, every push is on the edge the pusher is on, every
 transit starts at the contact pose on that edge, ends at the contact pose on the next push's edge,
-and uses a mode the scene allows (a lift only with ``pusher.transit: lift``). The drift treats a
-transit as the identity. Whether a transit's path is collision-free is the planner's rule
-(:mod:`planner.actions.transit`), not checked here; a plan read from a file is checked against its
-scene, obstacles included, before it is verified (:mod:`planner.execution.fit`, which uses
-:func:`check_chain`).
+and uses a mode the scene allows (a lift only with ``pusher.transit: lift``), and every transfer
+starts at the contact pose on the part it leaves and ends at the one on the edge it goes to. The
+drift treats a transit as the identity. Whether a transit's path is clear of the obstacles is the
+planner's rule (:mod:`planner.actions.transit`), not checked here; a plan read from a file is
+checked against its scene, obstacles included, before it is verified (:mod:`planner.execution.fit`,
+which uses :func:`check_chain`).
+
+Several parts. A plan is a sequence of moves, each of one part with the others standing still, so
+each move's pushes are verified as above under the distributions of that move's part. What the
+simulation of one part cannot see is another part in the way: every push and every transit of a
+move is swept against each other part where it stands then (:mod:`.sweep`), and a move that meets
+one fails, naming the part it meets.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from collections import Counter
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
 
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import exp_twist, log_pose, transform_points, wrap_angle
+from mechanics import Slider, exp_twist, log_pose, transform_points, wrap_angle
 from mechanics.quasistatic import (DEFAULT_STEPS, Contact, ContactMode, PushResult, SupportDistribution,
                                    dipod_supports, edge_contacts, grid_support, random_support, simulate_push,
                                    tripod_supports)
 
-from ..model.fields import SceneError, pose_text
-from ..model.plan import Plan
-from ..model.segments import Push, Transit
-from ..model.scene import Scene
 from ..actions.transit import edge_contact_pose
+from ..model.fields import SceneError, pose_text
+from ..model.plan import Move, Plan
+from ..model.plan_file import part_field
+from ..model.scene import Part, Pusher, Scene
+from ..model.segments import Push, Transfer, Transit
+from .sweep import collision_model, is_clear
 
-__all__ = ["TOLERANCE", "PushCheck", "Verification", "check_chain", "distributions", "verify"]
+__all__ = ["TOLERANCE", "MoveCheck", "PushCheck", "Verification", "check_chain", "check_solved", "distributions",
+           "placed_moves", "verify"]
 
-#: Default relative tolerance: positions in slider radii, angles in radians (module docstring).
+#: Default relative tolerance: positions in part radii, angles in radians (module docstring).
 TOLERANCE = 1e-6
 #: Support points of the uniform grid and of each random distribution.
 GRID_POINTS, RANDOM_POINTS = 100, 40
@@ -117,6 +130,8 @@ class PushCheck:
     ----------
     segment : Push
         The push as planned.
+    part : str
+        The part pushed.
     contacts : tuple of Contact
         The pusher's two end-point contacts (slider frame) the push was simulated with.
     results : tuple of PushResult
@@ -128,6 +143,7 @@ class PushCheck:
     """
 
     segment: Push
+    part: str
     contacts: tuple[Contact, ...]
     results: tuple[PushResult, ...]
     position_error: np.ndarray
@@ -157,26 +173,68 @@ class PushCheck:
 
 
 @dataclass(frozen=True, eq=False)
-class Verification:
-    """Outcome of :func:`verify`: per push, and the plan's drift when pushes are chained.
+class MoveCheck:
+    """One move of a plan verified: a check per push, in order, the worst CF distance (m) and
+    angle (rad) of its chained end from the move's, and the other parts it meets (none: clear)."""
 
-    ``pushes`` holds one check per push segment, in order (transits have nothing to simulate);
-    ``segments`` is the whole plan, so that :meth:`lines` can show where the pusher switched.
-    """
-
-    scene: Scene
-    segments: tuple[Push | Transit, ...]
-    supports: tuple[SupportDistribution, ...]
-    kinds: tuple[str, ...]
+    move: Move
     pushes: tuple[PushCheck, ...]
-    drift: tuple[float, float]  # worst CF distance (m) and angle (rad) of the chained end from the plan's
-    tolerance: tuple[float, float]
-    seconds: float
+    drift: tuple[float, float]
+    met: tuple[str, ...]
+
+    @property
+    def segments(self) -> list[Push | Transit | Transfer]:
+        """The move's segments as the plan numbers them: its transfer first, if it has one."""
+        return [self.move.transfer] * (self.move.transfer is not None) + list(self.move.segments)
 
     @property
     def passed(self) -> bool:
-        """No run of any push slipped."""
-        return all(p.passed for p in self.pushes)
+        return all(p.passed for p in self.pushes) and not self.met
+
+
+@dataclass(frozen=True, eq=False)
+class Verification:
+    """Outcome of :func:`verify`: per move, its pushes' checks, its drift and the parts it meets.
+
+    ``pushes`` holds one check per push of the plan, in order (transits and transfers have nothing
+    to simulate); ``segments`` is the whole plan, so that :meth:`lines` can show where the pusher
+    switched. ``supports`` and ``tolerance`` are those of the one part of a plan of one part.
+    """
+
+    scene: Scene
+    moves: tuple[MoveCheck, ...]
+    supports_of: dict[str, tuple[SupportDistribution, ...]]  # each part's, in the order of kinds
+    kinds: tuple[str, ...]
+    relative_tolerance: float  # positions in part radii, angles in radians
+    seconds: float
+
+    @property
+    def pushes(self) -> tuple[PushCheck, ...]:
+        return tuple(p for m in self.moves for p in m.pushes)
+
+    @property
+    def segments(self) -> tuple[Push | Transit | Transfer, ...]:
+        return tuple(s for m in self.moves for s in m.segments)
+
+    @property
+    def supports(self) -> tuple[SupportDistribution, ...]:
+        """The one part's distributions."""
+        return self.supports_of[self.scene.part().name]
+
+    @property
+    def tolerance(self) -> tuple[float, float]:
+        """Position (m) and angle (rad) beyond which a run of the one part slips."""
+        return self.relative_tolerance * self.scene.slider.radius, self.relative_tolerance
+
+    @property
+    def drift(self) -> tuple[float, float]:
+        """Worst CF distance (m) and angle (rad) of a move's chained end from the plan's."""
+        return (max((m.drift[0] for m in self.moves), default=0.0), max((m.drift[1] for m in self.moves), default=0.0))
+
+    @property
+    def passed(self) -> bool:
+        """No run of any push slipped, and no move meets another part."""
+        return all(m.passed for m in self.moves)
 
     @property
     def worst(self) -> tuple[float, float]:
@@ -195,30 +253,43 @@ class Verification:
         check = self.pushes[push]
         s, run = check.segment, check.worst if run is None else run
         dt = s.duration / DEFAULT_STEPS
-        return np.array([simulate_push(self.supports[run], check.contacts, s.twist, t, dt=dt,
-                                       footprint=self.scene.slider.polygon, start_pose=s.start).final_pose
+        footprint = self.scene.part(check.part).slider.polygon
+        return np.array([simulate_push(self.supports_of[check.part][run], check.contacts, s.twist, t, dt=dt,
+                                       footprint=footprint, start_pose=s.start).final_pose
                          if t > 0 else s.start for t in np.asarray(times, dtype=float)])
 
     def lines(self) -> list[str]:
         """A line per segment, in plan order, numbered from 1 (``plan --verify`` prints them, then
-        :meth:`summary`).
+        :meth:`summary`); with several parts, each move's segments after a line on the move.
 
-        A transit has nothing to simulate and :func:`verify` refuses a plan whose transits do not
-        join up, so every transit it reports on is ``ok``; its line shows where the edge changes.
+        A transit or a transfer has nothing to simulate and :func:`verify` refuses a plan whose
+        transits and transfers do not join up, so every one it reports on is ``ok``; its line shows
+        where the pusher goes.
         """
-        transits = [s for s in self.segments if s.kind == "transit"]
-        numbered = {"push": iter(enumerate(self.pushes, 1)), "transit": iter(enumerate(transits, 1))}
+        segments, pushes = self.segments, iter(self.pushes)
+        totals, seen = Counter(map(type, segments)), Counter()
         out = []
-        for n, s in enumerate(self.segments, 1):  # the plan's own numbering, as --simulate and the CSV use
-            k, item = next(numbered[s.kind])
-            out.append(f"segment {n}/{len(self.segments)}: " + (
-                self._push_line(k, item) if s.kind == "push" else
-                f"transit {k}/{len(transits)} (edge {item.from_edge} -> {item.to_edge}, {item.mode}, "
-                f"{item.duration:.3f} s): part still, flush on both edges: ok"))
+        for k, move in enumerate(self.moves, 1):
+            if len(self.scene.parts) > 1:  # a part alone has no other part to meet
+                clear = f"meets {', '.join(move.met)}: FAILED" if move.met else "clear of the other parts"
+                out.append(f"move {k}/{len(self.moves)} ({move.move.part}): {clear}")
+            for s in move.segments:
+                seen[type(s)] += 1
+                count = f"{seen[type(s)]}/{totals[type(s)]}"
+                if isinstance(s, Push):
+                    text = self._push_line(count, next(pushes))
+                elif isinstance(s, Transit):
+                    text = (f"transit {count} (edge {s.from_edge} -> {s.to_edge}, {s.mode}, {s.duration:.3f} s): "
+                            "part still, flush on both edges: ok")
+                else:
+                    text = (f"transfer {count} ({s.from_part} -> {s.to_part} edge {s.to_edge}, {s.mode}, "
+                            f"{s.duration:.3f} s): parts still, flush on both: ok")
+                # The plan's own numbering, as --simulate and the CSV use.
+                out.append(f"segment {sum(seen.values())}/{len(segments)}: {text}")
         return out
 
-    def _push_line(self, k: int, p: PushCheck) -> str:
-        """The verdict on push ``k`` (from 1) and what its runs did."""
+    def _push_line(self, count: str, p: PushCheck) -> str:
+        """The verdict on push ``count`` (``k/n``) and what its runs did."""
         runs = len(p.results)
         stuck = sum(r.sticks for r in p.results)
         stopped = {s: sum(r.status == s for r in p.results) for s in ("separated", "slid_off_edge", "no_solution")}
@@ -227,38 +298,47 @@ class Verification:
             notes.append(f"{ambiguous} ambiguous")
         if (modes := p.non_sticking_modes()):
             notes.append(f"modes {', '.join(modes)}")
-        return (f"push {k}/{len(self.pushes)} (edge {p.segment.edge}, {p.segment.duration:.3f} s): "
+        return (f"push {count} (edge {p.segment.edge}, {p.segment.duration:.3f} s): "
                 f"worst {p.position_error.max():.2e} m, {p.angle_error.max():.2e} rad "
                 f"({self.kinds[p.worst]} run {p.worst}); {', '.join(notes)}: {'ok' if p.passed else 'SLIPS'}")
 
     def summary(self) -> str:
-        """One line: the verdict, the distributions, the worst deviation and the chained drift."""
+        """One line: the verdict, the distributions, the worst deviation and the chained drift; with
+        several parts, the moves and the parts they meet."""
         mix = ", ".join(f"{self.kinds.count(k)} {k}" for k in dict.fromkeys(self.kinds))
         position, angle = self.worst
-        return (f"verify: {'passed' if self.passed else 'FAILED'}: {len(self.pushes)} push{'' if len(self.pushes) == 1 else 'es'} x "
-                f"{len(self.supports)} distributions ({mix}); worst deviation {position:.2e} m, {angle:.2e} rad; "
+        pushes = f"{len(self.pushes)} push{'' if len(self.pushes) == 1 else 'es'}"
+        if len(self.scene.parts) == 1:
+            limits, met = f"{self.tolerance[0]:.1e} m", ""
+        else:  # one tolerance in metres per part: said relative to the part
+            parts = sorted({p for m in self.moves for p in m.met})
+            pushes += f" of {len(self.moves)} move{'' if len(self.moves) == 1 else 's'}"
+            limits = f"{self.relative_tolerance:.1e} part radii"
+            met = "; " + (f"parts met: {', '.join(parts)}" if parts else "every move clear of the other parts")
+        return (f"verify: {'passed' if self.passed else 'FAILED'}: {pushes} x "
+                f"{len(self.kinds)} distributions ({mix}); worst deviation {position:.2e} m, {angle:.2e} rad; "
                 f"chained drift {self.drift[0]:.2e} m, {self.drift[1]:.2e} rad "
-                f"(tolerance {self.tolerance[0]:.1e} m, {self.tolerance[1]:.1e} rad)")
+                f"(tolerance {limits}, {self.relative_tolerance:.1e} rad){met}")
 
 
-def _allowed_edge(scene: Scene, edge: int, field: str) -> None:
+def _allowed_edge(part: Part, edge: int, field: str) -> None:
     """Refuse an edge the scene does not let the pusher push (a plan made for another scene)."""
-    if edge not in scene.edges:
+    if edge not in part.edges:
         raise SceneError(field, f"edge {edge} is not one the scene lets the pusher push "
-                                f"(allowed: {', '.join(map(str, scene.edges))})")
+                                f"(allowed: {', '.join(map(str, part.edges))})")
 
 
-def _off(scene: Scene, pose: ArrayLike, expected: ArrayLike) -> bool:
-    """``pose`` is not ``expected`` to :data:`TOLERANCE` (in slider radii and radians): the same
+def _off(part: Part, pose: ArrayLike, expected: ArrayLike) -> bool:
+    """``pose`` is not ``expected`` to :data:`TOLERANCE` (in part radii and radians): the same
     pose but for rounding, as in a plan file written with full precision."""
     gap = np.asarray(pose, dtype=float) - expected
-    return bool(np.hypot(gap[0], gap[1]) > TOLERANCE * scene.slider.radius or abs(wrap_angle(gap[2])) > TOLERANCE)
+    return bool(np.hypot(gap[0], gap[1]) > TOLERANCE * part.slider.radius or abs(wrap_angle(gap[2])) > TOLERANCE)
 
 
-def _contacts(scene: Scene, segment: Push, name: str) -> tuple[Contact, ...]:
-    """The scene's flat pusher on ``segment``'s edge, after checking the segment is for this scene."""
-    slider, pusher, edge = scene.slider, scene.pusher, segment.edge
-    _allowed_edge(scene, edge, f"{name}.edge")
+def _contacts(part: Part, pusher: Pusher, segment: Push, name: str) -> tuple[Contact, ...]:
+    """The scene's flat pusher on ``segment``'s edge, after checking the segment is for this part."""
+    slider, edge = part.slider, segment.edge
+    _allowed_edge(part, edge, f"{name}.edge")
     expected = slider.contact(edge, pusher.width)
     miss = min(np.abs(segment.contact - expected).max(), np.abs(segment.contact[::-1] - expected).max())
     if miss > TOLERANCE * slider.radius:  # a plan made for another part or another pusher width
@@ -269,71 +349,137 @@ def _contacts(scene: Scene, segment: Push, name: str) -> tuple[Contact, ...]:
     return edge_contacts(slider, edge, pusher.mu, pusher.width)
 
 
-def _check_transit(scene: Scene, transit: Transit, edge: int | None, name: str) -> None:
+def _check_flush(part: Part, edge: int, where: ArrayLike, pose: ArrayLike, name: str, verb: str, edge_text: str) -> None:
+    """Refuse a pusher ``pose`` (``verb``: how it is on segment ``name``'s path) that is not the
+    contact pose on ``part``'s ``edge`` (in words: ``edge_text``) with the part at ``where``."""
+    flush = edge_contact_pose(part.slider, edge, where)
+    if _off(part, pose, flush):
+        raise SceneError(f"{name}.pusher_path", f"{verb} at {pose_text(pose)}, not at the contact pose on "
+                                                f"{edge_text}: {pose_text(flush)}")
+
+
+def _check_transit(part: Part, pusher: Pusher, transit: Transit, edge: int | None, name: str) -> None:
     """Refuse a transit the scene does not allow, or one that does not leave from ``edge`` (the
     edge the pusher is on; None at the plan's start) and reach its own ``to_edge`` flush."""
-    allowed = scene.pusher.transit
+    allowed = pusher.transit
     if allowed == "none" or (transit.mode == "lift" and allowed != "lift"):
         raise SceneError(f"{name}.mode", f"a {transit.mode} transit is not allowed: the scene's pusher.transit "
                                          f"is {allowed!r}")
     if edge is not None and transit.from_edge != edge:
         raise SceneError(f"{name}.from_edge", f"must be {edge}, the edge the pusher is on, got {transit.from_edge}")
-    ends = (("from_edge", "starts", transit.from_edge, transit.pusher_path[0]),
-            ("to_edge", "ends", transit.to_edge, transit.pusher_path[-1]))
-    for field, verb, e, pose in ends:
-        _allowed_edge(scene, e, f"{name}.{field}")
-        flush = edge_contact_pose(scene.slider, e, transit.pose)
-        if _off(scene, pose, flush):
-            raise SceneError(f"{name}.pusher_path", f"{verb} at {pose_text(pose)}, not at the contact "
-                                                    f"pose on edge {e}: {pose_text(flush)}")
+    for field, verb, e, pose in (("from_edge", "starts", transit.from_edge, transit.pusher_path[0]),
+                                 ("to_edge", "ends", transit.to_edge, transit.pusher_path[-1])):
+        _allowed_edge(part, e, f"{name}.{field}")
+        _check_flush(part, e, transit.pose, pose, name, verb, f"edge {e}")
 
 
-def check_chain(scene: Scene, plan: Plan) -> list[tuple[Contact, ...]]:
-    """The pusher's contacts for each push, after checking that every segment fits the scene and
-    takes over where the one before left the part and the pusher (module docstring)."""
-    pose, edge, after = plan.start, None, "the plan's start"
-    contacts = []
-    for k, segment in enumerate(plan.segments):
+def check_solved(plan: Plan) -> None:
+    """Refuse a plan that is not solved: it holds no way to the goals to check or run."""
+    if not plan.solved:
+        raise SceneError("plan.solved", f"is false: the plan holds no way to the goal{'s' * (len(plan.names) > 1)} "
+                                        "to check or run"
+                                        + (f" ({plan.reason})" if plan.reason else ""))
+
+
+def placed_moves(plan: Plan) -> Iterator[tuple[Move, dict[str, np.ndarray], int]]:
+    """Each move of ``plan`` with where every part stands as it begins (its start, or where its
+    last move left it) and the index in :attr:`Plan.segments` of the move's first segment (after
+    its transfer)."""
+    poses = {n: np.asarray(p, dtype=float) for n, p in plan.starts.items()}
+    first = 0
+    for move in plan.moves:
+        first += move.transfer is not None
+        yield move, dict(poses), first
+        first += len(move.segments)
+        poses[move.part] = move.end
+
+
+def check_chain(scene: Scene, plan: Plan) -> list[list[tuple[Push, tuple[Contact, ...]]]]:
+    """Per move, each of its pushes with the pusher's contacts for it, after checking that the
+    plan's parts are the scene's and that every segment fits the scene and takes over where the one
+    before left its part and the pusher (module docstring). Errors name the plan's fields as its
+    file does (:func:`~planner.model.plan_file.part_field`), segments by their index in
+    :attr:`Plan.segments`."""
+    if sorted(plan.names) != sorted(scene.names):
+        raise SceneError("plan.parts", f"are {', '.join(plan.names)}, but the scene's parts are {', '.join(scene.names)}")
+    for part in scene.parts:
+        cf = plan.cfs.get(part.name)
+        if cf is not None and np.abs(cf - part.slider.cf).max() > TOLERANCE * part.slider.radius:
+            raise SceneError(part_field(plan, part.name, "cf"), f"is {np.round(cf, 6).tolist()}, but the scene's part "
+                                                                f"has its CF at {np.round(part.slider.cf, 6).tolist()}: "
+                                                                "a plan for another part")
+    out = []
+    for k, (move, poses, first) in enumerate(placed_moves(plan)):
+        part, edge, after = scene.part(move.part), None, "the plan's start"
+        if move.transfer is not None:
+            after = f"plan.segments[{first - 1}]"
+            if k == 0:
+                raise SceneError(after, "a transfer must come between two parts' segments")
+            before, to = plan.moves[k - 1], move.transfer.to_edge
+            last = before.segments[-1].edge
+            _check_flush(scene.part(before.part), last, poses[before.part], move.transfer.pusher_path[0], after,
+                         "starts", f"part {before.part}'s edge {last}")
+            _check_flush(part, to, poses[move.part], move.transfer.pusher_path[-1], after, "ends",
+                         f"part {move.part}'s edge {to}")
+            edge = to
+        out.append(_check_move(part, scene.pusher, move.segments, poses[move.part], edge, first, after))
+    return out
+
+
+def _check_move(part: Part, pusher: Pusher, segments: list[Push | Transit], pose: np.ndarray, edge: int | None,
+                first: int, after: str) -> list[tuple[Push, tuple[Contact, ...]]]:
+    """:func:`check_chain` of one move's ``segments`` (plan segments ``first`` on), ``part`` at
+    ``pose`` and the pusher on ``edge`` (None: anywhere) as ``after`` left them."""
+    out = []
+    for k, segment in enumerate(segments, first):
         name = f"plan.segments[{k}]"
         # A transit's pose is not in the file (it is the previous end), so only a plan built in
         # memory can get it wrong; then the segment as a whole is at fault.
-        if _off(scene, segment.start, pose):
-            raise SceneError(name if segment.kind == "transit" else f"{name}.start",
+        if _off(part, segment.start, pose):
+            raise SceneError(name if isinstance(segment, Transit) else f"{name}.start",
                              f"the part is at {pose_text(segment.start)}, not where {after} left it: "
                              f"{pose_text(pose)}")
-        if segment.kind == "transit":
-            _check_transit(scene, segment, edge, name)
+        if isinstance(segment, Transit):
+            _check_transit(part, pusher, segment, edge, name)
         else:
             if edge is not None and segment.edge != edge:
                 raise SceneError(f"{name}.edge", f"must be {edge}, the edge the pusher is on after {after} "
                                                  f"(a change of edge needs a transit), got {segment.edge}")
-            contacts.append(_contacts(scene, segment, name))
+            out.append((segment, _contacts(part, pusher, segment, name)))
         pose, edge, after = segment.end, segment.edge, name
-    return contacts
+    return out
 
 
-def _deviation(scene: Scene, simulated: np.ndarray, planned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+def _deviation(slider: Slider, simulated: np.ndarray, planned: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """CF distance and wrapped angle between simulated poses ``(n, 3)`` and a planned pose."""
-    cf = scene.slider.cf[None]
+    cf = slider.cf[None]
     gap = np.array([transform_points(cf, q)[0] for q in simulated]) - transform_points(cf, planned)[0]
     return np.linalg.norm(gap, axis=1), np.abs(wrap_angle(simulated[:, 2] - planned[2]))
 
 
+def _meets(scene: Scene, move: Move, poses: dict[str, np.ndarray], other: str) -> bool:
+    """Whether a push or transit of ``move`` is not clear of part ``other`` at its pose in ``poses``."""
+    only = replace(scene.move_scene(move.part, poses, others=False), obstacles=(scene.body(other, poses[other]),))
+    model = collision_model(only, move.segments)
+    return not all(is_clear(only, model, s) for s in move.segments)
+
+
 def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: float = TOLERANCE) -> Verification:
-    """Re-simulate every push of ``plan`` under ``n`` support distributions (module docstring).
+    """Re-simulate every push of ``plan`` under ``n`` support distributions of its part, and sweep
+    every move against the other parts (module docstring).
 
     Parameters
     ----------
     scene : Scene
-        The scene the plan is for: part, CF, pusher width and friction.
+        The scene the plan is for: parts, CFs, pusher width and friction.
     plan : Plan
-        The plan, from :func:`planner.plan` or :func:`planner.load_plan`.
+        The plan, from :func:`planner.plan` or :func:`planner.load_plan`, of any number of parts.
     n : int
-        Number of support distributions (see :func:`distributions`), >= 1.
+        Number of support distributions of each part (see :func:`distributions`), >= 1.
     seed : int
         Seed of the random distributions.
     tolerance : float
-        Relative tolerance: positions in slider radii, angles in radians.
+        Relative tolerance: positions in part radii, angles in radians.
 
     Returns
     -------
@@ -342,10 +488,10 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
     Raises
     ------
     SceneError
-        If a segment does not fit the scene (an edge the scene does not allow, a contact off its
-        edge, a push of no duration, a lift where the pusher must stay on the table) or does not
-        take over where the one before it left the part and the pusher (module docstring),
-        naming the plan field.
+        If the plan is not solved, or is for other parts, or a segment does not fit the scene (an
+        edge the scene does not allow, a contact off its edge, a push of no duration, a lift where
+        the pusher must stay on the table) or does not take over where the one before it left its
+        part and the pusher (module docstring), naming the plan field.
     ValueError
         If ``n < 1``.
 
@@ -357,20 +503,28 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
     >>> check.passed, len(check.pushes), check.worst[0] < 1e-12
     (True, 1, True)
     """
+    check_solved(plan)
     contacts = check_chain(scene, plan)
     clock = time.perf_counter()
-    supports, kinds = distributions(scene, n, seed)
-    limits = (tolerance * scene.slider.radius, tolerance)
-    footprint = scene.slider.polygon
-    checks = []
-    chained = np.tile(plan.start, (n, 1))  # transits leave it be: the part stands still
-    for segment, fingers in zip([s for s in plan.segments if s.kind == "push"], contacts):
-        results = tuple(simulate_push(s, fingers, segment.twist, segment.duration, footprint=footprint,
-                                      start_pose=segment.start) for s in supports)
-        ends = np.array([r.final_pose for r in results])
-        checks.append(PushCheck(segment, fingers, results, *_deviation(scene, ends, segment.end), limits))
-        # chained * (start^-1 end): each run's own relative motion, from where it got to.
-        chained = exp_twist(chained, log_pose(segment.start, ends))
-    drift = _deviation(scene, chained, plan.final)
-    return Verification(scene, tuple(plan.segments), tuple(supports), tuple(kinds), tuple(checks),
-                        (float(drift[0].max()), float(drift[1].max())), limits, time.perf_counter() - clock)
+    supports_of, kinds = {}, []
+    for part in scene.names:
+        supports, kinds = distributions(scene.move_scene(part, scene.starts, others=False), n, seed)
+        supports_of[part] = tuple(supports)
+    moves = []
+    for (move, poses, _), pushes in zip(placed_moves(plan), contacts):
+        part = scene.part(move.part)
+        limits = (tolerance * part.slider.radius, tolerance)
+        checks = []
+        chained = np.tile(move.start, (n, 1))  # transits leave it be: the part stands still
+        for segment, fingers in pushes:
+            results = tuple(simulate_push(s, fingers, segment.twist, segment.duration, footprint=part.slider.polygon,
+                                          start_pose=segment.start) for s in supports_of[move.part])
+            ends = np.array([r.final_pose for r in results])
+            checks.append(PushCheck(segment, move.part, fingers, results, *_deviation(part.slider, ends, segment.end),
+                                    limits))
+            # chained * (start^-1 end): each run's own relative motion, from where it got to.
+            chained = exp_twist(chained, log_pose(segment.start, ends))
+        drift = _deviation(part.slider, chained, move.end)
+        met = tuple(other for other in scene.names if other != move.part and _meets(scene, move, poses, other))
+        moves.append(MoveCheck(move, tuple(checks), (float(drift[0].max()), float(drift[1].max())), met))
+    return Verification(scene, tuple(moves), supports_of, tuple(kinds), tolerance, time.perf_counter() - clock)

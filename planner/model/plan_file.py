@@ -35,7 +35,7 @@ from .plan import FORMAT, FORMATS, Move, Plan
 from .scene import ONE_PART
 from .segments import Push, Transfer, Transit
 
-__all__ = ["FORMAT", "FORMATS", "MAX_BYTES", "load_plan", "read_plan"]
+__all__ = ["FORMAT", "FORMATS", "MAX_BYTES", "load_plan", "part_field", "read_plan"]
 
 #: Largest plan file read: a plan of ten thousand segments with their transits' paths.
 MAX_BYTES = 10_000_000
@@ -49,6 +49,20 @@ def read_plan(data: Any) -> Plan:
     if data.get("format") == FORMATS[1]:
         return _read_parts(data)
     raise SceneError("plan.format", f"must be one of {', '.join(map(repr, FORMATS))}, got {shown(data.get('format'))}")
+
+
+def part_field(plan: Plan, part: str, key: str) -> str:
+    """Part ``part``'s field ``key`` as ``plan``'s file names it, for errors about it: ``plan.<key>``
+    in a ``plan/1`` file (:meth:`Plan.to_dict` writes one for a plan of
+    :data:`~planner.model.scene.ONE_PART` alone), ``plan.parts.<part>.<key>`` in a ``plan/2``.
+
+    >>> tray = Plan.of_part("red", np.zeros(3), np.zeros(3), [], scene=None, solved=True, planner="rrt", seed=1,
+    ...                     planning_time_s=0.0)
+    >>> part_field(tray, "red", "start"), part_field(read_plan(Plan.of_part(ONE_PART, np.zeros(3), np.zeros(3), [],
+    ...     scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0).to_dict()), ONE_PART, "start")
+    ('plan.parts.red.start', 'plan.start')
+    """
+    return f"plan.{key}" if plan.names == (ONE_PART,) else f"plan.parts.{part}.{key}"
 
 
 def _check(plan: Plan, spec: dict) -> Plan:

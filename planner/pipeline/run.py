@@ -75,9 +75,9 @@ def run(scene: Scene, options: RunOptions = RunOptions(), *, progress: Callable[
 
 
 def _fitted(scene: Scene, path: str | Path) -> Plan:
-    from ..execution.fit import fit_parts_plan, fit_plan  # with the re-simulator: only for a plan file
+    from ..execution.fit import fit_plan  # with the re-simulator: only for a plan file
 
-    return (fit_plan if len(scene.parts) == 1 else fit_parts_plan)(scene, load_plan(path))
+    return fit_plan(scene, load_plan(path))
 
 
 def _checked(scene: Scene, options: RunOptions, result: Plan, session: Planner | None,
@@ -86,10 +86,8 @@ def _checked(scene: Scene, options: RunOptions, result: Plan, session: Planner |
     seed = scene.planner.seed
     check = motion = simulation = reach = None
     if options.verify and result.solved:
-        if len(scene.parts) == 1:
-            from ..execution.verify import verify  # the re-simulator, loaded only for verify
-        else:
-            from ..execution.parts_verify import verify_parts as verify
+        from ..execution.verify import verify  # the re-simulator, loaded only for verify
+
         check = verify(scene, result, options.verify, seed)
     if options.trajectory and result.solved:
         from ..execution.trajectory import trajectory  # loads ruckig, only for a trajectory
