@@ -97,7 +97,10 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         pose_noise=None if args.sim_pose_noise is None else _radians(args.sim_pose_noise),
         closed_loop=args.closed_loop, mjcf=None if args.mjcf is None else Path(args.mjcf), reach=args.reach,
         part=args.part, out=out, export_scene=None if args.export_scene is None else Path(args.export_scene))
-    return Inputs(scene, options.checked(scene))
+    try:
+        return Inputs(scene, options.checked(scene))
+    except SceneError as err:  # the library names its options' fields: the command, their flags
+        raise SceneError(flag_of(err.field), err.problem) from None
 
 
 def _radians(values: Sequence[float]) -> tuple[float, ...]:

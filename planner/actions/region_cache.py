@@ -24,7 +24,6 @@ process would compute, and this process alone writes the cache.
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 import os
@@ -49,7 +48,7 @@ from ..model.json_file import read_json
 from ..model.processes import cores, die_with_parent, fork_context
 from ..model.stop import quiet_child, signals_blocked
 
-__all__ = ["MEMORY_SIZE", "RegionCache", "cache_folder", "cache_key", "compute_regions", "default_cache",
+__all__ = ["MEMORY_SIZE", "RegionCache", "cache_folder", "cache_key", "compute_regions", "default_cache", "set_default_cache",
            "edge_region", "is_cached", "regions_held"]
 
 #: Bump when the exact region's construction (or the recording's analysis) changes, so old cache
@@ -141,13 +140,36 @@ def cache_folder() -> Path:
     return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "stablepush"
 
 
-@functools.cache
+#: The process's default cache (:func:`default_cache`), made on first use; :func:`set_default_cache` replaces it.
+_default: RegionCache | None = None
+
+
 def default_cache() -> RegionCache:
     """The cache of every call given none: one per process, so the planner, the queries and the
     recording share what each computed. It is made on first use, in :func:`cache_folder` as the
     environment says then (a later change is not seen), of :data:`MEMORY_SIZE` items, computing
-    with :func:`mechanics.exact_region`; a process forked later (the recorder) has a copy."""
-    return RegionCache(cache_folder())
+    with :func:`mechanics.exact_region`; a process forked later (the recorder) has a copy. The one
+    process-wide default of the planner: :func:`set_default_cache` replaces it."""
+    global _default
+    if _default is None:
+        _default = RegionCache(cache_folder())
+    return _default
+
+
+def set_default_cache(cache: RegionCache | None) -> RegionCache | None:
+    """Make ``cache`` the process's default (None: a new one, made from the environment at its next
+    use), and return the one it replaces (None if none was made yet), to put back later.
+
+    >>> mine = RegionCache("/tmp/stablepush-doctest-cache")
+    >>> before = set_default_cache(mine)
+    >>> default_cache() is mine
+    True
+    >>> set_default_cache(before) is mine
+    True
+    """
+    global _default
+    before, _default = _default, cache
+    return before
 
 
 def cache_key(kind: str, slider: Slider, edge: int, mu: float, width: float | None, cf_radius: float,

@@ -24,6 +24,8 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
+from mechanics import wrap_angle
+
 from ..actions.transit import TransitPlanner, backed_off, edge_contact_pose, in_plane_moves, path_duration, standoff
 from ..model.bodies import pusher_frame_body, slider_at
 from ..model.plan import Plan
@@ -63,7 +65,7 @@ def lead_in_pose(scene: Scene, model: CollisionModel, plan: Plan) -> np.ndarray:
 def _off_part(scene: Scene, part: shapely.Polygon, a: np.ndarray, b: np.ndarray) -> bool:
     """The pusher moving from ``a`` to ``b`` (linear in ``(x, y, theta)``) never touches ``part``."""
     body = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth)).buffer(-GRAZE, join_style="mitre")
-    turn = (b[2] - a[2] + math.pi) % (2 * math.pi) - math.pi
+    turn = float(wrap_angle(b[2] - a[2]))
     span = math.hypot(*(b[:2] - a[:2])) + abs(turn) * scene.slider.radius
     for u in np.linspace(0.0, 1.0, max(2, math.ceil(span / PART_STEP) + 1))[1:]:
         pose = a + u * np.array([*(b[:2] - a[:2]), turn])

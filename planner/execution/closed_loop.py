@@ -26,6 +26,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
+from mechanics import wrap_angle
+
 from ..model.plan import Plan
 from ..model.scene import Scene
 from ..queries.session import Planner
@@ -151,15 +153,15 @@ def _run(session: Planner, plan: Plan, support: Feet, mu: float | None, start: n
         collisions += world.colliding()
         if k % every == 0:
             seen = world.pose() + rng.normal(0.0, [noise[0], noise[0], noise[1]])
-            if tracker.observe(u, seen).kind in ("done", "give_up") or u > limit:
+            if tracker.observe(u, seen).kind.ended or u > limit:
                 break
         k += 1
     table = np.array(rows)
-    table[:, 3] = (table[:, 3] + np.pi) % (2 * np.pi) - np.pi
+    table[:, 3] = wrap_angle(table[:, 3])
     executed = Trajectory(*table[:, :8].T, table[:, 8].astype(int), table[:, 9].astype(int))
     part = table[:, 10:13]
     end = world.pose()
-    error = (math.hypot(*(end[:2] - scene.goal[:2])), abs(float((end[2] - scene.goal[2] + np.pi) % (2 * np.pi) - np.pi)))
+    error = (math.hypot(*(end[:2] - scene.goal[:2])), abs(float(wrap_angle(end[2] - scene.goal[2]))))
     reason = tracker.reason or ("" if tracker.done else f"not done after {limit:.0f} s")
     return ClosedRun(support, error, scene.within_tolerance(end), tuple(tracker.replans), reason, collisions,
                      time.perf_counter() - clock, float(table[-1, 0]), executed, part, tuple(tracker.carried))

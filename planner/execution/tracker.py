@@ -63,7 +63,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import Literal
+from enum import StrEnum
 
 import numpy as np
 import shapely
@@ -80,7 +80,7 @@ from .approach import approach, first_edge
 from .trajectory import Trajectory, planned_part, trajectory
 
 __all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "REPLAN_LIMIT", "FRACTION", "SETTLE", "SIGMAS",
-           "Command", "Replan", "Tracker", "mean_pose"]
+           "Action", "Command", "Replan", "Tracker", "mean_pose"]
 
 #: Thresholds: this fraction of the goal tolerance, and at least this many noise deviations.
 FRACTION, SIGMAS = 0.5, 5.0
@@ -98,18 +98,31 @@ REPLAN_LIMIT = 2.0
 FRICTION_STEP, FRICTION_FLOOR = 0.5, 0.125
 
 
+class Action(StrEnum):
+    """What a :class:`Command` tells the pusher to do (a string too: ``Action.STOP == 'stop'``)."""
+
+    FOLLOW = "follow"  # go on along the plan
+    STOP = "stop"  # hold still while the part is observed at rest
+    REPLAN = "replan"  # the command's plan is the new plan: the pusher now approaches its first contact
+    DONE = "done"  # the part is in the goal
+    GIVE_UP = "give_up"  # the command's reason says why
+
+    @property
+    def ended(self) -> bool:
+        """No command will follow this one but itself."""
+        return self in (Action.DONE, Action.GIVE_UP)
+
+
 @dataclass(frozen=True)
 class Command:
     """What the pusher should do after an observation.
 
-    ``kind``: ``'follow'`` (go on along the plan), ``'stop'`` (hold still while the part is
-    observed at rest), ``'replan'`` (``plan`` is the new plan, the pusher now approaches its first
-    contact), ``'done'`` (the part is in the goal) or ``'give_up'`` (``reason`` says why).
+    ``kind``: an :class:`Action`.
     ``pusher`` is where the pusher frame should be now ``(x, y, theta)``, ``height`` its height
     above the table (a lift's flight), ``contact`` whether it should be pushing, ``error`` the
     observed part's distance (m) and heading difference (rad) from its planned pose."""
 
-    kind: Literal["follow", "stop", "replan", "done", "give_up"]
+    kind: Action
     pusher: np.ndarray
     height: float
     contact: bool
@@ -180,7 +193,7 @@ class Tracker:
     >>> from planner import load_scene
     >>> session = Planner(load_scene("scenes/battery.yaml"))
     >>> tracker = Tracker(session, session.plan(seed=1))
-    >>> tracker.observe(0.0, session.scene.start).kind, tracker.replans
+    >>> str(tracker.observe(0.0, session.scene.start).kind), tracker.replans
     ('follow', [])
     """
 
@@ -214,8 +227,19 @@ class Tracker:
         self._strikes, self._jump, self._last = 0, 0.0, None
         self._body = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
         self._trigger: tuple[np.ndarray, tuple[float, float], str, bool] | None = None
-        self._window: list[np.ndarray] = []
-        self._held: tuple[np.ndarray, float] | None = None
+        self._window: list[np.ndarray] = []  # the observations since the pusher stopped
+        self._held: tuple[np.ndarray, float] | None = None  # where the pusher holds still (pose, height)
+        self._stopped = 0.0  # where on the plan's clock the pusher stopped
+        self._edge = -1  # the edge the pusher was on when it stopped
+        # The plan followed, from _begin: its segments (the approach first), the pusher's timed
+        # motion, the part's pose expected at each sample, the pusher's heading unwrapped along
+        # it, when it began on the caller's clock and until when a deviation is not counted.
+        self.plan = plan
+        self._segments: list = []
+        self.motion: Trajectory | None = None
+        self.expected = np.zeros((0, 3))
+        self._theta = np.zeros(0)
+        self._since, self._quiet = float(time), 0.0
         start = self._pose(plan.start, "plan.start")
         first = self._begin(plan, self._pose(pusher, "pusher") if pusher is not None else None, start, float(time))
         if first:
@@ -239,7 +263,7 @@ class Tracker:
             segments.insert(0, way)
         self.plan, self._segments = plan, segments
         led = plan.with_segments(segments)
-        self.motion: Trajectory = trajectory(self.scene, led)
+        self.motion = trajectory(self.scene, led)
         self.expected = planned_part(self.scene, led, self.motion)
         self._theta = np.unwrap(self.motion.theta)
         self._since, self._quiet = now, 0.0
@@ -262,7 +286,7 @@ class Tracker:
         rise = np.interp(u, m.t, np.gradient(m.z, m.t)) if len(m.t) > 1 else 0.0
         return np.array(column[:3]), float(column[3]), np.array([*column[4:], rise]), bool(m.contact[k])
 
-    def _command(self, kind: str, now: float, error: tuple[float, float], plan: Plan | None = None) -> Command:
+    def _command(self, kind: Action, now: float, error: tuple[float, float], plan: Plan | None = None) -> Command:
         pose, height, _, contact = self.pusher_at(now)
         return Command(kind, pose, height, contact, error, plan, self.reason)
 
@@ -292,11 +316,11 @@ class Tracker:
         now = float(now)
         error = self.error(now, pose)
         if self.done or self.reason:
-            return self._command("done" if self.done else "give_up", now, error)
+            return self._command(Action.DONE if self.done else Action.GIVE_UP, now, error)
         if self._held is not None:
             self._window.append(pose)
             if len(self._window) < self.settle:
-                return self._command("stop", now, error)
+                return self._command(Action.STOP, now, error)
             return self._settled(now, mean_pose(self._window), error)
         beyond = (error[0] > self.threshold[0] or error[1] > self.threshold[1]) and now - self._since >= self._quiet
         step = 0.0 if self._last is None else max(abs(a - b) / t for a, b, t in zip(error, self._last, self.threshold))
@@ -308,8 +332,8 @@ class Tracker:
                 f"off the plan by {error[0] * 1000:.1f} mm, {math.degrees(error[1]):.1f} deg")
             self._trigger = (pose, error, why, self._strikes >= self.confirm and self._slid(now, pose))
             self._stop(now)
-            return self._command("stop", now, error)
-        return self._command("follow", now, error)
+            return self._command(Action.STOP, now, error)
+        return self._command(Action.FOLLOW, now, error)
 
     def _slid(self, now: float, pose: np.ndarray) -> bool:
         """Whether the part, observed at ``pose``, strayed as a push that does not stick makes it:
@@ -334,7 +358,7 @@ class Tracker:
         """The part observed at rest at ``part`` (the mean): done, re-planned, or given up."""
         if self.scene.within_tolerance(part):
             self.done = True
-            return self._command("done", now, error)
+            return self._command(Action.DONE, now, error)
         if len(self.replans) + len(self.carried) >= self.budget:
             return self._give_up(now, error, f"the re-plan budget ({self.budget}) is spent")
         clock = time.perf_counter()
@@ -371,7 +395,7 @@ class Tracker:
             self._held = (pusher, 0.0)
             return self._give_up(now, error, problem)
         self.replans.append(Replan(now, part, trigger, trigger_error, why, latency, found, self.session.scene.pusher.mu))
-        return self._command("replan", now, error, found)
+        return self._command(Action.REPLAN, now, error, found)
 
     def _carry_on(self, now: float, error: tuple[float, float], reason: str, clock: float) -> Command:
         """No plan from where the part is (``reason``): go on with the plan from where the pusher
@@ -387,8 +411,8 @@ class Tracker:
         # It goes on once this was decided, from where it stopped.
         self._since = now + (time.perf_counter() - clock) - self._stopped
         self._held, self._strikes, self._last = None, 0, None
-        return self._command("follow", now, error)
+        return self._command(Action.FOLLOW, now, error)
 
     def _give_up(self, now: float, error: tuple[float, float], reason: str) -> Command:
         self.reason = reason
-        return self._command("give_up", now, error)
+        return self._command(Action.GIVE_UP, now, error)

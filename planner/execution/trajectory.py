@@ -58,7 +58,7 @@ from typing import NamedTuple
 import numpy as np
 import ruckig
 
-from mechanics import Slider, exp_twist, point_velocity, transform_points, wrap_angle
+from mechanics import Slider, compose, exp_twist, inverse, point_velocity, transform_points, wrap_angle
 
 from ..actions.transit import AIRBORNE, edge_contact_pose, piece_times
 from ..model.bodies import place, pusher_frame_body
@@ -187,8 +187,7 @@ def _push_piece(slider: Slider, index: int, push: Push, corners: np.ndarray, clo
         part = exp_twist(push.start, twist, s)
         turned = np.column_stack([np.zeros((len(s), 2)), part[:, 2]])  # the part's heading alone
         rate = np.column_stack([place(origin[None], turned)[:, 0], np.full(len(s), twist[2])])
-        pose = np.column_stack([place(local[None, :2], part)[:, 0], wrap_angle(part[:, 2] + local[2])])
-        return pose, rate, np.zeros(len(s))
+        return compose(part, local), rate, np.zeros(len(s))
 
     return _Piece(index, True, float(push.duration), speed, abs(float(twist[2])) * speed, clock, 1.0, at)
 
@@ -335,9 +334,5 @@ def planned_part(scene: Scene, plan: Plan, motion: Trajectory) -> np.ndarray:
             out[rows] = segment.start
             continue
         local = edge_contact_pose(scene.slider, segment.edge, np.zeros(3))  # pusher frame in the slider frame
-        theta = pusher[rows, 2] - local[2]
-        c, s = np.cos(theta), np.sin(theta)
-        out[rows, 0] = pusher[rows, 0] - (c * local[0] - s * local[1])
-        out[rows, 1] = pusher[rows, 1] - (s * local[0] + c * local[1])
-        out[rows, 2] = wrap_angle(theta)
+        out[rows] = compose(pusher[rows], inverse(local))  # the slider frame in the world
     return out
