@@ -544,9 +544,9 @@ def _plan_parts(inputs: Inputs) -> int:
 
         motion = trajectory(scene, result)
     if inputs.simulate and result.solved:
-        from .execution.parts_sim import simulate_parts  # MuJoCo is loaded only for --simulate
+        from .execution.mujoco_sim import simulate  # MuJoCo is loaded only for --simulate
 
-        simulation = simulate_parts(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset)
+        simulation = simulate(scene, result, inputs.simulate, seed, inputs.sim_mu, inputs.sim_cf_offset)
     if inputs.export_scene is not None:
         _export_scene(scene, inputs)
     with _writing(out, scene.name) as stage:
