@@ -5,7 +5,9 @@ within the scene's tolerance without slip or collision; with far less pusher fri
 or the centre of pressure moved well off the CF, some run slips or misses the goal (exit 3), and
 the recording shows that run's part where the printed line says it ended. A lift on its own
 (narrow_junction's) leaves the part where it was. Without MuJoCo, ``--simulate`` is bad input
-with one line saying how to install it.
+with one line saying how to install it. A plan of several parts runs through the same simulation:
+its model (every part a body of its own) loads in MuJoCo, a start error moves the part moved first
+and a bump the part the pusher is on.
 """
 
 from __future__ import annotations
@@ -14,6 +16,7 @@ import math
 import re
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -197,3 +200,92 @@ def test_pushes_inside_the_exact_region_stick_and_pushes_outside_slip_in_mujoco(
         slipped = slips(outside, [worst])[0]
         assert stuck.max() <= sim.SLIP, (vertex, stuck)
         assert slipped > sim.SLIP and slipped >= 2 * stuck[0], (vertex, stuck, slipped)
+
+
+CHANNEL = str(ROOT / "scenes" / "parts" / "channel.yaml")
+
+
+@pytest.fixture(scope="module")
+def channel():
+    from planner import Planner
+
+    scene = load_scene(CHANNEL)
+    return scene, Planner(scene, {"seed": 1, "time_limit": 60}).plan()
+
+
+def test_one_part_and_several_run_through_the_same_simulation_and_a_tray_model_loads(tmp_path, monkeypatch, channel):
+    """``plan --simulate`` calls the one :func:`simulate` for a scene of one part and of several;
+    the channel's ``--mjcf`` model loads, every part a body of its own, with keyframes of the planned
+    parts and the pusher along the run."""
+    import planner.execution.mujoco_sim as sim
+
+    scene, result = channel
+    calls, real = [], sim.simulate
+    monkeypatch.setattr(sim, "simulate", lambda scene, plan, *args: calls.append(len(scene.parts)) or real(scene, plan, *args))
+    assert main([BATTERY, "--simulate", "1", "--out", str(tmp_path / "one")]) == 0
+    (tmp_path / "channel.json").write_text(result.to_json())
+    model = tmp_path / "channel.xml"
+    assert main([CHANNEL, "--plan", str(tmp_path / "channel.json"), "--simulate", "1", "--mjcf", str(model),
+                 "--trajectory", "--out", str(tmp_path / "two")]) == 0
+    assert calls == [1, 2]
+    loaded = mujoco.MjModel.from_xml_path(str(model))
+    assert loaded.body("part0").id > 0 and loaded.body("part1").id > 0 and loaded.body("pusher").id > 0
+    csv = np.loadtxt(tmp_path / "two" / "channel.trajectory.csv", delimiter=",", skiprows=1, usecols=range(10))
+    assert loaded.nkey == math.ceil(csv[-1, 0]) + 1
+    parts = {name: loaded.joint(f"part{k}_x").qposadr[0] + np.arange(3) for k, name in enumerate(scene.names)}
+    pusher = loaded.joint("pusher_x").qposadr[0] + np.arange(4)
+    first, last = loaded.key("start").qpos, loaded.key(loaded.nkey - 1).qpos
+    for name, slots in parts.items():
+        assert np.allclose(first[slots], scene.starts[name]) and np.allclose(last[slots], result.finals[name], atol=1e-9)
+    for k in range(loaded.nkey):
+        time, qpos = loaded.key(k).time[0], loaded.key(k).qpos
+        row = csv[np.argmin(np.abs(csv[:, 0] - time))]
+        assert abs(row[0] - time) < 1e-9 and np.allclose(qpos[pusher], row[[1, 2, 7, 3]], atol=1e-9)
+
+
+def test_the_tray_model_has_every_part_on_its_feet_and_every_contact_that_tells():
+    """Every part of the tray a body at its start on its own feet; contacts of the pusher with every
+    part, and of every part with every other part and with the walls."""
+    from planner.execution.mujoco_sim import feet, mjcf
+
+    scene = load_scene(ROOT / "scenes" / "parts" / "tray.yaml")
+    supports = {name: feet(scene.move_scene(name, scene.starts), 1)[0] for name in scene.names}
+    model = mujoco.MjModel.from_xml_string(mjcf(scene, supports))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("start").id)
+    bodies = [model.body(model.geom_bodyid[g]).name for g in range(model.ngeom)]  # walls: the world's
+    pairs = {frozenset((bodies[model.pair_geom1[i]], bodies[model.pair_geom2[i]])) for i in range(model.npair)}
+    for k, name in enumerate(scene.names):
+        assert np.allclose(data.qpos[model.joint(f"part{k}_x").qposadr[0] + np.arange(3)], scene.starts[name])
+        assert sum(model.body(b).name.startswith(f"foot{k}_") for b in range(model.nbody)) == len(supports[name].points)
+        assert {frozenset((f"part{k}", "pusher")), frozenset((f"part{k}", "world"))} <= pairs
+        assert all(frozenset((f"part{k}", f"part{j}")) in pairs for j in range(k + 1, len(scene.parts)))
+
+
+def test_a_start_error_moves_the_part_moved_first_and_a_bump_the_part_the_pusher_is_on(channel):
+    """On the channel, far goes first: a start error moves far alone, a bump during near's move knocks
+    near; one that would put a part onto the other is bad input naming the flag, and the run knocks
+    the part the bump names."""
+    from planner.execution.mujoco_sim import perturbations, simulate
+    from planner.model.fields import SceneError
+    from planner.model.plan import Move
+
+    scene, result = channel
+    first, then = (m.part for m in result.moves)
+    setup = perturbations(scene, result, start_error=(0.0, 0.01, 0.0))
+    assert np.allclose(setup.starts[first], result.starts[first] + [0.0, 0.01, 0.0])
+    assert np.array_equal(setup.starts[then], result.starts[then])
+    later = setup.lead.duration + setup.motion.t[np.flatnonzero(setup.motion.part == then)[0]] + 1.0
+    assert [b[1] for b in perturbations(scene, result, bumps=[(0.0, 0.0, 0.001, 0.0), (later, 0.0, 0.001, 0.0)]).bumps] \
+        == [first, then]
+    onto = (result.starts[then] - result.starts[first])[:2]  # far's start onto near's
+    for field, kwargs in (("start_error", {"start_error": (*onto, 0.0)}), ("bump", {"bumps": [(0.0, *onto, 0.0)]})):
+        with pytest.raises(SceneError) as err:
+            perturbations(scene, result, **kwargs)
+        assert err.value.field == field and "cannot be" in err.value.problem
+    # The first push alone, far knocked 3 mm sideways as the pusher sets off: far is where the knock put it.
+    push = result.moves[0].segments[0]
+    short = replace(result, moves=[Move(first, [push])])
+    (run,) = simulate(scene, short, n=1, bumps=[(0.0, 0.0, 0.003, 0.0)]).runs
+    assert run.tracks[first][0][1] == pytest.approx(result.starts[first][1] + 0.003, abs=5e-4)
+    assert np.abs(run.tracks[then][-1] - result.starts[then]).max() < 1e-4

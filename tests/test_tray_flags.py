@@ -48,7 +48,7 @@ def test_reach_maps_one_part_of_a_tray_with_the_others_standing_as_obstacles(tmp
     (["--reach", "1"], "--part: the reachable set is one part's: name one of red, blue"),
     (["--reach", "1", "--part", "green"], "--part: no part is named 'green' (the parts: red, blue)"),
     (["--simulate", "1", "--closed-loop"], "--closed-loop: is for one-part scenes"),
-    (["--simulate", "1", "--sim-start-error", "0.01", "0", "0"], "--sim-start-error: is for one-part scenes"),
+    (["--simulate", "1", "--sim-pose-noise", "0.001", "1"], "--sim-pose-noise: is for one-part scenes"),
 ])
 def test_what_a_tray_does_not_take_is_one_line_naming_the_flag(tmp_path, capsys, monkeypatch, flags, named):
     if "--reach" in flags:

@@ -117,7 +117,8 @@ class ClosedLoop(Runs):
 
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:
         """Write the first run's model, the part at its perturbed start (:func:`.mujoco_sim.mjcf`)."""
-        write_mjcf(path, scene, self.runs[0].feet, self.mu, self.start)
+        name = scene.part().name
+        write_mjcf(path, scene, {name: self.runs[0].feet}, self.mu, {name: self.start})
 
     def executed_files(self, name: str) -> list[str]:
         """The executed paths' file names, one per run: ``<name>.executed.csv`` for the first (the
@@ -131,11 +132,11 @@ class ClosedLoop(Runs):
             run.executed.write_csv(Path(folder) / file)
 
 
-def _run(session: Planner, plan: Plan, support: Feet, mu: float | None, start: np.ndarray, bumps: tuple,
+def _run(session: Planner, plan: Plan, support: Feet, mu: float | None, starts: dict[str, np.ndarray], bumps: tuple,
          noise: np.ndarray, rng: np.random.Generator, lead: np.ndarray, seed: int | None) -> ClosedRun:
     scene = session.scene
     clock = time.perf_counter()
-    world = World(scene, support, mu, start, bumps)
+    world = World(scene, {scene.part().name: support}, mu, starts, bumps)
     tracker = Tracker(session, plan, pusher=lead, noise=(float(noise[0]), float(noise[1])), seed=seed)
     limit = PATIENCE * tracker.motion.duration + GRACE
 
@@ -150,7 +151,7 @@ def _run(session: Planner, plan: Plan, support: Feet, mu: float | None, start: n
         world.step_to(SETTLE + u, pusher)
         pose, height, rate, contact = tracker.pusher_at(u)
         rows.append([u, *pose, *rate[:3], height, contact, len(tracker.replans), *world.pose()])
-        collisions += world.colliding()
+        collisions += bool(world.faults(scene.names))  # the pusher may touch the one part at any time
         if k % every == 0:
             seen = world.pose() + rng.normal(0.0, [noise[0], noise[0], noise[1]])
             if tracker.observe(u, seen).kind.ended or u > limit:
@@ -184,9 +185,9 @@ def closed_loop(session: Planner, plan: Plan, n: int = 3, seed: int = 1, mu: flo
     needs_mujoco()
     scene = session.scene
     supports = feet(scene, n, seed, cf_offset)
-    start, knocks, _, _ = perturbations(scene, plan, session.model, start_error, bumps, noise)
+    setup = perturbations(scene, plan, session.model, start_error, bumps, noise)
     lead = lead_in_pose(scene, session.model, plan)
     rng = np.random.default_rng(seed)
     sigma = np.asarray(noise, dtype=float)
-    runs = tuple(_run(session, plan, s, mu, start, knocks, sigma, rng, lead, seed) for s in supports)
-    return ClosedLoop(runs, scene.pusher.mu if mu is None else mu, start)
+    runs = tuple(_run(session, plan, s, mu, setup.starts, setup.bumps, sigma, rng, lead, seed) for s in supports)
+    return ClosedLoop(runs, scene.pusher.mu if mu is None else mu, setup.starts[scene.part().name])

@@ -1,14 +1,17 @@
 """Whole plans run open-loop in MuJoCo: the pusher follows the plan's trajectory blindly.
 
 :mod:`.verify` re-simulates each push with the quasi-static mechanics the planner assumes. Here
-the plan meets a physics engine that assumes none of it: the part is a rigid body with mass on
+the plan meets a physics engine that assumes none of it: every part is a rigid body with mass on
 the table, the pusher a kinematic body driven along :func:`.trajectory.trajectory` (lifted to
-``z`` in a lift's flight), and every segment runs after the last with no correction.
+``z`` in a lift's flight), and every segment runs after the last with no correction. A plan of
+one part and a plan of several (moves joined by transfers) take the same path: one model with
+every part of the scene in it, one run loop, one report; a scene of one part is the case without
+part-part contacts.
 
 **The model** (:func:`mjcf`). A table (plane), the workspace walls and the obstacles as prisms
-(non-convex ones as their :func:`~planner.model.bodies.convex_pieces`), the part as one body made
+(non-convex ones as their :func:`~planner.model.bodies.convex_pieces`), each part as one body made
 of the convex pieces of its polygon (thin prisms), and the pusher as a prism of the pusher body's
-outline. The part does not lie on its face: it stands on a few small spherical *feet*, each a
+outline. A part does not lie on its face: it stands on a few small spherical *feet*, each a
 body of its own that slides vertically in the part and weighs its share ``w_i`` of the support
 (``w_i`` the foot's weight in the distribution, :class:`Feet`), so its normal force on the table,
 hence its friction, is exactly that share; the part's centre of mass is the support's centre (the
@@ -18,8 +21,10 @@ weights of three feet round the centre, or a grid's weights moved to put the cen
 heading): a free part rocked on its feet under the pusher's moment about the table, and the
 pusher's friction, which with a vertical face also acts vertically, carried some of its weight,
 so the feet's loads, hence the distribution, were not the ones meant. Only the listed contact
-pairs exist: feet-table (friction :data:`TABLE_MU`), pusher-part (the planned
-``scene.pusher.mu``, or ``mu=``) and part-obstacle (to detect collisions).
+pairs exist: feet-table (friction :data:`TABLE_MU`), pusher-part for every part (the planned
+``scene.pusher.mu``, or ``mu=``), part-obstacle (to detect collisions) and part-part (with the
+table's friction: a part shoved by another moves as it would, and the shove is seen). Each part has
+a foot set of its own: run ``k`` gives every part the ``k``-th foot set :func:`feet` draws for it.
 
 The pusher is not a mocap body: contact friction sees a mocap body's velocity as zero, so the
 part's friction against a moving pusher would be computed as if it were still (the part slid
@@ -40,20 +45,27 @@ millimetres. What remains is the soft contact's penetration of the pusher into t
 0.2 mm, which shows as the runs' deviation and "slip"; the slip threshold :data:`SLIP` is five
 times that.
 
-**What is measured** (:class:`Run`), at every trajectory sample: the part's simulated pose against
-its planned one (during a push, the pusher frame's pose times the inverse of the contact pose; in
-a transit, where the part was left), the pusher face's midpoint in the simulated part frame while
-``contact`` is 1 (it should stay where it was when the push began: moving along the edge is
-slip, away from it separation; measured per push, so that an error the part carries from earlier
-pushes is deviation, not slip), and contacts of the part with walls or obstacles.
+**What is measured** (:class:`Run`), at every trajectory sample: each part's simulated pose
+against its planned one (:func:`.trajectory.planned_part`: during a push of it, the pusher frame's
+pose times the inverse of the contact pose; otherwise where it was left), the pusher face's
+midpoint in the frame of the part it pushes while ``contact`` is 1 (it should stay where it was
+when the push began: moving along the edge is slip, away from it separation; measured per push, so
+that an error the part carries from earlier pushes is deviation, not slip), and the contacts that
+must not happen: a part against another part, a wall or an obstacle, or the pusher against a part
+other than the one it moves (or, on a transfer, leaves), so a push that shoves a second part is
+caught. A run fails if any part ends outside its goal tolerance, the pusher slips or any such
+contact happens. Every run begins with the pusher behind the first move's first contact, moving
+in (:func:`.approach.lead_in_pose`), and may be perturbed (:func:`perturbations`).
 """
 
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple, TypeVar
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -75,8 +87,8 @@ from ..world.validity import CollisionModel
 from .approach import first_edge, lead_in_pose
 from .trajectory import Trajectory, planned_part, trajectory
 
-__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Run", "Runs", "Simulation", "document", "feet", "mjcf",
-           "needs_mujoco", "part_body", "part_pairs", "table", "World", "perturbations", "simulate", "support_centre", "write_mjcf"]
+__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Perturbed", "Run", "Runs", "Simulation", "World", "feet",
+           "mjcf", "needs_mujoco", "perturbations", "simulate", "support_centre", "write_mjcf"]
 
 #: The one line ``plan --simulate`` prints (after ``plan: error: --simulate: ``) without MuJoCo.
 MISSING = "needs MuJoCo: pip install 'stablepush[mujoco]'"
@@ -90,12 +102,14 @@ SLIP = 0.001
 THICKNESS, FOOT, MASS, WALL_HEIGHT = 0.004, 0.001, 0.1, 0.03
 #: Mass of the pusher, kg: far heavier than the part, so a step's contact forces barely move it.
 PUSHER_MASS = 1000.0
-#: Time the part is left to settle on its feet before the pusher moves, s.
+#: Time the parts are left to settle on their feet before the pusher moves, s.
 SETTLE = 0.1
 #: Feet of a grid distribution (about).
 GRID_FEET = 9
 #: Step by which a knocked part is moved off the pusher, m.
 BUMP_STEP = 0.0002
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -174,7 +188,7 @@ def _second_moment(pieces: list[np.ndarray], centre: np.ndarray) -> float:
     return total / area
 
 
-def table(scene: Scene) -> tuple[list[str], list[str], list[str]]:
+def _table(scene: Scene) -> tuple[list[str], list[str], list[str]]:
     """The MJCF of what stands on the table: mesh assets, world geoms (the workspace walls and the
     obstacles as prisms, non-convex ones as their convex pieces) and the names of those geoms."""
     assets, world = [], []
@@ -197,9 +211,9 @@ def table(scene: Scene) -> tuple[list[str], list[str], list[str]]:
     return assets, world, blocks
 
 
-def document(scene: Scene, assets: list[str], world: list[str], bodies: list[str], pairs: list[str],
+def _document(scene: Scene, assets: list[str], world: list[str], bodies: list[str], pairs: list[str],
              keys: list[str]) -> str:
-    """The MJCF document of ``scene``: the options, the table plane, ``world``'s geoms, the part
+    """The MJCF document of ``scene``: the options, the table plane, ``world``'s geoms, the parts'
     ``bodies``, the pusher (a prism of its outline on x, y, z and heading joints, last in the
     joints' order), the contact ``pairs`` and the ``keys``."""
     xmin, ymin, xmax, ymax = scene.workspace
@@ -237,7 +251,7 @@ def document(scene: Scene, assets: list[str], world: list[str], bodies: list[str
 """
 
 
-def part_body(name: str, prefix: str, slider: Slider, support: Feet) -> tuple[list[str], str, list[str], list[str]]:
+def _part_body(name: str, prefix: str, slider: Slider, support: Feet) -> tuple[list[str], str, list[str], list[str]]:
     """The MJCF of a part on ``support``'s feet, its body called ``name`` and its joints, geoms and
     feet ``<prefix>_x``..., ``<prefix><j>``, ``foot<prefix-less k>``: its mesh assets, the body, its
     geoms' names and its feet's table contacts. The part's frame is the slider frame; gravity
@@ -268,7 +282,7 @@ def part_body(name: str, prefix: str, slider: Slider, support: Feet) -> tuple[li
     return assets, body, geoms, pairs
 
 
-def part_pairs(geoms: list[str], blocks: list[str], mu: float) -> list[str]:
+def _part_pairs(geoms: list[str], blocks: list[str], mu: float) -> list[str]:
     """The contacts of a part's ``geoms``: with the pusher (friction ``mu``), and with the walls
     and obstacles (``blocks``; frictionless, there only to be detected)."""
     pairs = []
@@ -278,36 +292,62 @@ def part_pairs(geoms: list[str], blocks: list[str], mu: float) -> list[str]:
     return pairs
 
 
-def mjcf(scene: Scene, support: Feet, mu: float | None = None, start: ArrayLike | None = None,
-         keys: ArrayLike | None = None) -> str:
-    """The MuJoCo model (MJCF XML) of ``scene`` with the part on ``support``'s feet, starting at
-    ``start`` (default: the scene's start), and pusher-part friction ``mu`` (default: the planned
-    ``scene.pusher.mu``); module docstring, "The model".
+def _names(scene: Scene) -> list[tuple[str, str]]:
+    """Each part's body name and the prefix of its geoms' names in the model, scene order: ``part``
+    and ``part`` for the one part of a scene (geoms ``part0``..., feet ``foot0``...: the one-part
+    model's names, which viewers and scripts know), ``part<k>`` and ``part<k>_`` for part ``k``
+    of several (geoms ``part<k>_0``..., feet ``foot<k>_0``...); the names are the model's own, as
+    the parts' may be any text."""
+    if len(scene.parts) == 1:
+        return [("part", "part")]
+    return [(f"part{k}", f"part{k}_") for k in range(len(scene.parts))]
 
-    ``keys``, rows ``(t, part x, y, theta, pusher x, y, z, theta)``, become keyframes ``t=<t>``
-    (the first named ``start``) so that a viewer can step along a run; without them the one
-    keyframe ``start`` has the part at ``start`` and the pusher at the world origin."""
+
+def mjcf(scene: Scene, supports: Mapping[str, Feet], mu: float | None = None,
+         starts: Mapping[str, ArrayLike] | None = None, keys: ArrayLike | None = None) -> str:
+    """The MuJoCo model (MJCF XML) of ``scene`` with each part on its ``supports`` feet (by part
+    name), starting at ``starts`` (default: the scene's starts), and pusher-part friction ``mu``
+    (default: the planned ``scene.pusher.mu``); module docstring, "The model". The bodies are
+    named by :func:`_names`.
+
+    ``keys``, rows ``(t, each part's x, y, theta in scene order, pusher x, y, z, theta)``, become
+    keyframes ``t=<t>`` (the first named ``start``) so that a viewer can step along a run; without
+    them the one keyframe ``start`` has the parts at ``starts`` and the pusher at the world origin."""
     mu = scene.pusher.mu if mu is None else mu
-    assets, world, blocks = table(scene)
-    part_assets, body, geoms, pairs = part_body("part", "part", scene.slider, support)
-    pairs += part_pairs(geoms, blocks, mu)
-    pose = scene.start if start is None else np.asarray(start, dtype=float)
-    return document(scene, assets + part_assets, world, [body], pairs, _keyframes(pose, len(support.points), keys))
-
-
-def _keyframes(start: np.ndarray, feet: int, keys: ArrayLike | None) -> list[str]:
-    """``<key>`` elements: the joints in model order are the part's three, one per foot (at rest:
-    0), then the pusher's four."""
+    starts = scene.starts if starts is None else starts
+    assets, world, blocks = _table(scene)
+    bodies, pairs, geoms = [], [], []
+    for (name, prefix), part in zip(_names(scene), scene.parts):
+        more, body, own, feet_pairs = _part_body(name, prefix, part.slider, supports[part.name])
+        assets += more
+        bodies.append(body)
+        geoms.append(own)
+        pairs += feet_pairs
+    for k, own in enumerate(geoms):
+        pairs += _part_pairs(own, blocks, mu)
+        # Parts against parts, with the table's friction: a part shoved by another moves as it would.
+        pairs += [f'<pair geom1="{g}" geom2="{h}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>'
+                  for g in own for other in geoms[k + 1:] for h in other]
+    feet_counts = [len(supports[name].points) for name in scene.names]
     if keys is None:
-        return [f'<key name="start" qpos="{_numbers([*start, *np.zeros(feet + 4)])}"/>']
-    return [f'<key name="{"start" if k == 0 else f"t={row[0]:.2f}"}" time="{row[0]:.17g}" '
-            f'qpos="{_numbers([*row[1:4], *np.zeros(feet), *row[4:8]])}"/>' for k, row in enumerate(np.asarray(keys))]
+        frames = [f'<key name="start" qpos="{_qpos([starts[n] for n in scene.names], feet_counts, np.zeros(4))}"/>']
+    else:
+        frames = [f'<key name="{"start" if k == 0 else f"t={row[0]:.2f}"}" time="{row[0]:.17g}" '
+                  f'qpos="{_qpos(np.reshape(row[1:-4], (-1, 3)), feet_counts, row[-4:])}"/>'
+                  for k, row in enumerate(np.asarray(keys))]
+    return _document(scene, assets, world, bodies, pairs, frames)
 
 
-def write_mjcf(path: str | Path, scene: Scene, support: Feet, mu: float | None = None,
-               start: ArrayLike | None = None, keys: ArrayLike | None = None) -> None:
+def _qpos(poses: list[ArrayLike], feet_counts: list[int], pusher: ArrayLike) -> str:
+    """A keyframe's ``qpos``: the joints in model order are each part's three and one per foot (at
+    rest: 0), in scene order, then the pusher's four."""
+    return _numbers([*(v for pose, k in zip(poses, feet_counts) for v in (*pose, *np.zeros(k))), *pusher])
+
+
+def write_mjcf(path: str | Path, scene: Scene, supports: Mapping[str, Feet], mu: float | None = None,
+               starts: Mapping[str, ArrayLike] | None = None, keys: ArrayLike | None = None) -> None:
     """Write :func:`mjcf` to ``path`` atomically (:func:`planner.model.files.write_atomic`)."""
-    write_atomic(path, mjcf(scene, support, mu, start, keys))
+    write_atomic(path, mjcf(scene, supports, mu, starts, keys))
 
 
 def needs_mujoco() -> None:
@@ -318,59 +358,113 @@ def needs_mujoco() -> None:
         raise SceneError("simulate", MISSING) from None
 
 
+def _one(by_part: Mapping[str, T]) -> T:
+    """The value of a run's one part; a run of several parts is asked by part name."""
+    if len(by_part) != 1:
+        raise SceneError("part", f"the run has {len(by_part)} parts ({', '.join(by_part)}): name one")
+    return next(iter(by_part.values()))
+
+
+def _worst(errors: Mapping[str, tuple[float, float]]) -> str:
+    """The part whose error (distance, angle) is the largest in distance (the first of equals)."""
+    return max(errors, key=lambda name: errors[name][0])
+
+
 @dataclass(frozen=True)
 class Run:
-    """One open-loop run of a whole plan on one foot set.
+    """One open-loop run of a whole plan, each part on one foot set of its own.
 
     Attributes
     ----------
-    feet : Feet
-    goal_error, final_error : (float, float)
-        Final pose against the scene's goal and against the plan's final pose: distance of the
-        slider frame's origin (m) and wrapped angle (rad).
+    supports : dict of str to Feet
+        Each part's feet, by part name.
+    goal_errors, final_errors : dict of str to (float, float)
+        Each part's final pose against its goal and against where the plan leaves it: distance of
+        the slider frame's origin (m) and wrapped angle (rad).
+    delivered : dict of str to bool
+        Whether each part's final pose is within the scene's tolerance of its goal.
     deviation : float
-        Largest distance (m) of the part's CF from its planned position over the samples.
+        Largest distance (m) of a part's CF from its planned position over the samples.
     slip : float
-        Largest distance (m) the pusher's face midpoint moved in the part frame during a push,
-        from where it was when the push began (slip along the edge, or separation).
+        Largest distance (m) the pusher's face midpoint moved in the pushed part's frame during a
+        push, from where it was when the push began (slip along the edge, or separation).
     collisions : int
-        Samples at which the part touched a wall or an obstacle.
-    in_goal : bool
-        The final pose is within the scene's tolerance.
+        Samples at which a contact that must not happen was on (module docstring).
+    faults : tuple of (float, str)
+        Those contacts in words (``'a touches b'``, ``'a touches a wall or obstacle'``, ``'the
+        pusher touches b'``), each once, with the trajectory time (s) it was first seen.
     seconds, simulated : float
         Wall time of the run and simulated time, s.
-    poses : (n, 3) ndarray
-        The part's simulated pose at each trajectory sample.
+    tracks : dict of str to (n, 3) ndarray
+        Each part's simulated pose at each trajectory sample.
     segment_deviation, segment_slip : tuple of float
-        ``deviation`` and ``slip`` of each plan segment alone (slip 0 on a transit), so that a
-        failure can be traced to the push or transit where it began.
+        ``deviation`` and ``slip`` of each plan segment alone (:attr:`Plan.segments`, transfers
+        included; slip 0 off a push), so that a failure can be traced to where it began.
+
+    ``feet`` and ``poses`` are the one part's, for a run of one part; ``goal_error`` and
+    ``final_error`` the part's farthest off, for any run.
     """
 
-    feet: Feet
-    goal_error: tuple[float, float]
-    final_error: tuple[float, float]
+    supports: dict[str, Feet]
+    goal_errors: dict[str, tuple[float, float]]
+    final_errors: dict[str, tuple[float, float]]
+    delivered: dict[str, bool]
     deviation: float
     slip: float
     collisions: int
-    in_goal: bool
+    faults: tuple[tuple[float, str], ...]
     seconds: float
     simulated: float
-    poses: np.ndarray
+    tracks: dict[str, np.ndarray]
     segment_deviation: tuple[float, ...]
     segment_slip: tuple[float, ...]
+
+    @property
+    def feet(self) -> Feet:
+        return _one(self.supports)
+
+    @property
+    def poses(self) -> np.ndarray:
+        return _one(self.tracks)
+
+    @property
+    def goal_error(self) -> tuple[float, float]:
+        return self.goal_errors[_worst(self.goal_errors)]
+
+    @property
+    def final_error(self) -> tuple[float, float]:
+        return self.final_errors[_worst(self.final_errors)]
+
+    @property
+    def in_goal(self) -> bool:
+        """Every part ends within tolerance of its goal."""
+        return all(self.delivered.values())
 
     @property
     def passed(self) -> bool:
         return self.in_goal and self.slip <= SLIP and not self.collisions
 
     def line(self, k: int, n: int) -> str:
-        faults = ([] if self.in_goal else ["misses the goal"]) + (["SLIPS"] if self.slip > SLIP else []) + (
-            [f"collides ({self.collisions} samples)"] if self.collisions else [])
-        return (f"simulate {k}/{n} ({self.feet.kind}, {len(self.feet.points)} feet): goal error "
-                f"{self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad; from the plan's end "
-                f"{self.final_error[0]:.2e} m, {self.final_error[1]:.2e} rad; path deviation {self.deviation:.2e} m"
-                f"{_where(self.segment_deviation)}; slip {self.slip:.2e} m{_where(self.segment_slip)}; "
-                f"{self.seconds:.1f} s for {self.simulated:.1f} s: "
+        """The run's line, numbered ``k`` of ``n``; with several parts it names the parts its
+        errors are of, the parts that miss their goals and the first few contacts that must not happen."""
+        several = len(self.supports) > 1
+
+        def of(name: str) -> str:
+            return f" ({name})" if several else ""
+
+        missed = ", ".join(name for name, ok in self.delivered.items() if not ok)
+        touches = "; ".join(f"{what} at {t:.1f} s" for t, what in self.faults[:3]) + (
+            f"; {len(self.faults) - 3} more" if len(self.faults) > 3 else "")
+        faults = ([] if self.in_goal else [f"misses the goal{': ' + missed if several else ''}"]) + (
+            ["SLIPS"] if self.slip > SLIP else []) + (
+            [f"collides ({self.collisions} samples{': ' + touches if several else ''})"] if self.collisions else [])
+        kinds = ", ".join(sorted({f.kind for f in self.supports.values()}))
+        goal, final = _worst(self.goal_errors), _worst(self.final_errors)
+        return (f"simulate {k}/{n} ({kinds}, {'+'.join(str(len(f.points)) for f in self.supports.values())} feet): "
+                f"goal error {self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad{of(goal)}; from the plan's end "
+                f"{self.final_error[0]:.2e} m, {self.final_error[1]:.2e} rad{of(final)}; path deviation "
+                f"{self.deviation:.2e} m{_where(self.segment_deviation)}; slip {self.slip:.2e} m"
+                f"{_where(self.segment_slip)}; {self.seconds:.1f} s for {self.simulated:.1f} s: "
                 f"{', '.join(faults) if faults else 'ok'}")
 
 
@@ -400,8 +494,8 @@ class Simulation(Runs):
     runs: tuple[Run, ...]
     mu: float
     motion: Trajectory
-    start: np.ndarray  # where the part is placed: the plan's start, moved by any start error
-    planned: np.ndarray  # the planned part pose at each of motion's samples
+    starts: dict[str, np.ndarray]  # where the parts are placed: the plan's starts, the first moved by any start error
+    planned: dict[str, np.ndarray]  # each part's planned pose at each of motion's samples
 
     #: Seconds between the keyframes :meth:`write_mjcf` writes along the run.
     KEY_EVERY = 1.0
@@ -413,45 +507,58 @@ class Simulation(Runs):
 
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:
         """Write the first run's model (:func:`mjcf`) to ``path`` atomically, with keyframes of the
-        planned part and the pusher every :attr:`KEY_EVERY` s of the trajectory and at its end
+        planned parts and the pusher every :attr:`KEY_EVERY` s of the trajectory and at its end
         (MuJoCo's viewer steps through them)."""
         m = self.motion
         rows = np.unique(np.append(np.searchsorted(m.t, np.arange(0.0, m.duration, self.KEY_EVERY)), len(m.t) - 1))
-        keys = np.column_stack([m.t, self.planned, m.x, m.y, m.z, np.unwrap(m.theta)])[rows]
-        write_mjcf(path, scene, self.runs[0].feet, self.mu, self.start, keys)
+        keys = np.column_stack([m.t, *(self.planned[n] for n in scene.names), m.x, m.y, m.z, np.unwrap(m.theta)])[rows]
+        write_mjcf(path, scene, self.runs[0].supports, self.mu, self.starts, keys)
 
     def summary(self) -> str:
-        worst = max(r.goal_error[0] for r in self.runs)
+        parts = len(self.starts)
+        delivered = min(sum(r.delivered.values()) for r in self.runs)
         return (f"simulate: {'passed' if self.passed else 'FAILED'}: {sum(r.passed for r in self.runs)}/{len(self.runs)} "
-                f"runs in the goal without slip or collision (MuJoCo, pusher mu {self.mu:g}, table mu {TABLE_MU:g}); "
-                f"worst goal error {worst:.2e} m, worst slip {max(r.slip for r in self.runs):.2e} m, "
-                f"{sum(r.seconds for r in self.runs):.1f} s")
+                f"runs {'with every part in its goal,' if parts > 1 else 'in the goal'} without slip or collision "
+                f"(MuJoCo, pusher mu {self.mu:g}, table mu {TABLE_MU:g}); "
+                f"{f'at least {delivered}/{parts} parts delivered in every run; ' if parts > 1 else ''}"
+                f"worst goal error {max(r.goal_error[0] for r in self.runs):.2e} m, "
+                f"worst slip {max(r.slip for r in self.runs):.2e} m, {sum(r.seconds for r in self.runs):.1f} s")
+
+
+#: The pusher as a function of a run's clock: ``u -> ((x, y, z, theta), their rates)``.
+Driver = Callable[[float], tuple[ArrayLike, ArrayLike]]
 
 
 class World:
-    """One run's MuJoCo model and data: the part placed at ``start``, the pusher driven by a
-    function of the run's clock ``u`` (seconds since the pusher began to move, after
-    :data:`SETTLE`), and the bumps ``(T, dx, dy, dtheta)`` applied when ``u`` passes ``T``."""
+    """One run's MuJoCo model and data: the parts placed at ``starts`` (by name) on their
+    ``supports``, the pusher driven by a function of the run's clock ``u`` (seconds since the
+    pusher began to move, after :data:`SETTLE`), and the bumps ``(T, part, dx, dy, dtheta)``
+    applied to that part when ``u`` passes ``T``."""
 
-    def __init__(self, scene: Scene, support: Feet, mu: float | None, start: np.ndarray, bumps: tuple = ()):
+    def __init__(self, scene: Scene, supports: Mapping[str, Feet], mu: float | None,
+                 starts: Mapping[str, ArrayLike], bumps: tuple = ()):
         import mujoco  # only when simulating: a plan run without --simulate never loads it
 
         self.mujoco = mujoco
-        self.model = mujoco.MjModel.from_xml_string(mjcf(scene, support, mu, start))
+        self.scene = scene
+        self.model = mujoco.MjModel.from_xml_string(mjcf(scene, supports, mu, starts))
         self.data = mujoco.MjData(self.model)
         mujoco.mj_resetDataKeyframe(self.model, self.data, self.model.key("start").id)
-        self.own = {self.model.geom(f"part{j}").id for j in range(len(convex_pieces(scene.slider.polygon)))}
-        self.part = self.model.joint("part_x").qposadr[0] + np.arange(3)
-        self.part_speed = self.model.joint("part_x").dofadr[0] + np.arange(3)
+        names = list(zip(_names(scene), scene.parts))
+        self.slots = {part.name: self.model.joint(f"{body}_x").qposadr[0] + np.arange(3) for (body, _), part in names}
+        self.speeds = {part.name: self.model.joint(f"{body}_x").dofadr[0] + np.arange(3) for (body, _), part in names}
+        self.owner = {self.model.geom(f"{prefix}{j}").id: part.name for (_, prefix), part in names
+                      for j in range(len(convex_pieces(part.slider.polygon)))}
+        self.owned = np.isin(np.arange(self.model.ngeom), list(self.owner))  # by geom id: a part's geom
         self.blocks = {self.model.geom(i).id for i in range(self.model.ngeom)
                        if self.model.geom(i).name.startswith(("wall", "obstacle"))}
+        self.pusher_geom = self.model.geom("pusher").id
         self.qpos = self.model.joint("pusher_x").qposadr[0] + np.arange(4)
         self.qvel = self.model.joint("pusher_x").dofadr[0] + np.arange(4)
         self.bumps = sorted(bumps)
-        self.outline = scene.slider.polygon
         self.pusher = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
 
-    def step_to(self, t: float, pusher) -> None:
+    def step_to(self, t: float, pusher: Driver) -> None:
         """Step to ``t`` (MuJoCo's clock), the pusher set before every step to ``pusher(u)``:
         ``(x, y, z, theta)`` and their rates; at rest before ``u = 0``."""
         data = self.data
@@ -463,31 +570,46 @@ class World:
             while self.bumps and self.bumps[0][0] <= u:
                 # A knock: the part is where it was moved to, at rest, and not into the pusher,
                 # which is rigid: a knock towards it leaves the part against its face.
-                data.qpos[self.part] = self._off_pusher(data.qpos[self.part] + self.bumps.pop(0)[1:], pose)
-                data.qvel[self.part_speed] = 0.0
+                _, name, *shift = self.bumps.pop(0)
+                data.qpos[self.slots[name]] = self._off_pusher(name, data.qpos[self.slots[name]] + shift, pose)
+                data.qvel[self.speeds[name]] = 0.0
             self.mujoco.mj_step(self.model, data)
 
-    def _off_pusher(self, part: np.ndarray, pusher: ArrayLike) -> np.ndarray:
-        """``part`` moved along the pusher's +x, by :data:`BUMP_STEP` steps, until it is off the
-        pusher's body at ``pusher`` (``x, y, z, theta``); as it is if the pusher is lifted."""
+    def _off_pusher(self, name: str, part: np.ndarray, pusher: ArrayLike) -> np.ndarray:
+        """Part ``name`` at ``part`` moved along the pusher's +x, by :data:`BUMP_STEP` steps, until
+        it is off the pusher's body at ``pusher`` (``x, y, z, theta``); as it is if the pusher is lifted."""
         x, y, z, theta = pusher
         body = slider_at(self.pusher, [x, y, theta])
+        outline = self.scene.part(name).slider.polygon
         along = np.array([math.cos(theta), math.sin(theta), 0.0])
         moved = part.copy()
-        while z < THICKNESS and slider_at(self.outline, moved).intersects(body) and np.linalg.norm(moved - part) < 0.1:
+        while z < THICKNESS and slider_at(outline, moved).intersects(body) and np.linalg.norm(moved - part) < 0.1:
             moved = moved + BUMP_STEP * along
         return moved
 
-    def pose(self) -> np.ndarray:
-        return self.data.qpos[self.part].copy()
+    def pose(self, name: str | None = None) -> np.ndarray:
+        """Part ``name``'s pose (default: the scene's one part's)."""
+        return self.data.qpos[self.slots[self.scene.part(name).name]].copy()
 
-    def colliding(self) -> bool:
-        """The part touches a wall or an obstacle."""
-        return any(c.dist < 0 and ({c.geom1, c.geom2} & self.blocks) and ({c.geom1, c.geom2} & self.own)
-                   for c in self.data.contact[:self.data.ncon])
+    def faults(self, allowed: Collection[str]) -> list[str]:
+        """The contacts on now that must not happen, in words: a part against another part, a wall
+        or an obstacle, or the pusher against a part not named in ``allowed``."""
+        out = []
+        contacts = self.data.contact
+        # The feet always press into the table: only a touching pair with a part's geom is looked at.
+        pairs = contacts.geom[contacts.dist < 0]
+        for pair in map(set, pairs[self.owned[pairs].any(axis=1)].tolist()):
+            touched = sorted({self.owner[g] for g in pair if g in self.owner})
+            if len(touched) == 2:
+                out.append(f"{touched[0]} touches {touched[1]}")
+            elif touched and pair & self.blocks:
+                out.append(f"{touched[0]} touches a wall or obstacle")
+            elif touched and self.pusher_geom in pair and touched[0] not in allowed:
+                out.append(f"the pusher touches {touched[0]}")
+        return out
 
 
-def _follower(motion: Trajectory):
+def _follower(motion: Trajectory) -> Driver:
     """``u -> (pusher qpos, qvel)`` along ``motion`` (linear interpolation between its samples)."""
     path = np.column_stack([motion.x, motion.y, motion.z, np.unwrap(motion.theta)])
     speed = np.column_stack([motion.vx, motion.vy, np.gradient(motion.z, motion.t) if len(motion.t) > 1
@@ -500,72 +622,110 @@ def _follower(motion: Trajectory):
     return at
 
 
-def _run(scene: Scene, plan: Plan, motion: Trajectory, planned: np.ndarray, support: Feet, mu: float | None,
-         start: np.ndarray, lead: Trajectory, bumps: tuple) -> Run:
+class Perturbed(NamedTuple):
+    """A run's set-up (:func:`perturbations`): where the parts start, the bumps ``(T, part, dx, dy,
+    dtheta)`` in time order, the pusher's lead-in, the plan's trajectory and each part's planned
+    pose at its samples."""
+
+    starts: dict[str, np.ndarray]
+    bumps: tuple[tuple[float, str, float, float, float], ...]
+    lead: Trajectory
+    motion: Trajectory
+    planned: dict[str, np.ndarray]
+
+
+def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], mu: float | None) -> Run:
     clock = time.perf_counter()
-    world = World(scene, support, mu, start, bumps)
+    world = World(scene, supports, mu, setup.starts, setup.bumps)
+    lead, motion = setup.lead, setup.motion
     led, follow = _follower(lead), _follower(motion)
 
-    def pusher(u: float):
+    def pusher(u: float) -> tuple[list[float], list[float]]:
         return led(u) if u < lead.duration else follow(u - lead.duration)
 
+    steps = plan.steps
+    # The pusher may touch the part of its segment, and on a transfer the part it leaves: a transit
+    # or a transfer begins (and ends) in contact.
+    allowed = [{name, s.from_part} if s.kind == "transfer" else {name} for name, s in steps]
     times = motion.t + SETTLE + lead.duration
-    poses = np.empty((len(times), 3))
-    collisions = 0
-    slips, starts = np.zeros(len(plan.segments)), {}
+    tracks = {name: np.empty((len(times), 3)) for name in scene.names}
+    collisions, faults, seen = 0, [], set()
+    slips, firsts = np.zeros(len(steps)), {}
     world.step_to(SETTLE + lead.duration, pusher)
     for row, t in enumerate(times):
         world.step_to(t, pusher)
-        poses[row] = world.pose()
-        collisions += world.colliding()
+        for name, track in tracks.items():
+            track[row] = world.pose(name)
+        k = int(motion.segment[row])
+        now = world.faults(allowed[k])
+        collisions += bool(now)
+        for fault in now:
+            if fault not in seen:
+                seen.add(fault)
+                faults.append((float(motion.t[row]), fault))
         if motion.contact[row]:
-            # The face midpoint in the part frame, against where it was when this push began.
-            face = relative_pose(poses[row], [motion.x[row], motion.y[row], motion.theta[row]])[:2]
-            k = int(motion.segment[row])
-            first = starts.setdefault(k, face)
+            # The face midpoint in the pushed part's frame, against where it was when this push began.
+            face = relative_pose(tracks[steps[k][0]][row], [motion.x[row], motion.y[row], motion.theta[row]])[:2]
+            first = firsts.setdefault(k, face)
             slips[k] = max(slips[k], float(np.linalg.norm(face - first)))
-    cf = scene.slider.cf[None]
-    gap = np.linalg.norm(np.array([transform_points(cf, p)[0] for p in poses])
-                         - np.array([transform_points(cf, p)[0] for p in planned]), axis=1)
-    by_segment = [motion.segment == k for k in range(len(plan.segments))]
-    end = poses[-1]
-    deviations = tuple(float(gap[rows].max(initial=0.0)) for rows in by_segment)
-    return Run(support, _error(end, scene.goal), _error(end, plan.final), float(gap.max()),
-               float(slips.max(initial=0.0)), collisions, scene.within_tolerance(end), time.perf_counter() - clock,
-               float(motion.duration + lead.duration), poses, deviations, tuple(float(v) for v in slips))
+    gap = np.max([_cf_gap(scene.part(name).slider.cf, track, setup.planned[name]) for name, track in tracks.items()],
+                 axis=0)
+    deviations = tuple(float(gap[motion.segment == k].max(initial=0.0)) for k in range(len(steps)))
+    ends = {name: track[-1] for name, track in tracks.items()}
+    return Run(dict(supports), {name: _error(end, scene.part(name).goal) for name, end in ends.items()},
+               {name: _error(end, plan.finals[name]) for name, end in ends.items()},
+               {name: scene.delivered(name, end) for name, end in ends.items()}, float(gap.max()),
+               float(slips.max(initial=0.0)), collisions, tuple(faults), time.perf_counter() - clock,
+               float(motion.duration + lead.duration), tracks, deviations, tuple(float(v) for v in slips))
+
+
+def _cf_gap(cf: np.ndarray, poses: np.ndarray, planned: np.ndarray) -> np.ndarray:
+    """The distance of the CF (part frame) at each of ``poses`` from where it is at ``planned``'s."""
+    return np.linalg.norm(transform_points(cf, poses) - transform_points(cf, planned), axis=1)
 
 
 def _error(end: np.ndarray, target: np.ndarray) -> tuple[float, float]:
     return math.hypot(end[0] - target[0], end[1] - target[1]), abs(float(wrap_angle(end[2] - target[2])))
 
 
+def _first_move(scene: Scene, plan: Plan) -> tuple[Scene, Plan]:
+    """The plan's first move as the plan of its one part, in the scene of moving it (the other
+    parts obstacles where they start; the scene itself for a scene of one part)."""
+    first = plan.moves[0]
+    return (scene.move_scene(first.part, plan.starts),
+            Plan.of_part(first.part, plan.starts[first.part], first.end, first.segments, scene=None, solved=True,
+                         planner=plan.planner, seed=plan.seed, planning_time_s=0.0))
+
+
 def _lead_in(scene: Scene, plan: Plan, model: CollisionModel) -> Trajectory:
-    """The pusher's move from :func:`.approach.lead_in_pose` to the plan's first contact."""
+    """The pusher's move from :func:`.approach.lead_in_pose` to the first contact of ``plan``, a
+    plan of ``scene``'s one part."""
     edge = first_edge(plan)
     contact = edge_contact_pose(scene.slider, edge, plan.start)
     path = np.array([lead_in_pose(scene, model, plan), contact])
     step = float(np.linalg.norm(path[1, :2] - path[0, :2]))
-    return trajectory(scene, Plan.of_part(scene.part().name, plan.start, plan.start, [Transit(edge, edge, "plane", path, step, np.asarray(plan.start, dtype=float))],
+    return trajectory(scene, Plan.of_part(plan.part, plan.start, plan.start, [Transit(edge, edge, "plane", path, step, np.asarray(plan.start, dtype=float))],
                                           scene=None, solved=True, planner=plan.planner, seed=plan.seed, planning_time_s=0.0))
 
 
-def perturbations(scene: Scene, plan: Plan, model: CollisionModel, start_error: ArrayLike = (0.0, 0.0, 0.0),
-                  bumps: ArrayLike = (), noise: ArrayLike = (0.0, 0.0)) -> tuple[np.ndarray, tuple, Trajectory,
-                                                                                 Trajectory]:
-    """Check a run's perturbations against ``plan`` and return the part's actual start, the bumps
-    as ``(T, dx, dy, dtheta)`` tuples in time order, the lead-in and the plan's trajectory.
+def perturbations(scene: Scene, plan: Plan, model: CollisionModel | None = None,
+                  start_error: ArrayLike = (0.0, 0.0, 0.0), bumps: ArrayLike = (),
+                  noise: ArrayLike = (0.0, 0.0)) -> Perturbed:
+    """Check a run's perturbations against ``plan`` and set the run up (:class:`Perturbed`).
 
-    ``start_error`` ``(dx, dy, dtheta)`` (m, m, rad, world frame) moves the part off the plan's
-    start; each bump ``(T, dx, dy, dtheta)`` displaces it at ``T`` seconds after the pusher
-    begins to move (its lead-in included) by that much; ``noise`` ``(sigma_m, sigma_rad)`` is on
-    what a closed loop observes.
+    ``start_error`` ``(dx, dy, dtheta)`` (m, m, rad, world frame) moves the first part the plan
+    moves off its start; each bump ``(T, dx, dy, dtheta)`` displaces the part the pusher is on
+    ``T`` seconds after it begins to move (its lead-in included: the first moved part; on a
+    transfer, the part it goes to) by that much; ``noise`` ``(sigma_m, sigma_rad)`` is on what a
+    closed loop observes. ``model`` is the collision model of the first move's scene (the
+    scene's own for a scene of one part; default: built here), which the lead-in avoids.
 
     Raises
     ------
     SceneError
         Naming ``start_error``, ``bump`` (and which, if several) or ``pose_noise``: a value not finite, negative noise, a
-        bump time outside the run, a perturbed part outside the workspace, on an obstacle or (at
-        the start) on the pusher.
+        bump time outside the run, a perturbed part outside the workspace, on an obstacle or
+        another part, or (at the start) on the pusher.
     """
     error = np.asarray(start_error, dtype=float)
     if error.shape != (3,) or not np.isfinite(error).all():
@@ -573,18 +733,20 @@ def perturbations(scene: Scene, plan: Plan, model: CollisionModel, start_error: 
     sigma = np.asarray(noise, dtype=float)
     if sigma.shape != (2,) or not np.isfinite(sigma).all() or (sigma < 0).any():
         raise SceneError("pose_noise", f"must be two finite standard deviations >= 0, got {np.ravel(sigma).tolist()}")
-    start = np.asarray(plan.start, dtype=float) + error
+    moving, lone = _first_move(scene, plan)
+    start = np.asarray(lone.start, dtype=float) + error
     start[2] = wrap_angle(start[2])
-    fault = placement_fault(scene.slider, scene.obstacles, scene.workspace, start)
-    lead = _lead_in(scene, plan, model)
+    fault = placement_fault(moving.slider, moving.obstacles, moving.workspace, start)
+    lead = _lead_in(moving, lone, CollisionModel(moving, moving.edges) if model is None else model)
     pusher = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
     if fault is None and slider_at(pusher, [lead.x[0], lead.y[0], lead.theta[0]]).intersects(
-            slider_at(scene.slider.polygon, start)):
+            slider_at(moving.slider.polygon, start)):
         fault = "the part is on the pusher where it starts"
     if fault:
         raise SceneError("start_error", f"puts the part where it cannot be: {fault}")
+    starts = {**{name: np.asarray(pose, dtype=float) for name, pose in plan.starts.items()}, lone.part: start}
     motion = trajectory(scene, plan)
-    planned = planned_part(scene, plan, motion)
+    planned = {name: planned_part(scene, plan, motion, name) for name in scene.names}
     rows = np.asarray(bumps, dtype=float).reshape(-1, 4) if len(bumps) else np.zeros((0, 4))
     out = []
     for k, (t, dx, dy, dtheta) in enumerate(rows):
@@ -593,19 +755,24 @@ def perturbations(scene: Scene, plan: Plan, model: CollisionModel, start_error: 
             raise SceneError(name, f"{which}must be four finite numbers (T, dx, dy, dtheta), got {rows[k].tolist()}")
         if not 0 <= t <= lead.duration + motion.duration:
             raise SceneError(name, f"{which}time {t:g} s is outside the run (0 to {lead.duration + motion.duration:.2f} s)")
-        at = planned[min(int(np.searchsorted(motion.t, t - lead.duration)), len(planned) - 1)] if t > lead.duration \
-            else start
-        moved = at + [dx, dy, dtheta]
-        if (fault := placement_fault(scene.slider, scene.obstacles, scene.workspace, moved)) is not None:
+        if t > lead.duration:
+            row = min(int(np.searchsorted(motion.t, t - lead.duration)), len(motion.t) - 1)
+            part, poses = plan.steps[int(motion.segment[row])][0], {n: pose[row] for n, pose in planned.items()}
+        else:
+            part, poses = lone.part, starts
+        knocked = scene.move_scene(part, poses)
+        if (fault := placement_fault(knocked.slider, knocked.obstacles, knocked.workspace,
+                                     poses[part] + [dx, dy, dtheta])) is not None:
             raise SceneError(name, f"{which}puts the part where it cannot be (where the plan has it at {t:g} s): {fault}")
-        out.append((float(t), float(dx), float(dy), float(dtheta)))
-    return start, tuple(sorted(out)), lead, motion
+        out.append((float(t), part, float(dx), float(dy), float(dtheta)))
+    return Perturbed(starts, tuple(sorted(out)), lead, motion, planned)
 
 
 def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
              cf_offset: ArrayLike = (0.0, 0.0), start_error: ArrayLike = (0.0, 0.0, 0.0),
              bumps: ArrayLike = ()) -> Simulation:
-    """Run ``plan`` open-loop in MuJoCo once per foot set of :func:`feet` (module docstring).
+    """Run ``plan``, of one part or several, open-loop in MuJoCo once per foot set: run ``k`` puts
+    every part on the ``k``-th of its own :func:`feet` (module docstring).
 
     Parameters
     ----------
@@ -618,9 +785,9 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
     mu : float, optional
         Pusher-part friction to simulate with; default the planned ``scene.pusher.mu``.
     cf_offset : (2,) array_like
-        Moves the support's centre of pressure from the CF, slider frame (m).
+        Moves every support's centre of pressure from its part's CF, slider frame (m).
     start_error, bumps : array_like
-        The part's start off the plan's, and knocks during the run (:func:`perturbations`).
+        The first moved part's start off the plan's, and knocks during the run (:func:`perturbations`).
 
     Every run begins with the pusher behind the first contact, moving in (:func:`.approach.lead_in_pose`).
 
@@ -631,13 +798,11 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
     Raises
     ------
     SceneError
-        If MuJoCo is missing (:data:`MISSING`), the offset centre is off the part, or a
+        If MuJoCo is missing (:data:`MISSING`), an offset centre is off its part, or a
         perturbation is bad (:func:`perturbations`).
     """
     needs_mujoco()
-    supports = feet(scene, n, seed, cf_offset)
-    start, knocks, lead, motion = perturbations(scene, plan, CollisionModel(scene, scene.edges), start_error,
-                                                bumps)
-    planned = planned_part(scene, plan, motion)
-    return Simulation(tuple(_run(scene, plan, motion, planned, s, mu, start, lead, knocks) for s in supports),
-                      scene.pusher.mu if mu is None else mu, motion, start, planned)
+    sets = {name: feet(scene.move_scene(name, scene.starts), n, seed, cf_offset) for name in scene.names}
+    setup = perturbations(scene, plan, None, start_error, bumps)
+    runs = tuple(_run(scene, plan, setup, {name: s[k] for name, s in sets.items()}, mu) for k in range(n))
+    return Simulation(runs, scene.pusher.mu if mu is None else mu, setup.motion, setup.starts, setup.planned)

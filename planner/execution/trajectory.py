@@ -323,16 +323,25 @@ def _timed(pusher: Pusher, segments: list[tuple[Slider, Push | Transit | Transfe
     return Trajectory(*out[:, :8].T, out[:, 8].astype(int), out[:, 9].astype(int), progress)
 
 
-def planned_part(scene: Scene, plan: Plan, motion: Trajectory) -> np.ndarray:
-    """The part's planned pose at each sample of ``motion`` (``plan``'s trajectory): during a push,
-    the pusher frame's pose times the inverse of the contact pose; in a transit, where the part was left."""
+def planned_part(scene: Scene, plan: Plan, motion: Trajectory, name: str | None = None) -> np.ndarray:
+    """Part ``name``'s (default: the plan's one part's) planned pose at each sample of ``motion``
+    (``plan``'s trajectory): during a push of it, the pusher frame's pose times the inverse of the
+    contact pose; in a transit of it, where the part was left; while another part moves or the
+    pusher travels between parts, where its last segment left it (its start before its first)."""
+    name = plan.part if name is None else name
+    slider = scene.part(name).slider
     out = np.empty((len(motion.t), 3))
     pusher = np.column_stack([motion.x, motion.y, motion.theta])
-    for k, segment in enumerate(plan.segments):
+    left = plan.starts[name]
+    for k, (part, segment) in enumerate(plan.steps):
         rows = motion.segment == k
+        if part != name or isinstance(segment, Transfer):
+            out[rows] = left
+            continue
+        left = segment.end
         if isinstance(segment, Transit):
             out[rows] = segment.start
             continue
-        local = edge_contact_pose(scene.slider, segment.edge, np.zeros(3))  # pusher frame in the slider frame
+        local = edge_contact_pose(slider, segment.edge, np.zeros(3))  # pusher frame in the slider frame
         out[rows] = compose(pusher[rows], inverse(local))  # the slider frame in the world
     return out

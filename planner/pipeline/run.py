@@ -109,10 +109,6 @@ def _simulated(scene: Scene, options: RunOptions, result: Plan, session: Planner
     """The MuJoCo runs of ``result`` (MuJoCo is loaded only now): open loop, or closed loop on
     ``session`` (made now for a plan read from a file), whose re-plans join ``result``."""
     seed, cf_offset = scene.planner.seed, options.sim_cf_offset or (0.0, 0.0)
-    if len(scene.parts) > 1:
-        from ..execution.parts_sim import simulate_parts
-
-        return simulate_parts(scene, result, options.simulate, seed, options.sim_mu, cf_offset)
     start_error = options.start_error or (0.0, 0.0, 0.0)
     if not options.closed_loop:
         from ..execution.mujoco_sim import simulate
