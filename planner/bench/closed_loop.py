@@ -46,15 +46,13 @@ def draw(kind: str, rng: np.random.Generator, duration: float, mu: float) -> dic
         angle, size = rng.uniform(0, 2 * math.pi), largest * math.sqrt(rng.uniform(0.25, 1.0))
         return [size * math.cos(angle), size * math.sin(angle), math.radians(rng.uniform(-degrees, degrees))]
 
-    case = {"start_error": offset(0.015, 8.0)} if kind != "knock" else {
-        "bumps": [[rng.uniform(0.2, 0.8) * duration, *offset(0.025, 10.0)]]}
-    if kind == "noisy":
-        case["noise"] = (0.001, math.radians(0.5))
-    if kind == "cf":
-        case["cf_offset"] = offset(0.005, 0.0)[:2]
-    if kind == "slippery":
-        case["mu"] = mu / 2
-    return case
+    # Each case draws in the order the recorded runs drew: the start error first.
+    cases = {"start": lambda: {"start_error": offset(0.015, 8.0)},
+             "knock": lambda: {"bumps": [[rng.uniform(0.2, 0.8) * duration, *offset(0.025, 10.0)]]},
+             "noisy": lambda: {"start_error": offset(0.015, 8.0), "noise": (0.001, math.radians(0.5))},
+             "cf": lambda: {"start_error": offset(0.015, 8.0), "cf_offset": offset(0.005, 0.0)[:2]},
+             "slippery": lambda: {"start_error": offset(0.015, 8.0), "mu": mu / 2}}
+    return cases[kind]()
 
 
 def _shown(case: dict) -> str:

@@ -81,7 +81,7 @@ from ..model.fields import SceneError
 from ..model.files import write_atomic
 from ..model.scene import Scene
 from ..model.plan import Plan
-from ..model.segments import Transit
+from ..model.segments import Transfer, Transit
 from ..model.scene_file import placement_fault
 from ..world.validity import CollisionModel
 from .approach import first_edge, lead_in_pose
@@ -646,7 +646,7 @@ def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], 
     steps = plan.steps
     # The pusher may touch the part of its segment, and on a transfer the part it leaves: a transit
     # or a transfer begins (and ends) in contact.
-    allowed = [{name, s.from_part} if s.kind == "transfer" else {name} for name, s in steps]
+    allowed = [{name, s.from_part} if isinstance(s, Transfer) else {name} for name, s in steps]
     times = motion.t + SETTLE + lead.duration
     tracks = {name: np.empty((len(times), 3)) for name in scene.names}
     collisions, faults, seen = 0, [], set()
