@@ -550,9 +550,9 @@ def _plan_parts(inputs: Inputs) -> int:
     if inputs.export_scene is not None:
         _export_scene(scene, inputs)
     with _writing(out, scene.name) as stage:
-        from .outputs.parts_recording import write_parts_recording  # rerun: only now
+        from .outputs.recording import write_recording  # rerun: only now
 
-        write_parts_recording(stage / f"{scene.name}.rrd", scene, result)
+        write_recording(stage / f"{scene.name}.rrd", scene, result)
         if motion is not None:
             motion.write_csv(stage / f"{scene.name}.trajectory.csv")
         if simulation is not None and inputs.mjcf is not None:
