@@ -256,3 +256,14 @@ def test_transfers_fly_where_the_scene_lets_the_pusher_lift(tmp_path):
     plan = Planner(parse_scene(spec), {"seed": 1}).plan()
     assert plan.solved and plan.transfers and all(m.transfer.mode == "lift" for m in plan.moves[1:])
     replay_parts_plan(spec, json.loads(plan.to_json()))
+
+
+def test_a_picture_of_a_multi_part_plan_holds_its_headline(plans, tmp_path):
+    """The one picture function draws a plan of several parts, as it does one of one part."""
+    pytest.importorskip("matplotlib")
+    from PIL import Image
+
+    from planner.outputs.picture import draw_plan
+
+    draw_plan(load_scene("scenes/parts/swap.yaml"), plans["swap"], str(tmp_path / "swap.png"))
+    assert Image.open(tmp_path / "swap.png").text["Description"] == f"swap: {plans['swap'].headline()}"

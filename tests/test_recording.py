@@ -13,6 +13,7 @@ import os
 import shutil
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +25,7 @@ from rerun.chunk import RrdReader
 import planner
 from mechanics import exp_twist
 from planner.actions.region_cache import RegionCache
+from planner.model.segments import Push, Transfer
 from planner.outputs import analysis, frames, recording
 
 RERUN = Path(sys.executable).parent / "rerun"
@@ -36,7 +38,7 @@ TURN_START = [0.02, -0.03, math.radians(20.0)]
 TURN = math.radians(30.0)
 
 STATIC = {"/world", "/log", "/world/workspace", "/world/obstacles", "/world/start", "/world/goal", "/world/tree",
-          "/world/transits"}
+          "/world/transits", "/world/transfers"}
 ANIMATED = {"/world/slider", "/world/pusher", "/world/pusher_lifted", "/world/cf_path", "/world/cor"}
 ANALYSIS = {"/analysis", "/analysis/part", "/analysis/contact", "/analysis/cor", "/analysis/stable/ccw", "/analysis/stable/cw",
             "/analysis/exact/ccw", "/analysis/exact/cw"} | {
@@ -403,8 +405,6 @@ def test_the_analysis_shows_the_pushed_edge_in_the_slider_frame(turn):
 
 
 def test_the_analysis_shows_the_exact_region_even_when_planning_with_stable(turn, tmp_path):
-    from dataclasses import replace
-
     scene, _, _ = turn
     scene = replace(scene, planner=replace(scene.planner, regions="stable"))
     plan = planner.plan(scene)
@@ -609,25 +609,101 @@ def test_a_half_turn_of_the_part_gives_the_twin_edges_analysis(tmp_path):
         analysis.analysis(scene, 1, held)
 
 
-def test_a_multi_part_recording_moves_every_part_on_one_timeline(tmp_path):
+@pytest.fixture(scope="module")
+def swap(tmp_path_factory):
+    """The shipped swap (two parts trading places), planned and recorded."""
+    scene = planner.load_scene(SCENES / "parts" / "swap.yaml")
+    result = planner.Planner(scene).plan()
+    assert result.solved and result.transfers == 2
+    path = tmp_path_factory.mktemp("swap") / "swap.rrd"
+    recording.write_recording(path, scene, result)
+    return scene, result, path
+
+
+def test_a_multi_part_recording_moves_every_part_on_one_timeline(swap):
     """Every part is its own labelled entity; at the last frame each outline is where the plan
     leaves the part (placed here from the scene's vertices), at the first where it starts; the
     transfers are drawn, one strip per piece; the summary names the parts delivered."""
-    from planner.outputs.parts_recording import write_parts_recording
-
-    scene = planner.load_scene(Path(__file__).resolve().parents[1] / "scenes" / "parts" / "swap.yaml")
-    result = planner.Planner(scene).plan()
-    path = tmp_path / "swap.rrd"
-    write_parts_recording(path, scene, result)
+    scene, result, path = swap
     verify(path)
-    assert {"/world/parts/red", "/world/parts/blue", "/world/transfers", "/world/pusher"} <= entities(path)
+    assert {"/world/parts/red/slider", "/world/parts/blue/slider", "/world/transfers", "/world/pusher"} <= entities(path)
     for part in scene.parts:
-        strips = rrd_rows(path, f"/world/parts/{part.name}", "LineStrips3D:strips", "time")
+        strips = rrd_rows(path, f"/world/parts/{part.name}/slider", "LineStrips3D:strips", "time")
         (_, first), (_, last) = strips[0], strips[-1]
         np.testing.assert_allclose(first[0], closed(placed(part.slider.vertices, part.start)), atol=1e-6)
         np.testing.assert_allclose(last[0], closed(placed(part.slider.vertices, result.finals[part.name])), atol=1e-6)
-        [(_, labels)] = rrd_rows(path, f"/world/parts/{part.name}", "LineStrips3D:labels")
+        [(_, labels)] = rrd_rows(path, f"/world/parts/{part.name}/slider", "LineStrips3D:labels")
         assert labels == [part.name]
     [(_, transfers)] = rrd_rows(path, "/world/transfers", "LineStrips3D:strips")
     assert len(transfers) == result.transfers  # walks on the table: one strip each
     assert "delivered: 2 of 2 parts" in summary_rows(path)
+
+
+def test_a_multi_part_recording_has_each_parts_ghosts_and_path_and_the_first_pushed_edge(swap):
+    """Each part's start and goal ghosts where the scene puts them, labelled with its name; its CF's
+    path ends at the CF of its final pose (the CF is the block's centre, the pose's origin); the
+    analysis is drawn for the first part pushed; nothing is at the one-part paths."""
+    scene, result, path = swap
+    for part in scene.parts:
+        for word, pose in (("start", part.start), ("goal", part.goal)):
+            (_, ghost), = rrd_rows(path, f"/world/parts/{part.name}/{word}", "LineStrips3D:strips")
+            np.testing.assert_allclose(ghost[0], closed(placed(part.slider.vertices, pose)), atol=1e-6)
+            (_, labels), = rrd_rows(path, f"/world/parts/{part.name}/{word}", "LineStrips3D:labels")
+            assert labels == [f"{part.name} {word}"]
+        cf = rrd_rows(path, f"/world/parts/{part.name}/cf_path", "LineStrips3D:strips", "step")
+        np.testing.assert_allclose(cf[-1][1][0][-1], result.finals[part.name][:2], atol=1e-5)
+    assert ANALYSIS <= entities(path)
+    first = next(s for _, s in result.steps if isinstance(s, Push))
+    (contact,) = strips(path, "/analysis/contact")
+    np.testing.assert_allclose(sorted(map(tuple, contact)), sorted(map(tuple, first.contact)), atol=1e-6)
+    assert not {"/world/slider", "/world/start", "/world/goal", "/world/cf_path"} & entities(path)
+
+
+def test_a_part_stands_still_while_another_is_pushed_and_the_pusher_touches_the_pushed_one(swap):
+    scene, result, path = swap
+    outlines = {p.name: rrd_rows(path, f"/world/parts/{p.name}/slider", "LineStrips3D:strips", "step")
+                for p in scene.parts}
+    pusher = rrd_rows(path, "/world/pusher", "LineStrips3D:strips", "step")
+    times = np.array([t for _, t in rrd_rows(path, "/world/parts/red/slider", "time", "step")]) / 1e9
+    clock = 0.0
+    for name, step in result.steps:
+        inside = np.flatnonzero((times >= clock - 1e-9) & (times < clock + step.duration - 1e-9))
+        clock += step.duration
+        assert len(inside)
+        for other in outlines:
+            if other != name or not isinstance(step, Push):
+                shown = {tuple(np.round(outlines[other][f][1][0], 6).ravel()) for f in inside}
+                assert len(shown) == 1, (other, step)  # stands still
+        if isinstance(step, Push):
+            for f in inside:
+                body, (face,) = shapely.Polygon(outlines[name][f][1][0]), pusher[f][1]
+                assert body.intersection(shapely.Polygon(face)).area < 1e-9
+                assert body.distance(shapely.Polygon(face)) < 1e-6
+
+
+def test_a_multi_part_summary_counts_moves_transfers_and_their_times(swap):
+    scene, result, path = swap
+    pushes = sum(s.duration for s in result.segments if isinstance(s, Push))
+    transfers = sum(s.duration for s in result.segments if isinstance(s, Transfer))
+    assert summary_rows(path) == [
+        "swap: planner rrt, seed 1: solved with 2 parts, 3 moves (1 buffer), 4 pushes and 2 transfers",
+        f"CF path length {result.length:.4f} m; cost {result.cost:.4f} m (length + 0.25 m per switch and per transfer)",
+        f"push time {pushes:.4f} s, transfer time {transfers:.4f} s (every point of the pusher at most 1 m/s)",
+        "delivered: 2 of 2 parts"]
+
+
+def test_an_unsolved_multi_part_plan_records_the_moves_it_made_and_who_was_not_delivered(swap, tmp_path):
+    """The first move alone (the red block pushed aside): the red block moves, the blue one stands,
+    and the summary says neither was delivered."""
+    scene, result, _ = swap
+    first = replace(result, moves=result.moves[:1], delivered=(), solved=False, reason="stopped")
+    path = tmp_path / "stopped.rrd"
+    recording.write_recording(path, scene, first)
+    verify(path)
+    moved = first.moves[0].part
+    for part in scene.parts:
+        (_, last) = rrd_rows(path, f"/world/parts/{part.name}/slider", "LineStrips3D:strips", "step")[-1]
+        np.testing.assert_allclose(last[0], closed(placed(part.slider.vertices, first.finals[part.name])), atol=1e-6)
+    assert not np.allclose(first.finals[moved], scene.part(moved).start)
+    assert summary_rows(path) == ["swap: planner rrt, seed 1: not solved: stopped",
+                                  "delivered: 0 of 2 parts; not delivered: red, blue"]

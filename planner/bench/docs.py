@@ -98,10 +98,11 @@ def parts_caption(name: str) -> str:
     """The picture of the seed-1 plan of the multi-part scene ``name`` and its caption."""
     _, result = seed_one(name)
     order = ", ".join(dict.fromkeys(m.part for m in result.moves))
+    switches = " and its switches of edge" if result.switches else ""
     text = (f"*`scenes/{name}.yaml`, seed 1: {result.headline()}. Each part is drawn in its colour where it "
             f"starts (grey), where its goal is (dashed) and where the plan leaves it (bold), with the path of its "
-            f"centre of friction; purple, the pusher's transfers from one part to the next. The parts go in "
-            f"the order {order}.*")
+            f"centre of friction; purple, the pusher's transfers from one part to the next{switches}. The parts go "
+            f"in the order {order}.*")
     return f"![A plan for scenes/{name}.yaml](docs/{PICTURES[name]}.png)\n\n{_wrapped(text)}"
 
 
@@ -165,11 +166,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.check:
         print("stale: " + ", ".join(stale) if stale else "every generated block is current")
         return 1 if stale else 0
-    from ..outputs.picture import draw_parts_plan, draw_plan
+    from ..outputs.picture import draw_plan
 
     for name, picture in PICTURES.items():
-        scene, result = seed_one(name)
-        (draw_parts_plan if len(scene.parts) > 1 else draw_plan)(scene, result, str(ROOT / "docs" / f"{picture}.png"))
+        draw_plan(*seed_one(name), str(ROOT / "docs" / f"{picture}.png"))
     if fresh != text:
         README.write_text(fresh)
     print(f"regenerated: {', '.join(made)}; stale before: {', '.join(stale) or 'none'}")

@@ -113,18 +113,19 @@ def _computed(scene: Scene, edge: int, cache: RegionCache) -> Analysis:
 
 def prepare(scene: Scene, wait: Callable[[float], bool], cache: RegionCache | None = None) -> None:
     """Compute ahead of :func:`~planner.outputs.recording.write_recording`, in this process, the analysis of each allowed
-    edge, as soon as its stable region is in ``cache`` (default:
+    edge of each part, as soon as its stable region is in ``cache`` (default:
     :func:`~planner.actions.region_cache.default_cache`), until ``wait(seconds)`` (which may wait
     that long) says a plan has come; the first pushed edge is one of them.
     :mod:`planner.outputs.recorder` runs this beside the search, which caches the regions of a new
     part first, and then writes the recording with the same cache."""
     p = scene.pusher
-    pending = list(scene.edges)
+    # Each part's edges, on its own scene (as the recording draws a part of several, alone).
+    pending = [(scene.move_scene(part.name, scene.starts, others=False), e) for part in scene.parts for e in part.edges]
     while pending and not wait(0.0):
-        ready = [e for e in pending if is_cached(scene.slider, e, p.mu, p.width, "exact", scene.cf_uncertainty, cache)]
+        ready = [k for k, (one, e) in enumerate(pending)
+                 if is_cached(one.slider, e, p.mu, p.width, "exact", one.cf_uncertainty, cache)]
         if not ready:
             if wait(_POLL):
                 return
             continue
-        analysis(scene, ready[0], cache)
-        pending.remove(ready[0])
+        analysis(*pending.pop(ready[0]), cache)

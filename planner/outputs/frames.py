@@ -1,9 +1,9 @@
-"""The animation of a plan, frame by frame: where the part and the pusher are, and when.
+"""The animation of a plan, frame by frame: where every part and the pusher are, and when.
 
 What the recording (:mod:`planner.outputs.recording`) draws at each frame, computed apart from
-drawing it: each segment is sampled so that no body point moves more than a step between frames
-(:func:`frames`), and the centre of friction's path so far is thinned for each frame
-(:func:`history`).
+drawing it: each step of the plan (:attr:`~planner.model.plan.Plan.steps`: pushes, transits and
+transfers) is sampled so that no body point moves more than a step between frames
+(:func:`frames`), and a point's path so far is thinned for each frame (:func:`history`).
 """
 
 from __future__ import annotations
@@ -17,14 +17,15 @@ from mechanics import Slider, exp_twist
 from ..actions.transit import edge_contact_pose, transit_poses
 from ..model.bodies import place, pusher_frame_body
 from ..model.plan import Plan
-from ..model.segments import Push, Transit
+from ..model.segments import Push, Transfer, Transit
 from ..model.scene import Scene
 
-__all__ = ["FRAMES_PER_RADIUS", "MAX_FRAMES", "PATH_POINTS", "Frames", "frames", "history", "pusher_on", "sample"]
+__all__ = ["FRAMES_PER_RADIUS", "MAX_FRAMES", "PATH_POINTS", "Frames", "frames", "history", "pusher_on"]
 
-#: Animation frames while a body point travels one slider radius (fewer if that exceeds MAX_FRAMES).
+#: Animation frames while a body point travels the radius of the scene's smallest part (fewer if
+#: that exceeds MAX_FRAMES).
 FRAMES_PER_RADIUS = 20
-#: Most animation frames a recording holds (for plans of fewer than ``MAX_FRAMES - 1`` pushes).
+#: Most animation frames a recording holds (for plans of fewer than ``MAX_FRAMES - 1`` steps).
 MAX_FRAMES = 600
 #: About the most points of the CF path drawn in one frame (it is redrawn every frame).
 PATH_POINTS = 100
@@ -33,9 +34,9 @@ PATH_POINTS = 100
 class Frames(NamedTuple):
     """The animation, one item per frame."""
 
-    index: np.ndarray  # the segment shown
+    index: np.ndarray  # the step shown (an index into Plan.steps)
     times: np.ndarray  # plan time, s
-    part: np.ndarray  # the part's pose
+    parts: dict[str, np.ndarray]  # each part's pose
     pusher: np.ndarray  # the pusher frame's world pose (planner.model.bodies.pusher_frame_body)
     lifted: np.ndarray  # whether the pusher is in the air
 
@@ -46,51 +47,65 @@ def pusher_on(slider: Slider, edge: int) -> np.ndarray:
     return edge_contact_pose(slider, edge, np.zeros(3))
 
 
-def sample(slider: Slider, body: np.ndarray, segment: Push | Transit,
-            t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The part's and the pusher's poses and the pusher's being airborne, ``t`` into ``segment``."""
-    if isinstance(segment, Transit):
+def _sample(slider: Slider, body: np.ndarray, segment: Push | Transit | Transfer, t: np.ndarray,
+            pose: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The poses of the part ``segment`` concerns (``slider``, at ``pose`` as it begins), of the
+    pusher, and the pusher's being airborne, ``t`` into ``segment``."""
+    if not isinstance(segment, Push):  # a transit or a transfer: the pusher follows its path, the part stands
         pusher, lifted = transit_poses(segment, body, t)
-        return np.tile(segment.pose, (len(t), 1)), pusher, lifted
+        return np.tile(pose, (len(t), 1)), pusher, lifted
     part = exp_twist(segment.start, segment.twist, t)
     local = pusher_on(slider, segment.edge)
     pusher = np.column_stack([place(local[None, :2], part)[:, 0], part[:, 2] + local[2]])
     return part, pusher, np.zeros(len(t), dtype=bool)
 
 
-def frames(scene: Scene, plan: Plan, step: float) -> Frames:
-    """Every animation frame.
+def frames(scene: Scene, plan: Plan) -> Frames:
+    """Every animation frame of ``plan`` (which has a step) for ``scene``.
 
-    No body point moves more than ``step`` between frames (pushes and transits alike, duration
-    bounds point travel), unless that would take more than ``MAX_FRAMES``: then frames are
-    shared out in proportion to the segments' durations. Every segment gets at least its first
-    frame, and a last frame shows the end of the last, so there are at most
-    ``max(MAX_FRAMES, segments + 1)`` frames.
+    No body point moves more than the smallest part's radius over ``FRAMES_PER_RADIUS`` between
+    frames (pushes, transits and transfers alike: duration bounds point travel), unless that would
+    take more than ``MAX_FRAMES``: then frames are shared out in proportion to the steps'
+    durations. Every step gets at least its first frame, and a last frame shows the end of the
+    last, so there are at most ``max(MAX_FRAMES, steps + 1)`` frames. A part stands where its
+    last step left it (at first, the plan's start) while another part is pushed.
     """
-    segments = plan.segments
+    steps = plan.steps
     body = pusher_frame_body(scene.pusher.width, scene.pusher.depth)
-    durations = np.array([s.duration for s in segments])
-    counts = np.maximum(np.ceil(durations / step), 1).astype(int)
+    durations = np.array([s.duration for _, s in steps])
+    counts = np.maximum(np.ceil(durations / (min(p.slider.radius for p in scene.parts) / FRAMES_PER_RADIUS)),
+                        1).astype(int)
     if counts.sum() > MAX_FRAMES - 1:
-        budget = max(MAX_FRAMES - 1 - len(segments), 0)
+        budget = max(MAX_FRAMES - 1 - len(steps), 0)
         counts = 1 + (budget * durations / durations.sum()).astype(int)
-    index, times, samples = [], [], []
+    at = {n: np.asarray(p, dtype=float) for n, p in plan.starts.items()}
+    index, times, parts, pusher, lifted = [], [], {n: [] for n in at}, [], []
     clock = 0.0
-    for k, (s, n) in enumerate(zip(segments, counts)):
+    for k, ((name, s), n) in enumerate(zip(steps, counts)):
         t = np.arange(n) * (s.duration / n)
+        # Sampled at its end too: where the step leaves the part, and the last frame if it is the last.
+        moving, where, up = _sample(scene.part(name).slider, body, s, np.append(t, s.duration), at[name])
+        for other, poses in parts.items():
+            poses.append(moving[:-1] if other == name else np.tile(at[other], (n, 1)))
         index.append(np.full(n, k))
         times.append(clock + t)
-        samples.append(sample(scene.slider, body, s, t))
+        pusher.append(where[:-1])
+        lifted.append(up[:-1])
         clock += s.duration
-    index.append([len(segments) - 1])
+        at[name] = moving[-1]
+    index.append([len(steps) - 1])
     times.append([clock])
-    samples.append(sample(scene.slider, body, segments[-1], np.array([segments[-1].duration])))
-    return Frames(np.concatenate(index), np.concatenate(times), *map(np.concatenate, zip(*samples)))
+    for other, poses in parts.items():
+        poses.append(at[other][None])
+    pusher.append(where[-1:])
+    lifted.append(up[-1:])
+    return Frames(np.concatenate(index), np.concatenate(times), {n: np.concatenate(p) for n, p in parts.items()},
+                  np.concatenate(pusher), np.concatenate(lifted))
 
 
 def history(points: np.ndarray, index: np.ndarray) -> list[np.ndarray]:
     """For each frame, the path of ``points`` (one per frame) so far, thinned to at most about
-    ``PATH_POINTS`` points: every few frames plus the first frame of each segment (where the path
+    ``PATH_POINTS`` points: every few frames plus the first frame of each step (where the path
     may turn sharply) and the current one."""
     keep = np.zeros(len(points), dtype=bool)
     keep[:: -(-len(points) // PATH_POINTS)] = True

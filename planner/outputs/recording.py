@@ -1,5 +1,6 @@
-"""Rerun recording of a plan: the scene, the search tree and the pushes, animated (the frames come
-from :mod:`planner.outputs.frames`, the pushed edge's mechanics from :mod:`planner.outputs.analysis`).
+"""Rerun recording of a plan of any number of parts: the scene, the search tree and the steps,
+animated (the frames come from :mod:`planner.outputs.frames`, the pushed edge's mechanics from
+:mod:`planner.outputs.analysis`, each part's colours from :mod:`planner.outputs.looks`).
 
 :func:`write_recording` writes one ``.rrd`` file (application ``stablepush``, recording id
 ``<scene>-<planner>-seed<seed>``, no wall-clock timeline, so the same plan gives the same file).
@@ -7,55 +8,66 @@ Everything is in world coordinates, metres, z up; outlines are closed ``LineStri
 plane of the table (each kind at its own height of a few millimetres, ``_LAYER``, so that the
 part is drawn over its path and everything over the search tree), points ``Points3D``. They are
 3-D so that a view can show them the right way up (y up, as in the scene files and the README's
-figures): rerun's 2-D views draw y downwards. Entities:
+figures): rerun's 2-D views draw y downwards. A part's entities lie under ``<part>``: ``/world``
+for the one part of a ``slider:`` scene (the paths a recording of one part has always had),
+``/world/parts/<name>`` for each part of a ``parts:`` scene, whose labels then carry its name.
+Entities:
 
 Static (no timeline, always visible)
 
 * ``/world/workspace`` -- the workspace bounds, one closed strip;
 * ``/world/obstacles`` -- one strip per obstacle, labelled ``obstacle <k>`` in scene order;
-* ``/world/start``, ``/world/goal`` -- the slider's outline at the start and goal poses (ghosts);
-* ``/world/tree`` -- one strip per search-tree edge (``Plan.tree``; empty after a one-step plan);
+* ``<part>/start``, ``<part>/goal`` -- the part's outline at its start and goal poses (ghosts),
+  labelled ``start`` and ``goal`` (``<name> start``, ``<name> goal``);
+* ``/world/tree`` -- one strip per search-tree edge (``Plan.tree``; empty after a one-step plan
+  and for several parts, whose search keeps none);
 * ``/world/transits`` -- the path of the pusher's face centre on each transit (edge switch),
   labelled ``transit <k>`` in plan order: one strip for a walk round the part, three for a lift,
   whose middle, airborne, strip is labelled ``transit <k> lifted`` and drawn thin and faint in
   the lifted pusher's colour (no strip for a plan without switches);
+* ``/world/transfers`` -- the same for each transfer of the pusher from one part to the next,
+  labelled ``transfer <k> to <name>`` (no strip for a plan of one part);
 * ``/log`` -- ``TextLog``, the summary panel's rows (``WARN`` when not solved): what was solved
-  with how many pushes and switches, the CF path length and the cost (length plus
-  ``switch_cost`` per switch), the push and transit times, the search tree's size. They are on
-  both timelines at 0, not static: a text log view lists only rows of its timeline.
+  with how many parts, moves, pushes, switches and transfers, the CF path length and the cost
+  (length plus ``switch_cost`` per switch and per transfer), the push, transit and transfer
+  times, and last, for several parts which were delivered, for one part the search tree's size.
+  They are on both timelines at 0, not static: a text log view lists only rows of its timeline.
 
-Animated, one row per frame on the timelines ``time`` (plan time in seconds, pushes and transits
-alike: no body point moves faster than 1 m/s) and ``step`` (frame index), only for a plan with
-segments. Frames are ``FRAMES_PER_RADIUS`` per slider radius of point travel, at most
-``MAX_FRAMES`` in all:
+Animated, one row per frame on the timelines ``time`` (plan time in seconds, pushes, transits and
+transfers alike: no body point moves faster than 1 m/s) and ``step`` (frame index), only for a
+plan with a step. Frames are ``FRAMES_PER_RADIUS`` per radius of the smallest part of point
+travel, at most ``MAX_FRAMES`` in all:
 
-* ``/world/slider`` -- the slider's outline; it stands still during a transit;
+* ``<part>/slider`` -- the part's outline; it stands still but while it is pushed;
 * ``/world/pusher`` -- the pusher's outline on the table: on the pushed edge during a push, and
-  along the transit's path (:func:`planner.actions.transit.transit_poses`) during a transit; no strip while it is lifted;
+  along the path (:func:`planner.actions.transit.transit_poses`) during a transit or transfer; no
+  strip while it is lifted;
 * ``/world/pusher_lifted`` -- the pusher's outline while it is in the air (the inside of a lift's
   middle piece), thin, faint and labelled ``lifted``; no strip on every other frame;
-* ``/world/cf_path`` -- the path of the centre of friction so far (thinned to about
-  ``PATH_POINTS`` points, always through the segments' ends);
+* ``<part>/cf_path`` -- the path of the part's centre of friction so far (thinned to about
+  ``PATH_POINTS`` points, always through the steps' ends);
 * ``/world/cor`` -- ``Points3D``, the current push's centre of rotation, labelled ``COR`` (no
-  point for a translation, whose COR is at infinity, nor during a transit). The stable regions
-  it lies in are drawn in the slider frame only (below): carried with the part in the world
-  they were large outlines easily read as obstacles.
+  point for a translation, whose COR is at infinity, nor during a transit or transfer). The
+  stable regions it lies in are drawn in the slider frame only (below): carried with the part in
+  the world they were large outlines easily read as obstacles.
 
-The first pushed edge's mechanics (Lynch 1992's figures 11 and 14 for this part), static, in the
-slider frame, for a plan with a push:
+The first pushed edge's mechanics (Lynch 1992's figures 11 and 14 for the part first pushed),
+static, in that part's frame, for a plan with a push:
 
-* ``/analysis/part`` -- the slider's outline at the origin of its frame, and ``/analysis/contact``
+* ``/analysis/part`` -- the part's outline at the origin of its frame, and ``/analysis/contact``
   the pushed contact segment;
 * ``/analysis/stable/{ccw,cw}`` -- procedure STABLE's COR regions; ``/analysis/exact/{ccw,cw}``
   the exact regions (contain STABLE's; :mod:`mechanics.exact_region`);
 * ``/analysis/sticking/{ccw,cw}/{P,U,I}`` -- the force status of sticking (both ends) for every
   COR of each sense (:func:`mechanics.force_status_regions`, ``ANALYSIS_RAYS`` rays), for every CF
-  of the scene's uncertainty disk;
-* ``/analysis/cor`` -- ``Points3D``, the centres of rotation of the plan's pushes on that edge
-  inside the window (pushes on other edges belong with other regions).
+  of the part's uncertainty disk;
+* ``/analysis/cor`` -- ``Points3D``, the centres of rotation of the plan's pushes of that part on
+  that edge inside the window (pushes on other edges belong with other regions).
 
-All COR regions are clipped to a square of half-side 4 slider radii about the CF.
+All COR regions are clipped to a square of half-side 4 part radii about the CF.
 
+The checks below are drawn for a plan of one part: their reports for several parts
+(:mod:`planner.execution.parts_verify`, :mod:`planner.execution.parts_sim`) hold other records.
 With a :class:`~planner.execution.verify.Verification` (``plan --verify``), also:
 
 * ``/world/ghost`` -- the slider's outline as simulated under each push's worst support
@@ -97,7 +109,9 @@ With a reachable-set map (``plan --reach N``; :mod:`planner.queries.reachable_se
 * ``/world/reach`` -- ``Points3D``, static, one point per reachable cell centre, green for one
   push and amber for two.
 
-Styles (colours, line widths in UI points) are logged statically on the animated entities. The
+Styles (colours, line widths in UI points) are logged statically on the animated entities: the
+one part of a ``slider:`` scene blue, its goal green and its CF's path light blue; each part of a
+``parts:`` scene, its goal and its path in its colour (:func:`~planner.outputs.looks.looks`). The
 default blueprint shows ``/world`` and, beside it, ``/analysis`` each in a 3-D view looking
 straight down (x to the right, y up; the world view framing the workspace), above the summary
 panel, a text log view of ``/log``.
@@ -120,12 +134,12 @@ from ..actions.region_cache import RegionCache
 from ..actions.transit import transit_pieces
 from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
-from ..model.scene import Scene
-from ..model.segments import Transfer
 from ..model.plan import Plan
-from ..model.segments import Transit
+from ..model.scene import Scene
+from ..model.segments import Push, Transfer, Transit, path_length
 from .analysis import STATUS, analysis
-from .frames import FRAMES_PER_RADIUS, frames, history
+from .frames import Frames, frames, history
+from .looks import Look, looks
 
 if TYPE_CHECKING:  # the simulators behind them import scipy or MuJoCo: not needed to draw a plan
     from ..execution.closed_loop import ClosedLoop
@@ -142,7 +156,7 @@ RUN_FRAMES_HZ = 10.0
 
 _THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0.5, 1.0, 2.0, 4.0]))
 _GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
-_SLIDER, _GOAL, _CF = [40, 110, 220], [40, 170, 70], [90, 160, 255]
+_SLIDER, _GOAL, _CF = (40, 110, 220), (40, 170, 70), (90, 160, 255)
 _CCW, _CW, _COR, _GHOST, _SIMULATED = [20, 170, 150], [230, 130, 20], [210, 40, 190], [140, 60, 230], [235, 70, 120]
 _LIFTED = [110, 110, 110, 110]  # a faint, see-through grey: the pusher off the table, seen from above
 _STATUS = dict(zip(STATUS, ([40, 170, 70], [230, 190, 40], [200, 50, 50])))
@@ -176,21 +190,46 @@ def _closed(points: ArrayLike) -> np.ndarray:
     return np.vstack([p, p[:1]])
 
 
+def _root(look: Look) -> str:
+    """Where a part's entities lie (module docstring): ``world`` for the one part of a
+    ``slider:`` scene, ``world/parts/<name>`` for a named part.
+
+    >>> _root(Look((0, 0, 0), (0, 0, 0), (0, 0, 0), None)), _root(Look((0, 0, 0), (0, 0, 0), (0, 0, 0), "red"))
+    ('world', 'world/parts/red')
+    """
+    return "world" if look.name is None else f"world/parts/{look.name}"
+
+
+def _analysed(scene: Scene, plan: Plan) -> tuple[str, int | None]:
+    """The part and edge ``/analysis`` shows: the first push's (for a plan without a push, the
+    scene's first part and no edge)."""
+    return next(((name, s.edge) for name, s in plan.steps if isinstance(s, Push)), (scene.names[0], None))
+
+
 def _summary(scene: Scene, plan: Plan) -> list[str]:
     """The summary panel's rows; no planning time, so that the same plan always gives the same
-    recording."""
+    recording. Length and cost come from the scene's CFs and switch cost, which a plan made
+    without them (:meth:`~planner.model.plan.Plan.of_part` without ``cf``) does not hold."""
     head = f"{scene.name}: planner {plan.planner}, seed {plan.seed}"
-    tree = f"search tree: {len(plan.tree)} edges"
+    # The last row: with several parts, which were delivered (a plan may deliver some and not
+    # others); with one, the size of the search tree (the search of several parts keeps none).
+    if len(scene.parts) > 1:
+        missing = [n for n in scene.names if n not in plan.delivered]
+        last = f"delivered: {len(plan.delivered)} of {len(scene.names)} parts" + (
+            f"; not delivered: {', '.join(missing)}" if missing else "")
+    else:
+        last = f"search tree: {len(plan.tree)} edges"
     if not plan.solved:
-        return [f"{head}: not solved: {plan.reason}", tree]
-    length = plan.path_length(scene.slider.cf)
-    cost = length + plan.switches * scene.planner.switch_cost
-    times = [f"push time {sum(s.duration for s in plan.segments if s.kind == 'push'):.4f} s"]
-    if plan.switches:
-        times.append(f"transit time {sum(s.duration for s in plan.segments if s.kind == 'transit'):.4f} s")
-    return [f"{head}: solved with {plan.contents(' and ')}",
-            f"CF path length {length:.4f} m; cost {cost:.4f} m (length + {scene.planner.switch_cost:g} m per switch)",
-            f"{', '.join(times)} (every point of the pusher at most 1 m/s)", tree]
+        return [f"{head}: not solved: {plan.reason}", last]
+    length = sum(path_length(m.segments, scene.part(m.part).slider.cf) for m in plan.moves)
+    cost = length + (plan.switches + plan.transfers) * scene.planner.switch_cost
+    per = "per switch" + (" and per transfer" if plan.transfers else "")
+    times = [f"{word} time {sum(s.duration for s in plan.segments if isinstance(s, kind)):.4f} s"
+             for word, kind in (("push", Push), ("transit", Transit), ("transfer", Transfer))
+             if kind is Push or any(isinstance(s, kind) for s in plan.segments)]
+    return [f"{head}: solved with {' and '.join(plan.contents().rsplit(', ', 1))}",
+            f"CF path length {length:.4f} m; cost {cost:.4f} m (length + {scene.planner.switch_cost:g} m {per})",
+            f"{', '.join(times)} (every point of the pusher at most 1 m/s)", last]
 
 
 def _log_text(rec: rr.RecordingStream, entity: str, lines: list[str], level: str) -> None:
@@ -223,16 +262,23 @@ def _log_pusher_paths(rec: rr.RecordingStream, entity: str, moves: list[tuple[st
         labels=[f"{label}{' lifted' if up else ''}" for label, _, up in pieces]), static=True)
 
 
-def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> None:
-    outline = _closed(scene.slider.vertices)
-    ghosts = place(outline, np.array([scene.start, scene.goal]))
+def _log_static(rec: rr.RecordingStream, scene: Scene, plan: Plan, look: dict[str, Look]) -> None:
+    """The table, each part's start and goal, the search tree, the pusher's paths between
+    contacts and the summary (module docstring)."""
     _log_table(rec, scene)
-    rec.log("world/start", rr.LineStrips3D(_z(ghosts[:1]), colors=_GREY, radii=_LINE, labels="start"), static=True)
-    rec.log("world/goal", rr.LineStrips3D(_z(ghosts[1:]), colors=_GOAL, radii=_LINE, labels="goal"), static=True)
+    for part in scene.parts:
+        ghosts = place(_closed(part.slider.vertices), np.array([part.start, part.goal]))
+        mine, root = look[part.name], _root(look[part.name])
+        rec.log(f"{root}/start", rr.LineStrips3D(_z(ghosts[:1]), colors=_GREY, radii=_LINE, labels=mine.label("start")),
+                static=True)
+        rec.log(f"{root}/goal", rr.LineStrips3D(_z(ghosts[1:]), colors=mine.goal, radii=_LINE, labels=mine.label("goal")),
+                static=True)
     rec.log("world/tree", rr.LineStrips3D(_z(np.asarray(plan.tree, dtype=float).reshape(-1, 2, 2), "tree"),
                                           colors=_GREY, radii=_THIN), static=True)
     _log_pusher_paths(rec, "world/transits", [(f"transit {k + 1}", t) for k, t in
-                                              enumerate(s for s in plan.segments if s.kind == "transit")])
+                                              enumerate(s for s in plan.segments if isinstance(s, Transit))])
+    _log_pusher_paths(rec, "world/transfers", [(f"transfer {k + 1} to {name}", t) for k, (name, t) in
+                                               enumerate((n, s) for n, s in plan.steps if isinstance(s, Transfer))])
     _log_text(rec, "log", _summary(scene, plan), "INFO" if plan.solved else "WARN")
 
 
@@ -242,39 +288,40 @@ def _rings(geometry: shapely.Geometry) -> list[np.ndarray]:
     return [np.asarray(g.exterior.coords) for g in parts if isinstance(g, shapely.Polygon) and g.area > 0]
 
 
-def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan, cache: RegionCache | None) -> None:
-    """``/analysis``: the first pushed edge's regions in the slider frame (module docstring)."""
-    pushes = [s for s in plan.segments if s.kind == "push"]
-    edge = pushes[0].edge
+def _log_analysis(rec: rr.RecordingStream, scene: Scene, plan: Plan, edge: int, cache: RegionCache | None) -> None:
+    """``/analysis``: ``edge``'s regions in the frame of ``scene``'s part (module docstring);
+    ``scene`` is the problem of that part alone (:meth:`~planner.model.scene.Scene.move_scene`)."""
+    name, slider = scene.names[0], scene.slider
     window, contact, polygons = analysis(scene, edge, cache)
     rec.log("analysis", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-    rec.log("analysis/part", rr.LineStrips3D([_z(_closed(scene.slider.vertices), "part")], colors=_SLIDER,
+    rec.log("analysis/part", rr.LineStrips3D([_z(_closed(slider.vertices), "part")], colors=_SLIDER,
                                              radii=_BOLD), static=True)
     rec.log("analysis/contact", rr.LineStrips3D([_z(contact, "part")], colors=_DARK, radii=_BOLD), static=True)
-    for name, width in (("stable", _BOLD), ("exact", _LINE)):
+    for kind, width in (("stable", _BOLD), ("exact", _LINE)):
         for side, colour in (("ccw", _CCW), ("cw", _CW)):
-            rings = _rings(polygons[name][1 if side == "ccw" else -1])
-            rec.log(f"analysis/{name}/{side}", rr.LineStrips3D(_zs(rings, "path"), colors=colour, radii=width),
+            rings = _rings(polygons[kind][1 if side == "ccw" else -1])
+            rec.log(f"analysis/{kind}/{side}", rr.LineStrips3D(_zs(rings, "path"), colors=colour, radii=width),
                     static=True)
     for side, sense in (("ccw", 1), ("cw", -1)):
         for label, colour in _STATUS.items():
             rings = _rings(polygons[label][sense])
             rec.log(f"analysis/sticking/{side}/{label}", rr.LineStrips3D(_zs(rings), colors=colour, radii=_THIN),
                     static=True)
-    cors = [c for c, sense in map(twist_to_cor, (s.twist for s in pushes if s.edge == edge)) if sense != 0]
+    pushes = (s for n, s in plan.steps if n == name and isinstance(s, Push) and s.edge == edge)
+    cors = [c for c, sense in map(twist_to_cor, (s.twist for s in pushes)) if sense != 0]
     inside = [c for c in cors if shapely.box(*window).contains(shapely.Point(c))]  # far ones would zoom the view out
     rec.log("analysis/cor", rr.Points3D(_z(inside or np.zeros((0, 2)), "marker"), colors=_COR, radii=_DOT),
             static=True)
 
 
-def _log_ghost(rec: rr.RecordingStream, plan: Plan, verification: Verification, index: np.ndarray,
-               times: np.ndarray) -> None:
+def _log_ghost(rec: rr.RecordingStream, plan: Plan, verification: Verification, shown: Frames) -> None:
     """``/world/ghost`` at up to ``GHOST_SAMPLES`` of each push's frames, and ``/log/verify``.
 
     The verification checks pushes only, in plan order: its ``i``-th is the plan's ``i``-th push,
     whose frames are found by that push's segment index."""
+    index, times = shown.index, shown.times
     frames, poses = [], []
-    segment_of = [k for k, s in enumerate(plan.segments) if s.kind == "push"]
+    segment_of = [k for k, s in enumerate(plan.segments) if isinstance(s, Push)]
     for i in range(len(verification.pushes)):
         mine = np.flatnonzero(index == segment_of[i])  # the last segment's frames include the final one
         mine = mine[np.unique(np.linspace(0, len(mine) - 1, min(GHOST_SAMPLES, len(mine))).round().astype(int))]
@@ -321,8 +368,8 @@ def _log_closed_loop(rec: rr.RecordingStream, scene: Scene, loop: ClosedLoop) ->
         rec.log(f"{root}/pusher_path", rr.LineStrips3D.from_fields(colors=_DARK, radii=_THIN), static=True)
         for j, replan in enumerate(run.replans, 1):
             rec.set_time("time", duration=replan.time)
-            shown = frames(scene, replan.plan, scene.slider.radius / FRAMES_PER_RADIUS)
-            rec.log(f"{root}/replan/{j}", rr.LineStrips3D([_z(place(scene.slider.cf[None], shown.part)[:, 0], "path")],
+            shown = frames(scene, replan.plan).parts[replan.plan.part]
+            rec.log(f"{root}/replan/{j}", rr.LineStrips3D([_z(place(scene.slider.cf[None], shown)[:, 0], "path")],
                                                           colors=_COR, radii=_LINE))
             rec.log(f"{root}/replan/{j}/start", rr.Points3D(
                 _z(place(scene.slider.cf[None], replan.start[None])[0], "marker"), colors=_COR, radii=_DOT,
@@ -337,37 +384,38 @@ def _log_closed_loop(rec: rr.RecordingStream, scene: Scene, loop: ClosedLoop) ->
     _log_text(rec, "log/closed_loop", [loop.summary(), *loop.lines()], "INFO" if loop.passed else "WARN")
 
 
-def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan) -> tuple[np.ndarray, np.ndarray]:
-    """The animated entities; returns the frames' segment indices and times."""
-    shown = frames(scene, plan, scene.slider.radius / FRAMES_PER_RADIUS)
-    index, times, poses = shown.index, shown.times, shown.part
-    steps = [rr.TimeColumn("step", sequence=np.arange(len(times))), rr.TimeColumn("time", duration=times)]
-    slider = scene.slider
-    # Per frame: the current push's COR, none or one (a transit's twist is zero: no COR).
+def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan, look: dict[str, Look]) -> Frames:
+    """The animated entities; returns the frames."""
+    shown = frames(scene, plan)
+    steps = [rr.TimeColumn("step", sequence=np.arange(len(shown.times))), rr.TimeColumn("time", duration=shown.times)]
+    # Per frame: the current push's COR, none or one (a transit or a transfer turns nothing: no COR).
     cor: list[np.ndarray] = []
-    for k, s in enumerate(plan.segments):
-        at = poses[index == k]
-        centre, sense = twist_to_cor(s.twist)
+    for k, (name, s) in enumerate(plan.steps):
+        at = shown.parts[name][shown.index == k]
+        centre, sense = twist_to_cor(s.twist) if isinstance(s, Push) else (None, 0)
         cor += list(place(centre[None], at)) if sense != 0 else [np.zeros((0, 2))] * len(at)
 
     def send(entity: str, columns: rr.ComponentColumnList, lengths: ArrayLike | None = None) -> None:
         """One row per frame; ``lengths`` (how many items each frame has) splits ``columns`` into them."""
         rec.send_columns(entity, indexes=steps, columns=columns if lengths is None else columns.partition(lengths))
 
-    send("world/slider", rr.LineStrips3D.columns(strips=_z(place(_closed(slider.vertices), poses), "part")))
+    for part in scene.parts:
+        poses, mine, root = shown.parts[part.name], look[part.name], _root(look[part.name])
+        send(f"{root}/slider", rr.LineStrips3D.columns(strips=_z(place(_closed(part.slider.vertices), poses), "part")))
+        send(f"{root}/cf_path", rr.LineStrips3D.columns(
+            strips=_zs(history(place(part.slider.cf[None], poses)[:, 0], shown.index), "path")))
+        rec.log(f"{root}/slider", rr.LineStrips3D.from_fields(
+            colors=mine.part, radii=_BOLD, labels=None if mine.name is None else [mine.name]), static=True)
+        rec.log(f"{root}/cf_path", rr.LineStrips3D.from_fields(colors=mine.path, radii=_LINE), static=True)
     pusher = _z(place(_closed(pusher_frame_body(scene.pusher.width, scene.pusher.depth)), shown.pusher), "part")
     for entity, where in (("world/pusher", ~shown.lifted), ("world/pusher_lifted", shown.lifted)):
         send(entity, rr.LineStrips3D.columns(strips=pusher[where]), where.astype(int))
-    send("world/cf_path", rr.LineStrips3D.columns(strips=_zs(history(place(slider.cf[None], poses)[:, 0], index),
-                                                                "path")))
     send("world/cor", rr.Points3D.columns(positions=_z(np.concatenate(cor), "marker")), [len(c) for c in cor])
-    for entity, color, radius in (("world/slider", _SLIDER, _BOLD), ("world/pusher", _DARK, _BOLD),
-                                  ("world/cf_path", _CF, _LINE)):
-        rec.log(entity, rr.LineStrips3D.from_fields(colors=color, radii=radius), static=True)
+    rec.log("world/pusher", rr.LineStrips3D.from_fields(colors=_DARK, radii=_BOLD), static=True)
     rec.log("world/pusher_lifted", rr.LineStrips3D.from_fields(colors=_LIFTED, radii=_THIN, labels=["lifted"]),
             static=True)
     rec.log("world/cor", rr.Points3D.from_fields(colors=_COR, radii=_DOT, labels=["COR"]), static=True)
-    return index, times
+    return shown
 
 
 def _log_reach(rec: rr.RecordingStream, reach: ReachableSet) -> None:
@@ -403,17 +451,21 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
     path : str or Path
         The ``.rrd`` file to write; its folder must exist.
     scene : Scene
-        The scene that was planned.
+        The scene that was planned, of any number of parts.
     plan : Plan
-        The planner's result, solved or not (an unsolved plan gives the static scene only).
+        The planner's result, solved or not (a plan without a move, as an unsolved plan of one part
+        is, gives the static scene only).
     verification : Verification, optional
-        :func:`planner.verify` of ``plan``: adds the simulated ghost and the verdict.
+        :func:`planner.verify` of ``plan``, a plan of one part: adds the simulated ghost and the
+        verdict (the checks are drawn for one part only, as the module docstring says).
     reach : ReachableSet, optional
         :func:`planner.queries.reachable_set.reachable_set` from the scene's start: adds ``/world/reach``.
     simulation : Simulation, optional
-        :func:`planner.execution.mujoco_sim.simulate` of ``plan``: adds the simulated part and the verdict.
+        :func:`planner.execution.mujoco_sim.simulate` of ``plan``, a plan of one part: adds the
+        simulated part and the verdict.
     closed_loop : ClosedLoop, optional
-        :func:`planner.execution.closed_loop.closed_loop` of ``plan``: adds its runs and re-plans.
+        :func:`planner.execution.closed_loop.closed_loop` of ``plan``, a plan of one part: adds its
+        runs and re-plans.
     cache : RegionCache, optional
         Where the plan's regions and the analysis are found, or kept once computed (default:
         :func:`~planner.actions.region_cache.default_cache`); :func:`~planner.outputs.analysis.prepare` may have filled it.
@@ -424,11 +476,13 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         If the file cannot be written whole (a full disk, say), naming ``path``.
     """
     xmin, ymin, xmax, ymax = scene.workspace
-    cf, radius = scene.slider.cf, scene.slider.radius
+    look = looks(scene, (_SLIDER, _GOAL, _CF))
+    name, edge = _analysed(scene, plan)
+    first = scene.part(name).slider
     blueprint = rrb.Blueprint(rrb.Vertical(
         rrb.Horizontal(
             _top_view("/world", scene.name, (xmin + xmax) / 2, (ymin + ymax) / 2, max(xmax - xmin, ymax - ymin) / 2),
-            _top_view("/analysis", "pushed edge (slider frame)", *cf, 6 * radius),
+            _top_view("/analysis", f"{look[name].label('pushed edge')} (slider frame)", *first.cf, 6 * first.radius),
             column_shares=[3, 2]),
         rrb.TextLogView(origin="/log", name="summary"),
         row_shares=[3, 1]))
@@ -441,16 +495,17 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
         # Active, not only default: in a stream the data comes first, and the viewer would keep the
         # layout it makes up for it (seen in the web viewer; tests/test_recording.py checks the file).
         rec.send_blueprint(blueprint, make_active=True, make_default=True)
-        _log_static(rec, scene, plan)
-        if plan.segments:
-            index, times = _log_motion(rec, scene, plan)
-            if plan.pushes:
-                _log_analysis(rec, scene, plan, cache)
-            if verification is not None:
-                _log_ghost(rec, plan, verification, index, times)
-            if simulation is not None:
-                _log_simulated(rec, scene, simulation, times)
-            if closed_loop is not None:
+        _log_static(rec, scene, plan, look)
+        if plan.moves:
+            shown = _log_motion(rec, scene, plan, look)
+            if edge is not None:
+                _log_analysis(rec, scene.move_scene(name, scene.starts, others=False), plan, edge, cache)
+            one = len(scene.parts) == 1  # the checks' reports of one part (module docstring)
+            if verification is not None and one:
+                _log_ghost(rec, plan, verification, shown)
+            if simulation is not None and one:
+                _log_simulated(rec, scene, simulation, shown.times)
+            if closed_loop is not None and one:
                 _log_closed_loop(rec, scene, closed_loop)
         if reach is not None:
             _log_reach(rec, reach)

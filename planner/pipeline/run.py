@@ -166,13 +166,8 @@ def _write(outcome: Outcome, options: RunOptions, write_recording: Callable[...,
         except OSError as err:
             raise OutputError(f"cannot write {shown(str(options.export_scene))}: {err.strerror or err}") from None
     with _writing(out, name) as stage:
-        if len(scene.parts) == 1:
-            write_recording(stage / f"{name}.rrd", scene, outcome.plan, outcome.verification, outcome.reach,
-                            None if closed else simulation, simulation if closed else None)
-        else:
-            from ..outputs.parts_recording import write_parts_recording  # rerun: only now
-
-            write_parts_recording(stage / f"{name}.rrd", scene, outcome.plan)
+        write_recording(stage / f"{name}.rrd", scene, outcome.plan, outcome.verification, outcome.reach,
+                        None if closed else simulation, simulation if closed else None)
         if outcome.trajectory is not None:
             outcome.trajectory.write_csv(stage / f"{name}.trajectory.csv")
             files.append(f"{name}.trajectory.csv")
