@@ -299,6 +299,23 @@ class Planner:
         self._moves.file(key, part, session)  # the latest used, the last dropped
         return session
 
+    def clear(self) -> None:
+        """Forget what the queries found (plans per goal, goals reached, move sessions), as OMPL's
+        ``SimpleSetup.clear`` does, keeping the set-up (regions, collisions, transits): the next
+        query answers as a fresh session's would, faster.
+
+        >>> from planner import load_scene
+        >>> scene = load_scene("scenes/parking.yaml")
+        >>> session, moved = Planner(scene), scene.start + [0.005, 0.0, 0.02]
+        >>> _ = session.plan(seed=1)
+        >>> session.plan(start=moved, seed=1).headline()          # joined to the first plan
+        '4 pushes, cost 0.838 m, length 0.838 m'
+        >>> session.clear()
+        >>> session.plan(start=moved, seed=1).headline() == Planner(scene).plan(start=moved, seed=1).headline()
+        True
+        """
+        self._plans, self._reached, self._moves = (Memory(m.limit) for m in (self._plans, self._reached, self._moves))
+
     def certify_unreachable(self, goal: ArrayLike | None = None, *, start: ArrayLike | None = None) -> str | None:
         """Why ``goal`` (default: the scene's) is certainly unreachable from ``start`` (default:
         the scene's), or None if no certificate shows it (:mod:`planner.queries.reachability`)."""
