@@ -55,10 +55,10 @@ from ..model.scene import Scene
 from ..model.segments import Transit
 from ..queries.session import Planner
 from .approach import first_edge, lead_in_pose
-from .mujoco_sim import (SETTLE, TABLE_MU, Feet, Runs, World, _error, _one, _worst, foot_sets, needs_mujoco,
+from .mujoco_sim import (SETTLE, TABLE_MU, ByPart, Feet, Runs, World, _error, _one, _worst, foot_sets, needs_mujoco,
                          perturbations, write_mjcf)
 from .tracker import BUDGET, CONFIRM, Replan, Tracker, mean_pose
-from .tracker import SETTLE as AT_REST
+from .tracker import SETTLE as AT_REST  # observations of the parts at rest (mujoco_sim's SETTLE is seconds)
 from .trajectory import RATE, Trajectory
 
 __all__ = ["GRACE", "OBSERVE_HZ", "PATIENCE", "ClosedLoop", "ClosedRun", "closed_loop"]
@@ -70,7 +70,7 @@ PATIENCE, GRACE = 3.0, 20.0
 
 
 @dataclass(frozen=True)
-class ClosedRun:
+class ClosedRun(ByPart):
     """One closed-loop run, each part on one foot set of its own: each part's true final pose
     against its goal (distance, angle) and whether it is within tolerance, the re-plans
     (:class:`~.tracker.Replan`: the trackers', and for several parts the re-plans of the moves
@@ -98,21 +98,9 @@ class ClosedRun:
     faults: tuple[tuple[float, str], ...] = ()
 
     @property
-    def feet(self) -> Feet:
-        return _one(self.supports)
-
-    @property
     def part(self) -> np.ndarray:
-        return _one(self.tracks)
-
-    @property
-    def goal_error(self) -> tuple[float, float]:
-        return self.goal_errors[_worst(self.goal_errors)]
-
-    @property
-    def in_goal(self) -> bool:
-        """Every part ends within tolerance of its goal."""
-        return all(self.delivered.values())
+        """:attr:`poses` (the one part's), as the recording reads them."""
+        return self.poses
 
     @property
     def passed(self) -> bool:

@@ -87,7 +87,7 @@ from ..world.validity import CollisionModel
 from .approach import first_edge, lead_in_pose
 from .trajectory import Trajectory, planned_part, trajectory
 
-__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Perturbed", "Run", "Runs", "Simulation", "World", "feet",
+__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "ByPart", "Feet", "Perturbed", "Run", "Runs", "Simulation", "World", "feet",
            "foot_sets", "mjcf", "needs_mujoco", "perturbations", "simulate", "support_centre", "write_mjcf"]
 
 #: The one line ``plan --simulate`` prints (after ``plan: error: --simulate: ``) without MuJoCo.
@@ -377,8 +377,36 @@ def _worst(errors: Mapping[str, tuple[float, float]]) -> str:
     return max(errors, key=lambda name: errors[name][0])
 
 
+class ByPart:
+    """What a run, open or closed loop, reports of each part by name (``supports``,
+    ``goal_errors``, ``delivered``, ``tracks``), read as a whole: the one part's feet, the
+    farthest-off part's goal error, whether every part is in its goal, the one part's poses."""
+
+    supports: dict[str, Feet]
+    goal_errors: dict[str, tuple[float, float]]
+    delivered: dict[str, bool]
+    tracks: dict[str, np.ndarray]
+
+    @property
+    def feet(self) -> Feet:
+        return _one(self.supports)
+
+    @property
+    def goal_error(self) -> tuple[float, float]:
+        return self.goal_errors[_worst(self.goal_errors)]
+
+    @property
+    def in_goal(self) -> bool:
+        """Every part ends within tolerance of its goal."""
+        return all(self.delivered.values())
+
+    @property
+    def poses(self) -> np.ndarray:
+        return _one(self.tracks)
+
+
 @dataclass(frozen=True)
-class Run:
+class Run(ByPart):
     """One open-loop run of a whole plan, each part on one foot set of its own.
 
     Attributes
@@ -427,25 +455,8 @@ class Run:
     segment_slip: tuple[float, ...]
 
     @property
-    def feet(self) -> Feet:
-        return _one(self.supports)
-
-    @property
-    def poses(self) -> np.ndarray:
-        return _one(self.tracks)
-
-    @property
-    def goal_error(self) -> tuple[float, float]:
-        return self.goal_errors[_worst(self.goal_errors)]
-
-    @property
     def final_error(self) -> tuple[float, float]:
         return self.final_errors[_worst(self.final_errors)]
-
-    @property
-    def in_goal(self) -> bool:
-        """Every part ends within tolerance of its goal."""
-        return all(self.delivered.values())
 
     @property
     def passed(self) -> bool:
