@@ -255,8 +255,9 @@ class _Loop:
             if len(self.scene.parts) == 1:  # the tracker's end is the run's
                 self.done, self.reason = self.tracker.done, self.tracker.reason
                 return True
-            why = f"{self.moving}'s move is done" if self.tracker.done else f"gave up on {self.moving}: {self.tracker.reason}"
-            self._hold(now, self.moving, seen[self.moving], command.error, why, not self.tracker.done)
+            done = self.tracker.done
+            why = f"{self.moving}'s move is done" if done else f"gave up on {self.moving}: {self.tracker.reason}"
+            self._hold(now, self.moving, seen[self.moving], command.error, why, not done)
             return False
         for name, pose in seen.items():
             if name == self.moving:
@@ -298,7 +299,6 @@ class _Loop:
         if not found.solved:
             self.reason = f"no plan of the moves left ({why}): {found.reason}"
             return
-        latency = time.perf_counter() - clock
         left, pusher = self.moving, self._held[0]
         self.session, self.plan = session, found
         mover, lone, goal = self._move()
@@ -307,6 +307,7 @@ class _Loop:
             edge = first_edge(lone)
             reach = edge_contact_pose(observed.part(lone.part).slider, edge, lone.start)
             way = session.paths.find(means, left, pusher, lone.part, edge, reach, self.seed)
+        latency = time.perf_counter() - clock  # the plan and its transfer: the pusher waits for both
         if way is not None:
             # The transfer as the new plan's way in: the tracker follows it as it does its approaches.
             lone = lone.with_segments([Transit(way.to_edge, way.to_edge, way.mode, way.pusher_path, way.duration,
@@ -333,13 +334,15 @@ def _after_first_move(plan: Plan, motion: Trajectory) -> float:
 
 def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | None, starts: dict[str, np.ndarray],
          bumps: tuple, noise: np.ndarray, rng: np.random.Generator, seed: int | None, later: float) -> ClosedRun:
+    """One run of :func:`closed_loop`, each part on its ``supports`` and placed at ``starts``;
+    ``later`` is how long the plan runs after its first move (:func:`_after_first_move`)."""
     scene = session.scene
     clock = time.perf_counter()
     world = World(scene, supports, mu, starts, bumps)
     loop = _Loop(session, plan, (float(noise[0]), float(noise[1])), seed)
     limit = PATIENCE * (loop.tracker.motion.duration + later) + GRACE
 
-    def pusher(u: float):
+    def pusher(u: float) -> tuple[list[float], list[float]]:
         pose, height, rate, _ = loop.pusher_at(u)
         return [pose[0], pose[1], height, pose[2]], [rate[0], rate[1], rate[3], rate[2]]
 
@@ -349,7 +352,8 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
         u = k / RATE
         world.step_to(SETTLE + u, pusher)
         pose, height, rate, contact = loop.pusher_at(u)
-        rows.append([u, *pose, *rate[:3], height, contact, len(loop.replans), *np.ravel([world.pose(n) for n in scene.names])])
+        parts = np.ravel([world.pose(n) for n in scene.names])
+        rows.append([u, *pose, *rate[:3], height, contact, len(loop.replans), *parts])
         moving.append(loop.moving)
         now = world.faults(loop.allowed)
         collisions += bool(now)
