@@ -114,7 +114,8 @@ $STABLEPUSH_CACHE, else $XDG_CACHE_HOME/stablepush or ~/.cache/stablepush (here:
                         "an open loop observes nothing)")
     p.add_argument("--closed-loop", action="store_true",
                    help="with --simulate: observe the part at 20 Hz and re-plan from where it is when it strays from "
-                        "the plan (planner.execution.tracker); the summary counts the re-plans; with --trajectory "
+                        "the plan (planner.execution.tracker; a tray's parts each, its moves left re-planned as each "
+                        "move ends); the summary counts the re-plans; with --trajectory "
                         "each run's executed pusher path is written as <name>.executed.csv (the first run), "
                         "<name>.executed-<k>.csv (run k)")
     p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")

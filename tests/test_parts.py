@@ -162,7 +162,6 @@ def test_cli_plans_a_multi_part_scene(tmp_path):
     ({"parts.1.start": [0.02, 0.02, 0]}, [], "parts[1].start: part 'b' overlaps part 'a' at their starts"),
     ({"parts.1.name": "a"}, [], "parts[1].name: part 'a' is named twice"),
     ({}, ["--reach", "1"], "--part: the reachable set is one part's: name one of a, b"),
-    ({}, ["--simulate", "1", "--closed-loop"], "--closed-loop: is for one-part scenes"),
 ])
 def test_cli_bad_multi_part_input_is_one_line(tmp_path, changes, args, words):
     scene = tmp_path / "bad.yaml"

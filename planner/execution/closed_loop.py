@@ -1,8 +1,8 @@
-"""Whole plans run closed-loop in MuJoCo: the part observed, the plan tracked and re-planned.
+"""Whole plans run closed-loop in MuJoCo: the parts observed, the plan tracked and re-planned.
 
 The MuJoCo model and the perturbations are those of the open-loop runs
-(:mod:`.mujoco_sim`): the part starts where ``start_error`` puts it, is knocked by the bumps, and
-the pusher begins behind the first contact. Here the pusher follows a
+(:mod:`.mujoco_sim`): the part moved first starts where ``start_error`` puts it, the bumps knock
+parts, and the pusher begins behind the first contact. Here the pusher follows a
 :class:`~.tracker.Tracker`: every ``1 / OBSERVE_HZ`` seconds of simulated time the part's pose,
 with Gaussian noise of the given deviations, is handed to it, and the pusher is set before every
 step to where the tracker has it (stopped while the tracker waits for the part to settle, then
@@ -11,16 +11,36 @@ simulated time goes on as the wall clock did (the re-plan's latency), the pusher
 new plan begins after it, as on a robot. So a run is repeatable up to those waits, which differ
 from one run to the next by milliseconds with the part at rest.
 
-A run ends when the tracker is done (the part observed at rest within the goal tolerance) or gives
-up, or after :data:`PATIENCE` times the first plan's duration plus :data:`GRACE` seconds.
-Whether it passed is judged on the part's true pose: in the goal, no collision, not given up.
+**Several parts.** A plan of several parts is followed move by move, each move tracked as a plan
+of one part is: by a tracker on the move's one-part session (the part among the others where the
+plan has them, :meth:`~planner.queries.session.Planner.move_session`), which takes the part to
+the move's end (its goal, or the buffer pose it is left at for a later move). Every part is
+observed, each with noise of its own. The moves left are re-planned when the move's tracker is
+done or gives up, or when a part not being moved is observed off where the plan has it (beyond
+the tracker's thresholds on :data:`~.tracker.CONFIRM` observations in a row: it was knocked or
+shoved): the pusher is held still, :data:`~.tracker.SETTLE` observations of every part at rest
+are averaged, and a fresh session of the scene, every part's start at its mean (parts in their
+goals stay, as the search leaves them), plans the moves left; the re-plan's latency runs on the
+simulated clock as a tracker's does. The new plan's first move begins from where the pusher is:
+from another part by a transfer as the planner makes them
+(:class:`~planner.search.transfer.TransferPaths`, the parts where they are observed), from the
+same part (or where no transfer is found) by the tracker's approach. Re-plans a move's end did
+not ask for count against the tracker's :data:`~.tracker.BUDGET`.
+
+A run ends when every part is observed at rest in its goal (one part: the tracker is done), when
+it gives up (the tracker, for one part; no plan of the moves left, or the budget spent, for
+several), or after :data:`PATIENCE` times the first plan's duration plus :data:`GRACE` seconds.
+Whether it passed is judged on the parts' true poses: every part in its goal, no contact that
+must not happen (:meth:`.mujoco_sim.World.faults`: a part against another part, a wall or an
+obstacle, or the pusher against a part other than the one it moves and, on its way to that
+one, the one it leaves), not given up.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -28,12 +48,17 @@ from numpy.typing import ArrayLike
 
 from mechanics import wrap_angle
 
+from ..actions.transit import edge_contact_pose
+from ..model.fields import SceneError
 from ..model.plan import Plan
 from ..model.scene import Scene
+from ..model.segments import Transit
 from ..queries.session import Planner
-from .approach import lead_in_pose
-from .mujoco_sim import SETTLE, TABLE_MU, Feet, Runs, World, feet, needs_mujoco, perturbations, write_mjcf
-from .tracker import Replan, Tracker
+from .approach import first_edge, lead_in_pose
+from .mujoco_sim import (SETTLE, TABLE_MU, ByPart, Feet, Runs, World, _error, _one, _worst, foot_sets, needs_mujoco,
+                         perturbations, write_mjcf)
+from .tracker import BUDGET, CONFIRM, Replan, Tracker, mean_pose
+from .tracker import SETTLE as AT_REST  # observations of the parts at rest (mujoco_sim's SETTLE is seconds)
 from .trajectory import RATE, Trajectory
 
 __all__ = ["GRACE", "OBSERVE_HZ", "PATIENCE", "ClosedLoop", "ClosedRun", "closed_loop"]
@@ -45,25 +70,37 @@ PATIENCE, GRACE = 3.0, 20.0
 
 
 @dataclass(frozen=True)
-class ClosedRun:
-    """One closed-loop run on one foot set: the part's true final pose against the goal, the
-    re-plans (:class:`~.tracker.Replan`) and the times it went on without one
-    (:attr:`~.tracker.Tracker.carried`), why the tracker gave up (empty if it did not), samples
-    of the part touching a wall or obstacle, wall and simulated seconds, the pusher's executed
-    path (a :class:`~.trajectory.Trajectory` at :data:`~.trajectory.RATE` Hz) and the part's
-    true pose at each of its samples."""
+class ClosedRun(ByPart):
+    """One closed-loop run, each part on one foot set of its own: each part's true final pose
+    against its goal (distance, angle) and whether it is within tolerance, the re-plans
+    (:class:`~.tracker.Replan`: the trackers', and for several parts the re-plans of the moves
+    left, whose ``start`` is the pose of the part that asked for it and ``plan`` the new plan of
+    the scene) and the times it went on without one (:attr:`~.tracker.Tracker.carried`), why it
+    gave up (empty if it did not), samples at which a contact that must not happen was on and
+    those contacts in words with when each was first seen, wall and simulated seconds, the
+    pusher's executed path (a :class:`~.trajectory.Trajectory` at :data:`~.trajectory.RATE` Hz)
+    and each part's true pose at each of its samples.
 
-    feet: Feet
-    goal_error: tuple[float, float]
-    in_goal: bool
+    ``feet`` and ``part`` (the poses) are the one part's, for a run of one part; ``goal_error``
+    the part's farthest off, for any run."""
+
+    supports: dict[str, Feet]
+    goal_errors: dict[str, tuple[float, float]]
+    delivered: dict[str, bool]
     replans: tuple[Replan, ...]
     reason: str
     collisions: int
     seconds: float
     simulated: float
     executed: Trajectory
-    part: np.ndarray
+    tracks: dict[str, np.ndarray]
     carried: tuple[tuple[float, str], ...] = ()
+    faults: tuple[tuple[float, str], ...] = ()
+
+    @property
+    def part(self) -> np.ndarray:
+        """:attr:`poses` (the one part's), as the recording reads them."""
+        return self.poses
 
     @property
     def passed(self) -> bool:
@@ -74,14 +111,21 @@ class ClosedRun:
         return [r.latency for r in self.replans]
 
     def line(self, k: int, n: int) -> str:
-        faults = ([] if self.in_goal else ["misses the goal"]) + (
-            [f"collides ({self.collisions} samples)"] if self.collisions else []) + (
+        """The run's line, numbered ``k`` of ``n``; with several parts it names the part its goal
+        error is of, the parts that miss their goals and the first contacts that must not happen."""
+        several = len(self.supports) > 1
+        missed = ", ".join(name for name, ok in self.delivered.items() if not ok)
+        touches = "; ".join(f"{what} at {t:.1f} s" for t, what in self.faults[:3])
+        faults = ([] if self.in_goal else [f"misses the goal{': ' + missed if several else ''}"]) + (
+            [f"collides ({self.collisions} samples{': ' + touches if several else ''})"] if self.collisions else []) + (
             [f"gave up: {self.reason}"] if self.reason else [])
         latency = (f" (latency median {np.median(self.latencies) * 1e3:.0f} ms, max {max(self.latencies) * 1e3:.0f} ms;"
                    f" triggered by {'; '.join(_trigger(r) for r in self.replans)})" if self.replans else "")
-        return (f"closed loop {k}/{n} ({self.feet.kind}, {len(self.feet.points)} feet): goal error "
-                f"{self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad; {len(self.replans)} re-plans{latency}; "
-                f"{_carried(self.carried)}"
+        kinds = ", ".join(sorted({f.kind for f in self.supports.values()}))
+        worst = f" ({_worst(self.goal_errors)})" if several else ""
+        return (f"closed loop {k}/{n} ({kinds}, {'+'.join(str(len(f.points)) for f in self.supports.values())} feet): "
+                f"goal error {self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad{worst}; {len(self.replans)} "
+                f"re-plans{latency}; {_carried(self.carried)}"
                 f"{self.seconds:.1f} s for {self.simulated:.1f} s: {', '.join(faults) if faults else 'ok'}")
 
 
@@ -103,22 +147,28 @@ class ClosedLoop(Runs):
 
     runs: tuple[ClosedRun, ...]
     mu: float
-    start: np.ndarray  # where the part was placed
+    starts: dict[str, np.ndarray]  # where the parts were placed: the first moved by any start error
+
+    @property
+    def start(self) -> np.ndarray:
+        """Where the one part was placed, for a run of one part."""
+        return _one(self.starts)
 
     def summary(self) -> str:
         latencies = [x for r in self.runs for x in r.latencies]
         timing = (f", re-plan latency median {np.median(latencies) * 1e3:.0f} ms, max {max(latencies) * 1e3:.0f} ms"
                   if latencies else "")
+        placed = "; ".join(f"{'the part' if len(self.starts) == 1 else name} started at ({pose[0]:.17g}, "
+                           f"{pose[1]:.17g}, {math.degrees(pose[2]):.17g} deg)" for name, pose in self.starts.items())
+        goal = "in the goal" if len(self.starts) == 1 else "with every part in its goal"
         return (f"closed loop: {'passed' if self.passed else 'FAILED'}: {sum(r.passed for r in self.runs)}/"
-                f"{len(self.runs)} runs in the goal without collision (MuJoCo, pusher mu {self.mu:g}, table mu "
+                f"{len(self.runs)} runs {goal} without collision (MuJoCo, pusher mu {self.mu:g}, table mu "
                 f"{TABLE_MU:g}); {sum(len(r.replans) for r in self.runs)} re-plans{timing}; worst goal error "
-                f"{max(r.goal_error[0] for r in self.runs):.2e} m; the part started at ({self.start[0]:.17g}, "
-                f"{self.start[1]:.17g}, {math.degrees(self.start[2]):.17g} deg); {sum(r.seconds for r in self.runs):.1f} s")
+                f"{max(r.goal_error[0] for r in self.runs):.2e} m; {placed}; {sum(r.seconds for r in self.runs):.1f} s")
 
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:
-        """Write the first run's model, the part at its perturbed start (:func:`.mujoco_sim.mjcf`)."""
-        name = scene.part().name
-        write_mjcf(path, scene, {name: self.runs[0].feet}, self.mu, {name: self.start})
+        """Write the first run's model, the parts where they were placed (:func:`.mujoco_sim.mjcf`)."""
+        write_mjcf(path, scene, self.runs[0].supports, self.mu, self.starts)
 
     def executed_files(self, name: str) -> list[str]:
         """The executed paths' file names, one per run: ``<name>.executed.csv`` for the first (the
@@ -132,47 +182,208 @@ class ClosedLoop(Runs):
             run.executed.write_csv(Path(folder) / file)
 
 
-def _run(session: Planner, plan: Plan, support: Feet, mu: float | None, starts: dict[str, np.ndarray], bumps: tuple,
-         noise: np.ndarray, rng: np.random.Generator, lead: np.ndarray, seed: int | None) -> ClosedRun:
+class _Loop:
+    """What a run's pusher follows (module docstring): the tracker of the move under way, and for
+    a scene of several parts the re-plans of the moves left.
+
+    ``session`` is the session of the scene run, ``plan`` its plan; the first move begins with
+    the pusher behind its first contact (:func:`.approach.lead_in_pose`). :meth:`pusher_at` says
+    where the pusher is at any time, :meth:`observe` takes every part's observed pose."""
+
+    def __init__(self, session: Planner, plan: Plan, noise: tuple[float, float], seed: int | None):
+        self.session, self.plan, self.scene = session, plan, session.scene
+        self.noise, self.seed = noise, seed
+        self.reason, self.done = "", False
+        self._past: list[Replan] = []  # the re-plans of the trackers before this one, and of the moves left
+        self._carried: list[tuple[float, str]] = []
+        self._spent = 0  # re-plans of the moves left that no move's end asked for
+        self._held: tuple[np.ndarray, float] | None = None  # the pusher held still while the moves left are re-planned
+        self._window: list[dict[str, np.ndarray]] = []  # every part's observations since
+        self._trigger: tuple[str, np.ndarray, tuple[float, float], str, bool] | None = None
+        self._strikes: dict[str, int] = {}
+        self._left: str | None = None  # the part the pusher leaves for this move's, until it pushes
+        session, lone, goal = self._move()
+        self.tracker = Tracker(session, lone, pusher=lead_in_pose(session.scene, session.model, lone), noise=noise,
+                               seed=seed, goal=goal)
+
+    @property
+    def moving(self) -> str:
+        """The part of the move under way."""
+        return self.tracker.plan.part
+
+    @property
+    def replans(self) -> list[Replan]:
+        return [*self._past, *self.tracker.replans]
+
+    @property
+    def carried(self) -> list[tuple[float, str]]:
+        return [*self._carried, *self.tracker.carried]
+
+    @property
+    def allowed(self) -> set[str]:
+        """The parts the pusher may touch now."""
+        return {self.moving} if self._left is None else {self.moving, self._left}
+
+    def _move(self) -> tuple[Planner, Plan, np.ndarray | None]:
+        """The session the plan's first move is tracked on, the move as a plan of its part, and the
+        pose it takes the part to where that is not the part's goal (a buffer). A plan of one part
+        is its own move, on the session given."""
+        if len(self.scene.parts) == 1:
+            return self.session, self.plan, None
+        lone = self.plan.move_plan()
+        goal = None if self.scene.delivered(lone.part, lone.final) else lone.final
+        return self.session.move_session(lone.part, self.plan.starts), lone, goal
+
+    def pusher_at(self, now: float) -> tuple[np.ndarray, float, np.ndarray, bool]:
+        """:meth:`.tracker.Tracker.pusher_at` of the tracker, or the pusher held still."""
+        if self._held is not None:
+            pose, height = self._held
+            return pose.copy(), height, np.zeros(4), False
+        return self.tracker.pusher_at(now)
+
+    def observe(self, now: float, seen: dict[str, np.ndarray]) -> bool:
+        """Take every part's observed pose at ``now``; whether the run has ended."""
+        if self._held is not None:
+            self._window.append(seen)
+            if len(self._window) >= AT_REST:
+                self._replan(now)
+            return self.done or bool(self.reason)
+        command = self.tracker.observe(now, seen[self.moving])
+        if command.contact:
+            self._left = None
+        if command.kind.ended:
+            if len(self.scene.parts) == 1:  # the tracker's end is the run's
+                self.done, self.reason = self.tracker.done, self.tracker.reason
+                return True
+            done = self.tracker.done
+            why = f"{self.moving}'s move is done" if done else f"gave up on {self.moving}: {self.tracker.reason}"
+            self._hold(now, self.moving, seen[self.moving], command.error, why, not done)
+            return False
+        for name, pose in seen.items():
+            if name == self.moving:
+                continue
+            planned = self.plan.starts[name]  # where the plan has it until it is moved
+            error = (math.hypot(*(pose[:2] - planned[:2])), abs(float(wrap_angle(pose[2] - planned[2]))))
+            beyond = error[0] > self.tracker.threshold[0] or error[1] > self.tracker.threshold[1]
+            self._strikes[name] = self._strikes.get(name, 0) + 1 if beyond else 0
+            if self._strikes[name] >= CONFIRM:
+                why = f"{name} is off the plan by {error[0] * 1000:.1f} mm, {math.degrees(error[1]):.1f} deg"
+                self._hold(now, name, pose, error, why, True)
+                break
+        return False
+
+    def _hold(self, now: float, name: str, pose: np.ndarray, error: tuple[float, float], why: str,
+              counted: bool) -> None:
+        """Hold the pusher where it is and observe the parts at rest before re-planning the moves
+        left, because of part ``name`` observed at ``pose`` (``counted`` against the budget)."""
+        pusher, height, _, _ = self.tracker.pusher_at(now)
+        self._held, self._window = (pusher, height), []
+        self._trigger = (name, pose, error, why, counted)
+
+    def _replan(self, now: float) -> None:
+        """Re-plan the moves left from the parts' mean poses and begin the new plan's first move
+        (module docstring); or end the run: every part in its goal, or given up."""
+        clock = time.perf_counter()
+        means = {name: mean_pose([seen[name] for seen in self._window]) for name in self.scene.names}
+        name, trigger, error, why, counted = self._trigger
+        if all(self.scene.delivered(n, pose) for n, pose in means.items()):
+            self.done = True
+            return
+        self._spent += counted
+        if self._spent > BUDGET:
+            self.reason = f"the re-plan budget ({BUDGET}) is spent: {why}"
+            return
+        observed = replace(self.scene, parts=tuple(replace(p, start=means[p.name]) for p in self.scene.parts))
+        session = Planner(observed, self.session.options)
+        found = session.plan(seed=self.seed)
+        if not found.solved:
+            self.reason = f"no plan of the moves left ({why}): {found.reason}"
+            return
+        left, pusher = self.moving, self._held[0]
+        self.session, self.plan = session, found
+        mover, lone, goal = self._move()
+        way = None
+        if lone.part != left:
+            edge = first_edge(lone)
+            reach = edge_contact_pose(observed.part(lone.part).slider, edge, lone.start)
+            way = session.paths.find(means, left, pusher, lone.part, edge, reach, self.seed)
+        latency = time.perf_counter() - clock  # the plan and its transfer: the pusher waits for both
+        if way is not None:
+            # The transfer as the new plan's way in: the tracker follows it as it does its approaches.
+            lone = lone.with_segments([Transit(way.to_edge, way.to_edge, way.mode, way.pusher_path, way.duration,
+                                               lone.start), *lone.segments])
+        try:
+            tracker = Tracker(mover, lone, pusher=None if way is not None else pusher, time=now + latency,
+                              noise=self.noise, seed=self.seed, goal=goal)
+        except SceneError as err:
+            self.reason = f"no way for the pusher from {left} to {lone.part}: {err.problem}"
+            return
+        self._past += [*self.tracker.replans, Replan(now, means[name], trigger, error, why, latency, found,
+                                                     observed.pusher.mu)]
+        self._carried += self.tracker.carried
+        self.tracker, self._held, self._strikes = tracker, None, {}
+        self._left = left if lone.part != left else None
+
+
+def _after_first_move(plan: Plan, motion: Trajectory) -> float:
+    """Seconds of ``motion``, the trajectory of ``plan``, after its first move (the later moves,
+    with their transfers): 0 for a plan of one move."""
+    later = motion.segment >= len(plan.moves[0].segments)  # the first move has no transfer
+    return motion.duration - float(motion.t[later][0]) if later.any() else 0.0
+
+
+def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | None, starts: dict[str, np.ndarray],
+         bumps: tuple, noise: np.ndarray, rng: np.random.Generator, seed: int | None, later: float) -> ClosedRun:
+    """One run of :func:`closed_loop`, each part on its ``supports`` and placed at ``starts``;
+    ``later`` is how long the plan runs after its first move (:func:`_after_first_move`)."""
     scene = session.scene
     clock = time.perf_counter()
-    world = World(scene, {scene.part().name: support}, mu, starts, bumps)
-    tracker = Tracker(session, plan, pusher=lead, noise=(float(noise[0]), float(noise[1])), seed=seed)
-    limit = PATIENCE * tracker.motion.duration + GRACE
+    world = World(scene, supports, mu, starts, bumps)
+    loop = _Loop(session, plan, (float(noise[0]), float(noise[1])), seed)
+    limit = PATIENCE * (loop.tracker.motion.duration + later) + GRACE
 
-    def pusher(u: float):
-        pose, height, rate, _ = tracker.pusher_at(u)
+    def pusher(u: float) -> tuple[list[float], list[float]]:
+        pose, height, rate, _ = loop.pusher_at(u)
         return [pose[0], pose[1], height, pose[2]], [rate[0], rate[1], rate[3], rate[2]]
 
     every = max(1, round(RATE / OBSERVE_HZ))
-    rows, collisions, k = [], 0, 0
+    rows, moving, collisions, faults, k = [], [], 0, {}, 0
     while True:
         u = k / RATE
         world.step_to(SETTLE + u, pusher)
-        pose, height, rate, contact = tracker.pusher_at(u)
-        rows.append([u, *pose, *rate[:3], height, contact, len(tracker.replans), *world.pose()])
-        collisions += bool(world.faults(scene.names))  # the pusher may touch the one part at any time
+        pose, height, rate, contact = loop.pusher_at(u)
+        parts = np.ravel([world.pose(n) for n in scene.names])
+        rows.append([u, *pose, *rate[:3], height, contact, len(loop.replans), *parts])
+        moving.append(loop.moving)
+        now = world.faults(loop.allowed)
+        collisions += bool(now)
+        for fault in now:
+            faults.setdefault(fault, u)
         if k % every == 0:
-            seen = world.pose() + rng.normal(0.0, [noise[0], noise[0], noise[1]])
-            if tracker.observe(u, seen).kind.ended or u > limit:
+            seen = {n: world.pose(n) + rng.normal(0.0, [noise[0], noise[0], noise[1]]) for n in scene.names}
+            if loop.observe(u, seen) or u > limit:
                 break
         k += 1
     table = np.array(rows)
     table[:, 3] = wrap_angle(table[:, 3])
-    executed = Trajectory(*table[:, :8].T, table[:, 8].astype(int), table[:, 9].astype(int))
-    part = table[:, 10:13]
-    end = world.pose()
-    error = (math.hypot(*(end[:2] - scene.goal[:2])), abs(float(wrap_angle(end[2] - scene.goal[2]))))
-    reason = tracker.reason or ("" if tracker.done else f"not done after {limit:.0f} s")
-    return ClosedRun(support, error, scene.within_tolerance(end), tuple(tracker.replans), reason, collisions,
-                     time.perf_counter() - clock, float(table[-1, 0]), executed, part, tuple(tracker.carried))
+    executed = Trajectory(*table[:, :8].T, table[:, 8].astype(int), table[:, 9].astype(int),
+                          part=np.array(moving) if len(scene.parts) > 1 else None)
+    tracks = {n: table[:, 10 + 3 * j:13 + 3 * j] for j, n in enumerate(scene.names)}
+    ends = {n: world.pose(n) for n in scene.names}
+    reason = loop.reason or ("" if loop.done else f"not done after {limit:.0f} s")
+    return ClosedRun(dict(supports), {n: _error(end, scene.part(n).goal) for n, end in ends.items()},
+                     {n: scene.delivered(n, end) for n, end in ends.items()}, tuple(loop.replans), reason, collisions,
+                     time.perf_counter() - clock, float(table[-1, 0]), executed, tracks, tuple(loop.carried),
+                     tuple((t, what) for what, t in faults.items()))
 
 
 def closed_loop(session: Planner, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
                 cf_offset: ArrayLike = (0.0, 0.0), start_error: ArrayLike = (0.0, 0.0, 0.0), bumps: ArrayLike = (),
                 noise: ArrayLike = (0.0, 0.0)) -> ClosedLoop:
-    """Run ``plan`` closed-loop in MuJoCo once per foot set of :func:`.mujoco_sim.feet`
-    (module docstring), re-planning with ``session`` (its scene is the one run).
+    """Run ``plan``, of one part or several, closed-loop in MuJoCo once per foot set: run ``k``
+    puts every part on the ``k``-th of its own :func:`.mujoco_sim.feet` (module docstring),
+    re-planning with ``session`` (its scene is the one run; for several parts, its move sessions
+    track the first plan's first move).
 
     ``seed`` draws the foot sets, the observation noise and the re-plans; the perturbations are
     :func:`.mujoco_sim.perturbations`' (``noise``: ``(sigma_m, sigma_rad)``).
@@ -184,10 +395,10 @@ def closed_loop(session: Planner, plan: Plan, n: int = 3, seed: int = 1, mu: flo
     """
     needs_mujoco()
     scene = session.scene
-    supports = feet(scene, n, seed, cf_offset)
+    sets = foot_sets(scene, n, seed, cf_offset)
     setup = perturbations(scene, plan, session.model, start_error, bumps, noise)
-    lead = lead_in_pose(scene, session.model, plan)
     rng = np.random.default_rng(seed)
     sigma = np.asarray(noise, dtype=float)
-    runs = tuple(_run(session, plan, s, mu, setup.starts, setup.bumps, sigma, rng, lead, seed) for s in supports)
-    return ClosedLoop(runs, scene.pusher.mu if mu is None else mu, setup.starts[scene.part().name])
+    later = _after_first_move(plan, setup.motion)
+    runs = tuple(_run(session, plan, s, mu, setup.starts, setup.bumps, sigma, rng, seed, later) for s in sets)
+    return ClosedLoop(runs, scene.pusher.mu if mu is None else mu, setup.starts)

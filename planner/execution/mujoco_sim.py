@@ -87,8 +87,8 @@ from ..world.validity import CollisionModel
 from .approach import first_edge, lead_in_pose
 from .trajectory import Trajectory, planned_part, trajectory
 
-__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "Feet", "Perturbed", "Run", "Runs", "Simulation", "World", "feet",
-           "mjcf", "needs_mujoco", "perturbations", "simulate", "support_centre", "write_mjcf"]
+__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "ByPart", "Feet", "Perturbed", "Run", "Runs", "Simulation", "World", "feet",
+           "foot_sets", "mjcf", "needs_mujoco", "perturbations", "simulate", "support_centre", "write_mjcf"]
 
 #: The one line ``plan --simulate`` prints (after ``plan: error: --simulate: ``) without MuJoCo.
 MISSING = "needs MuJoCo: pip install 'stablepush[mujoco]'"
@@ -163,6 +163,13 @@ def feet(scene: Scene, n: int, seed: int = 1, offset: ArrayLike = (0.0, 0.0)) ->
                 and (weights := np.linalg.solve(a, [*centre, 1.0])).min() >= 0.05):
             out.append(Feet("random", points, weights, centre))
     return out
+
+
+def foot_sets(scene: Scene, n: int, seed: int = 1, offset: ArrayLike = (0.0, 0.0)) -> list[dict[str, Feet]]:
+    """The feet of ``n`` runs, by part name: run ``k`` puts every part on the ``k``-th of its own
+    :func:`feet` (``seed`` and ``offset`` as there)."""
+    sets = {name: feet(scene.move_scene(name, scene.starts), n, seed, offset) for name in scene.names}
+    return [{name: s[k] for name, s in sets.items()} for k in range(n)]
 
 
 def _numbers(values: ArrayLike) -> str:
@@ -370,8 +377,36 @@ def _worst(errors: Mapping[str, tuple[float, float]]) -> str:
     return max(errors, key=lambda name: errors[name][0])
 
 
+class ByPart:
+    """What a run, open or closed loop, reports of each part by name (``supports``,
+    ``goal_errors``, ``delivered``, ``tracks``), read as a whole: the one part's feet, the
+    farthest-off part's goal error, whether every part is in its goal, the one part's poses."""
+
+    supports: dict[str, Feet]
+    goal_errors: dict[str, tuple[float, float]]
+    delivered: dict[str, bool]
+    tracks: dict[str, np.ndarray]
+
+    @property
+    def feet(self) -> Feet:
+        return _one(self.supports)
+
+    @property
+    def goal_error(self) -> tuple[float, float]:
+        return self.goal_errors[_worst(self.goal_errors)]
+
+    @property
+    def in_goal(self) -> bool:
+        """Every part ends within tolerance of its goal."""
+        return all(self.delivered.values())
+
+    @property
+    def poses(self) -> np.ndarray:
+        return _one(self.tracks)
+
+
 @dataclass(frozen=True)
-class Run:
+class Run(ByPart):
     """One open-loop run of a whole plan, each part on one foot set of its own.
 
     Attributes
@@ -420,25 +455,8 @@ class Run:
     segment_slip: tuple[float, ...]
 
     @property
-    def feet(self) -> Feet:
-        return _one(self.supports)
-
-    @property
-    def poses(self) -> np.ndarray:
-        return _one(self.tracks)
-
-    @property
-    def goal_error(self) -> tuple[float, float]:
-        return self.goal_errors[_worst(self.goal_errors)]
-
-    @property
     def final_error(self) -> tuple[float, float]:
         return self.final_errors[_worst(self.final_errors)]
-
-    @property
-    def in_goal(self) -> bool:
-        """Every part ends within tolerance of its goal."""
-        return all(self.delivered.values())
 
     @property
     def passed(self) -> bool:
@@ -691,10 +709,7 @@ def _error(end: np.ndarray, target: np.ndarray) -> tuple[float, float]:
 def _first_move(scene: Scene, plan: Plan) -> tuple[Scene, Plan]:
     """The plan's first move as the plan of its one part, in the scene of moving it (the other
     parts obstacles where they start; the scene itself for a scene of one part)."""
-    first = plan.moves[0]
-    return (scene.move_scene(first.part, plan.starts),
-            Plan.of_part(first.part, plan.starts[first.part], first.end, first.segments, scene=None, solved=True,
-                         planner=plan.planner, seed=plan.seed, planning_time_s=0.0))
+    return scene.move_scene(plan.moves[0].part, plan.starts), plan.move_plan()
 
 
 def _lead_in(scene: Scene, plan: Plan, model: CollisionModel) -> Trajectory:
@@ -802,7 +817,7 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
         perturbation is bad (:func:`perturbations`).
     """
     needs_mujoco()
-    sets = {name: feet(scene.move_scene(name, scene.starts), n, seed, cf_offset) for name in scene.names}
+    sets = foot_sets(scene, n, seed, cf_offset)
     setup = perturbations(scene, plan, None, start_error, bumps)
-    runs = tuple(_run(scene, plan, setup, {name: s[k] for name, s in sets.items()}, mu) for k in range(n))
+    runs = tuple(_run(scene, plan, setup, supports, mu) for supports in sets)
     return Simulation(runs, scene.pusher.mu if mu is None else mu, setup.motion, setup.starts, setup.planned)

@@ -182,6 +182,9 @@ class Tracker:
         The re-plans' seed (default: the session's).
     time_limit : float
         Each re-plan's search time limit, s (:data:`REPLAN_LIMIT`).
+    goal : (3,) array_like, optional
+        Where the part is taken (default: the scene's goal): a move of a scene of several parts
+        may leave its part aside, at a buffer pose, for a later move.
 
     Raises
     ------
@@ -199,7 +202,8 @@ class Tracker:
 
     def __init__(self, session: Planner, plan: Plan, *, pusher: ArrayLike | None = None, time: float = 0.0,
                  noise: tuple[float, float] = (0.0, 0.0), confirm: int = CONFIRM, settle: int = SETTLE,
-                 budget: int = BUDGET, seed: int | None = None, time_limit: float = REPLAN_LIMIT):
+                 budget: int = BUDGET, seed: int | None = None, time_limit: float = REPLAN_LIMIT,
+                 goal: ArrayLike | None = None):
         if not isinstance(session, Planner):
             raise SceneError("session", f"must be a Planner, got {type(session).__name__}")
         if not (isinstance(plan, Plan) and plan.solved and plan.segments):
@@ -217,6 +221,8 @@ class Tracker:
         if not 0 < float(time_limit) < math.inf:
             raise SceneError("time_limit", f"must be a positive number of seconds, got {time_limit}")
         self.confirm, self.settle, self.budget, self.seed = confirm, settle, budget, seed
+        #: Where the part is taken; None: the scene's goal (the session's plans and certificates default to it).
+        self.goal = None if goal is None else self._pose(goal, "goal")
         self.time_limit = min(float(time_limit), session.options.time_limit)
         #: The re-plans so far.
         self.replans: list[Replan] = []
@@ -356,7 +362,7 @@ class Tracker:
 
     def _settled(self, now: float, part: np.ndarray, error: tuple[float, float]) -> Command:
         """The part observed at rest at ``part`` (the mean): done, re-planned, or given up."""
-        if self.scene.within_tolerance(part):
+        if self.scene.within_tolerance(part, self.goal):
             self.done = True
             return self._command(Action.DONE, now, error)
         if len(self.replans) + len(self.carried) >= self.budget:
@@ -365,7 +371,7 @@ class Tracker:
         trigger, trigger_error, why, slid = self._trigger
         if slid:
             why += self._lower_friction()
-        certificate = self.session.certify_unreachable(start=part)
+        certificate = self.session.certify_unreachable(self.goal, start=part)
         if certificate:
             return self._give_up(now, error, f"the goal is unreachable from the observed pose: {certificate}")
         pusher = self._held[0]
@@ -374,16 +380,16 @@ class Tracker:
             # back to the part; then one that begins on an edge the pusher can get to from there.
             found = None
             if self._approach(pusher, part, self._edge) is not None:
-                found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=[self._edge],
-                                          observed=True)
+                found = self.session.plan(start=part, goal=self.goal, seed=self.seed, time_limit=self.time_limit,
+                                          edges=[self._edge], observed=True)
             if found is None or not found.solved:
                 others = [e for e in self.session.stable_edges if e != self._edge]
                 reached = [e for e in others if self._approach(pusher, part, e) is not None]
                 if not reached and found is None:
                     return self._carry_on(now, error, "no free approach from the pusher to any edge of the part", clock)
                 if reached:
-                    found = self.session.plan(start=part, seed=self.seed, time_limit=self.time_limit, edges=reached,
-                                              observed=True)
+                    found = self.session.plan(start=part, goal=self.goal, seed=self.seed, time_limit=self.time_limit,
+                                              edges=reached, observed=True)
         except SceneError as err:  # the pusher has no room at the observed pose
             return self._carry_on(now, error, f"no plan from the observed pose: {err.problem}", clock)
         if not found.solved or not found.segments:

@@ -113,6 +113,14 @@ class Plan:
                    delivered=(part,) if fields.get("solved") else (),
                    cfs={} if cf is None else {part: np.asarray(cf, dtype=float)}, **fields)
 
+    def move_plan(self, k: int = 0) -> "Plan":
+        """Move ``k`` as the plan of its one part (solved, planning time 0): from where the moves
+        before it leave the part to where this one does, without its transfer."""
+        move = self.moves[k]
+        where = {**self.starts, **{m.part: m.end for m in self.moves[:k]}}
+        return Plan.of_part(move.part, where[move.part], move.end, move.segments, scene=None, solved=True,
+                            planner=self.planner, seed=self.seed, planning_time_s=0.0)
+
     def with_segments(self, segments: list[Segment]) -> "Plan":
         """This plan of one part, by ``segments`` instead of its own."""
         return replace(self, moves=[Move(self.part, list(segments))] if segments else [])

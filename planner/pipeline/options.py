@@ -104,17 +104,12 @@ class RunOptions:
 
     def _fit(self, scene: Scene) -> None:
         """Refuse what ``scene`` does not take: a part it does not have, or one not named where
-        it has several; what the closed loop cannot do for several parts yet. (A start error of a
-        scene of several parts moves the part the plan moves first, which only the plan knows:
-        the simulation checks where it puts it.)"""
+        it has several. (A start error of a scene of several parts moves the part the plan moves
+        first, which only the plan knows: the simulation checks where it puts it.)"""
         if self.part is not None:
             scene.part(self.part)
         elif self.reach is not None and len(scene.parts) > 1:
             raise SceneError("part", f"the reachable set is one part's: name one of {', '.join(scene.names)}")
-        if len(scene.parts) > 1:
-            for name in ("pose_noise", "closed_loop"):
-                if getattr(self, name) not in (None, False, ()):
-                    raise SceneError(name, "is for one-part scenes (slider, start, goal), not a scene with parts")
         if self.sim_cf_offset is not None:
             from ..execution.mujoco_sim import support_centre
 

@@ -118,7 +118,9 @@ def _simulated(scene: Scene, options: RunOptions, result: Plan, session: Planner
 
     if session is None:
         session = Planner(scene)
-        session.plan(start=result.start)  # a plan for the goal that re-plans are joined to
+        # A plan for the goal that re-plans are joined to; a tray's move sessions are made as its moves are tracked.
+        if len(scene.parts) == 1:
+            session.plan(start=result.start)
     return closed_loop(session, result, options.simulate, seed, options.sim_mu, cf_offset, start_error,
                        options.bumps, options.pose_noise or (0.0, 0.0))
 
