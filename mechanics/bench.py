@@ -2,7 +2,7 @@
 
 For every case of the stored reference regions (``tests/data/exact_regions_v2.json``: each shipped
 scene's allowed edges, parts shared by several scenes once, and the fixtures of
-``tests/test_exact_region.py`` and ``tests/test_uncertainty.py``) it prints the per-edge cold CPU
+``tests/mechanics/test_exact_region.py`` and ``tests/planner/queries/test_uncertainty.py``) it prints the per-edge cold CPU
 time of procedure STABLE and of the exact region (a fresh computation, no cache), the exact
 time the reference recorded for the previous algorithm, the area ratio of the new region to
 the stored one, and the region's gap bound (how far the true boundary may lie beyond it, as a

@@ -68,7 +68,7 @@ __all__ = ["DEFAULT_PLANNER", "OneStep", "Plan", "Planner", "PlannerOptions", "R
 #: Every public name is imported on first use, from its module: ``import planner`` itself loads
 #: nothing (the ``plan`` command sets up the process before numpy is loaded, planner.cli), and the
 #: controllability report (scipy) and the re-simulator are loaded only where used
-#: (tests/test_startup.py).
+#: (tests/planner/test_startup.py).
 _ON_FIRST_USE = {
     "SceneError": ".model.fields", "DEFAULT_PLANNER": ".model.options", "PlannerOptions": ".model.options",
     "Planner": ".queries.session", "Plan": ".model.plan", "Move": ".model.plan", "Push": ".model.segments",

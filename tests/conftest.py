@@ -47,8 +47,8 @@ def region_cache(request, tmp_path_factory):
         os.environ["STABLEPUSH_CACHE"] = old
 
 
-# Hypothesis (tests/test_fuzz_scenes.py): CI runs a fixed, derandomised budget that keeps the fuzz
-# tests within about half a minute on two cores; `--hypothesis-profile long` runs 10,000 examples a
+# Hypothesis (tests/planner/model/test_fuzz_scenes.py): CI runs a fixed, derandomised budget that
+# keeps the fuzz tests within about half a minute on two cores; `--hypothesis-profile long` runs 10,000 examples a
 # test with fresh randomness (its example database, in .hypothesis/, which Hypothesis git-ignores
 # itself, replays a failure first on the next run). Examples touch files, so no deadline.
 _FUZZ = dict(deadline=None, print_blob=True, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])

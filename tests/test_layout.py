@@ -114,3 +114,23 @@ def test_the_walker_resolves_relative_imports_at_any_depth():
     found = [t for t, _ in _imports_of(source, "planner.model")]
     assert found == ["numpy", "planner.model", "planner.model.fields", "planner.search.planning"]
     assert _rank("planner.search.planning") > _rank("planner.model.scene")  # so it is caught
+
+
+#: The tests of the project as a whole (its layout, its README, its documents' references), at tests/.
+PROJECT_TESTS = {"test_layout.py", "test_readme.py", "test_docs_refs.py"}
+
+
+def test_the_tests_mirror_the_packages():
+    """A test module lives in the folder of the package it tests (tests/mechanics/ for mechanics,
+    tests/planner/<role>/ for a role package, tests/planner/ for the command), so that the tests
+    of a package are found beside each other; only the project's own tests stand at tests/."""
+    misplaced = []
+    for path in sorted((ROOT / "tests").rglob("test_*.py")):
+        folder = path.parent.relative_to(ROOT / "tests")
+        if folder == Path("."):
+            if path.name not in PROJECT_TESTS:
+                misplaced.append(f"{path.name}: at tests/, but it tests no part of the project as a whole")
+        elif not (ROOT / folder / "__init__.py").is_file():
+            misplaced.append(f"{folder / path.name}: {folder} is not a package of the project")
+    assert misplaced == []
+    assert {p.name for p in (ROOT / "tests").glob("test_*.py")} == PROJECT_TESTS

@@ -15,7 +15,7 @@ everything else is prose, kept as written. The blocks:
   the committed table).
 
 Every block comes from seed-1 plans, which a seed decides, and seeded simulations: regenerating
-twice changes nothing. tests/test_docs.py fails when a committed block or picture no longer
+twice changes nothing. tests/planner/bench/test_docs.py fails when a committed block or picture no longer
 matches what this makes.
 """
 

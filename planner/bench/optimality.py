@@ -11,7 +11,7 @@ bound, the median length and switches, and the median time to the first plan.
 The best-known plans are plan files, one per scene, in a folder (``--best``, default
 ``scenes/best``): the cheapest plan ever found for the scene by any method. With ``--record``,
 every plan that beats its scene's is written there (atomically), so the reference only gets
-better; tests/test_best_known.py replays and verifies every one of them.
+better; tests/planner/queries/test_best_known.py replays and verifies every one of them.
 """
 
 from __future__ import annotations

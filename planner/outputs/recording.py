@@ -493,7 +493,7 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
     stream = rec.binary_stream()
     try:
         # Active, not only default: in a stream the data comes first, and the viewer would keep the
-        # layout it makes up for it (seen in the web viewer; tests/test_recording.py checks the file).
+        # layout it makes up for it (seen in the web viewer; tests/planner/outputs/test_recording.py checks the file).
         rec.send_blueprint(blueprint, make_active=True, make_default=True)
         _log_static(rec, scene, plan, look)
         if plan.moves:

@@ -1,0 +1,291 @@
+"""Whole plans run open-loop in MuJoCo (planner.execution.mujoco_sim, ``plan --simulate``).
+
+The battery's seed-1 plan (one push) is run on a few support distributions: as planned it ends
+within the scene's tolerance without slip or collision; with far less pusher friction than planned,
+or the centre of pressure moved well off the CF, some run slips or misses the goal (exit 3), and
+the recording shows that run's part where the printed line says it ended. A lift on its own
+(narrow_junction's) leaves the part where it was. Without MuJoCo, ``--simulate`` is bad input
+with one line saying how to install it. A plan of several parts runs through the same simulation:
+its model (every part a body of its own) loads in MuJoCo, a start error moves the part moved first
+and a bump the part the pusher is on.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from planner import load_scene, plan
+from planner.cli import main
+from planner.model.plan import Plan
+from test_recording import rrd_rows
+
+ROOT = Path(__file__).resolve().parents[3]
+BATTERY = str(ROOT / "scenes" / "battery.yaml")
+
+
+def test_without_mujoco_simulate_is_one_line_of_bad_input(tmp_path):
+    """``import mujoco`` made to fail in a fresh interpreter: the line, exit 1, nothing written."""
+    script = f"""
+import sys
+sys.modules["mujoco"] = None  # an import of it raises ImportError
+from planner.cli import main
+sys.exit(main([{BATTERY!r}, "--simulate", "2", "--out", {str(tmp_path / 'out')!r}]))
+"""
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert run.returncode == 1
+    assert run.stderr.strip() == "plan: error: --simulate: needs MuJoCo: pip install 'stablepush[mujoco]'"
+    assert not (tmp_path / "out").exists()
+
+
+mujoco = pytest.importorskip("mujoco", reason="MuJoCo is not installed: pip install 'stablepush[mujoco]'")
+
+
+@pytest.fixture(scope="module")
+def battery():
+    scene = load_scene(BATTERY)
+    return scene, plan(scene, seed=1)
+
+
+def test_the_battery_plan_reaches_the_goal_in_mujoco(battery):
+    from planner.execution.mujoco_sim import SLIP, simulate
+
+    scene, result = battery
+    simulation = simulate(scene, result, n=3, seed=1)
+    assert [r.feet.kind for r in simulation.runs] == ["grid", "extreme", "random"]
+    for run in simulation.runs:
+        assert run.goal_error[0] <= scene.tolerance_position and run.goal_error[1] <= scene.tolerance_angle
+        assert run.in_goal and run.slip <= SLIP and run.collisions == 0
+        assert run.deviation < scene.tolerance_position
+    assert simulation.passed
+
+
+def test_plan_simulate_passes_and_writes_a_model_mujoco_reads(tmp_path, capsys):
+    model = tmp_path / "battery.xml"
+    code = main([BATTERY, "--simulate", "3", "--mjcf", str(model), "--trajectory", "--out", str(tmp_path / "out")])
+    lines = capsys.readouterr().out.splitlines()
+    assert code == 0
+    assert [line.split(" (")[0] for line in lines[1:4]] == ["simulate 1/3", "simulate 2/3", "simulate 3/3"]
+    assert lines[4].startswith("simulate: passed: 3/3 runs")
+    loaded = mujoco.MjModel.from_xml_path(str(model))
+    assert loaded.body("part").id > 0 and loaded.body("pusher").id > 0
+    # Keyframes along the run: the pusher where the trajectory has it at the key's time.
+    csv = np.loadtxt(tmp_path / "out" / "battery.trajectory.csv", delimiter=",", skiprows=1)
+    assert loaded.nkey == math.ceil(csv[-1, 0]) + 1 and loaded.key("start").time[0] == 0.0
+    pusher = loaded.joint("pusher_x").qposadr[0] + np.array([0, 1, 2, 3])
+    for k in range(loaded.nkey):
+        time, qpos = loaded.key(k).time[0], loaded.key(k).qpos
+        row = csv[np.argmin(np.abs(csv[:, 0] - time))]
+        assert abs(row[0] - time) < 1e-9 and np.allclose(qpos[pusher], row[[1, 2, 7, 3]], atol=1e-9)
+
+
+def pose_of(strip: np.ndarray, vertices: np.ndarray) -> np.ndarray:
+    """The rigid pose that puts the part's ``vertices`` on the closed outline ``strip`` (least squares)."""
+    drawn = np.asarray(strip, dtype=float)[:-1]
+    a, b = vertices - vertices.mean(axis=0), drawn - drawn.mean(axis=0)
+    theta = np.arctan2((a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum(), (a * b).sum())
+    c, s = np.cos(theta), np.sin(theta)
+    origin = drawn.mean(axis=0) - np.array([[c, -s], [s, c]]) @ vertices.mean(axis=0)
+    assert np.abs(drawn - (origin + vertices @ np.array([[c, s], [-s, c]]))).max() < 1e-6  # a rigid copy (rerun keeps float32)
+    return np.array([*origin, theta])
+
+
+@pytest.mark.parametrize("flags", [["--sim-mu", "0.01"], ["--sim-cf-offset", "0", "-0.012"]],
+                         ids=["friction-far-below-plan", "centre-of-pressure-off-the-cf"])
+def test_a_plan_simulated_outside_its_assumptions_fails(tmp_path, capsys, flags):
+    code = main([BATTERY, "--simulate", "3", "--out", str(tmp_path / "out"), *flags])
+    out = capsys.readouterr().out
+    assert code == 3
+    assert "simulate: FAILED" in out and ("SLIPS" in out or "misses the goal" in out)
+    assert (tmp_path / "out" / "battery.json").is_file()
+    # The recording shows the run straying farthest, ending where its line says it ended.
+    runs = [(float(d), float(e)) for e, d in re.findall(r"from the plan's end ([\d.e+-]+) m.*?path deviation ([\d.e+-]+) m",
+                                                      out)]
+    _, ended = max(runs)
+    rrd = tmp_path / "out" / "battery.rrd"
+    shown = [strip for _, (strip,) in rrd_rows(rrd, "/world/simulated", "LineStrips3D:strips", "step")]
+    planned = [strip for _, (strip,) in rrd_rows(rrd, "/world/slider", "LineStrips3D:strips", "step")]
+    assert len(shown) == len(planned) > 2
+    vertices = load_scene(BATTERY).slider.vertices
+    start, first = pose_of(planned[0], vertices), pose_of(shown[0], vertices)
+    assert np.abs(first - start).max() < 1e-3  # both start at the start: the part settled on its feet
+    gap = np.linalg.norm(pose_of(shown[-1], vertices)[:2] - pose_of(planned[-1], vertices)[:2])
+    assert gap == pytest.approx(ended, rel=0.01)
+    (_, summary), = rrd_rows(rrd, "/log/simulate", "TextLog:text")
+    assert summary[0].startswith("simulate: FAILED")
+
+
+def test_a_lift_alone_leaves_the_part_where_it_is():
+    """The pusher rises straight off the part and lands beside it: the part does not move. (Rising
+    while turning once swung the face's ends into it: 1.7 mm and 1.5 degrees.)"""
+    from planner.execution.mujoco_sim import simulate
+
+    scene = load_scene(ROOT / "scenes" / "narrow_junction.yaml")
+    result = plan(scene, seed=1)
+    lift = next(s for s in result.segments if s.kind == "transit" and s.mode == "lift")
+    alone = Plan.of_part("part", lift.pose, lift.pose, [lift],
+                         scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0)
+    (run,) = simulate(scene, alone, n=1).runs
+    assert run.collisions == 0 and run.final_error[0] < 5e-5 and run.final_error[1] < 1e-3
+    assert run.deviation < 5e-5
+
+
+@pytest.mark.parametrize("argv, field", [(["--sim-mu", "0.5"], "--sim-mu"), (["--simulate", "0"], "--simulate"),
+                                         (["--simulate", "1", "--sim-cf-offset", "1", "0"], "--sim-cf-offset")])
+def test_bad_simulation_flags_are_bad_input(tmp_path, capsys, argv, field):
+    assert main([BATTERY, "--out", str(tmp_path / "out"), *argv]) == 1
+    assert capsys.readouterr().err.startswith(f"plan: error: {field}: ")
+    assert not (tmp_path / "out").exists()
+
+
+def test_pushes_inside_the_exact_region_stick_and_pushes_outside_slip_in_mujoco(monkeypatch):
+    """The battery's pushing edge, six vertices of its exact region beyond STABLE's: the twist 5 %
+    closer to the region's centre and the one 10 % farther out, each pushed 6 cm (the part's
+    fastest point) on the simulator's own foot sets and on the distribution the independent LP
+    (tests/oracle.py, no ``mechanics`` code) finds worst for the outside twist, two or three feet
+    on the part's rim. Slip is the pusher face's motion in the part frame over the push, against
+    :data:`SLIP` (five times the soft contact's penetration): every inside run stays under it; on
+    its worst distribution every outside twist slips past it, and by at least twice as far as the
+    inside twist on the same feet (the outside twists do not slip on a grid of feet: only some
+    distributions break them, which is what the region guards against)."""
+    import shapely
+    from scipy.optimize import linprog
+
+    import oracle as O
+    import planner.execution.mujoco_sim as sim
+    from mechanics import exact_region
+    from planner.model.segments import Push
+
+    scene = load_scene(BATTERY)
+    slider, pusher = scene.slider, scene.pusher
+    edge = scene.edges[0]
+    region = exact_region(slider, edge, pusher.mu, pusher.width)
+    polygon, centre = region.section()
+    ring = np.asarray(polygon.exterior.coords)[:-1]
+    beyond = ring[~region.stable.contains(region.plane.twists(ring))]
+    rim = shapely.get_coordinates(shapely.line_interpolate_point(
+        shapely.Polygon(slider.vertices).exterior, np.linspace(0, 1, 96, endpoint=False), normalized=True))
+    lp = O.LPOracle(O.Reference(slider.vertices, slider.cf, edge, pusher.mu, pusher.width),
+                    np.vstack([O.support_samples(slider.vertices, 24), rim]))
+
+    def worst_feet(twist):
+        g = lp.wrenches(twist)
+        runs = [linprog(-(g @ a), A_eq=lp.A_eq, b_eq=lp.b_eq, bounds=(0, None), method="highs") for a in lp.facets]
+        best = min(runs, key=lambda res: res.fun)
+        assert -best.fun > 1e-9  # the LP breaks sticking: this twist is not stable
+        on = best.x > 1e-9
+        return sim.Feet("worst", lp.x[on], best.x[on] / best.x[on].sum(), slider.cf)
+
+    def slips(twist, feet):
+        speed = max(math.hypot(*twist[:2]), abs(twist[2]) * slider.radius)
+        push = Push.along(edge, region.contact, twist, 0.06 / speed, scene.start)
+        one = Plan.of_part("part", scene.start, push.end, [push],
+                           scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0)
+        monkeypatch.setattr(sim, "feet", lambda *args, **kwargs: feet)
+        return np.array([run.slip for run in sim.simulate(scene, one, n=len(feet)).runs])
+
+    own = sim.feet(scene, 3, seed=1)
+    for vertex in beyond[np.linspace(0, len(beyond), 6, endpoint=False).astype(int)]:
+        inside, outside = region.plane.twists(centre + np.array([[0.95], [1.10]]) * (vertex - centre))
+        assert region.contains(inside) and not region.contains(outside)
+        worst = worst_feet(outside)
+        stuck = slips(inside, [worst, *own])
+        slipped = slips(outside, [worst])[0]
+        assert stuck.max() <= sim.SLIP, (vertex, stuck)
+        assert slipped > sim.SLIP and slipped >= 2 * stuck[0], (vertex, stuck, slipped)
+
+
+CHANNEL = str(ROOT / "scenes" / "parts" / "channel.yaml")
+
+
+@pytest.fixture(scope="module")
+def channel():
+    from planner import Planner
+
+    scene = load_scene(CHANNEL)
+    return scene, Planner(scene, {"seed": 1, "time_limit": 60}).plan()
+
+
+def test_one_part_and_several_run_through_the_same_simulation_and_a_tray_model_loads(tmp_path, monkeypatch, channel):
+    """``plan --simulate`` calls the one :func:`simulate` for a scene of one part and of several;
+    the channel's ``--mjcf`` model loads, every part a body of its own, with keyframes of the planned
+    parts and the pusher along the run."""
+    import planner.execution.mujoco_sim as sim
+
+    scene, result = channel
+    calls, real = [], sim.simulate
+    monkeypatch.setattr(sim, "simulate", lambda scene, plan, *args: calls.append(len(scene.parts)) or real(scene, plan, *args))
+    assert main([BATTERY, "--simulate", "1", "--out", str(tmp_path / "one")]) == 0
+    (tmp_path / "channel.json").write_text(result.to_json())
+    model = tmp_path / "channel.xml"
+    assert main([CHANNEL, "--plan", str(tmp_path / "channel.json"), "--simulate", "1", "--mjcf", str(model),
+                 "--trajectory", "--out", str(tmp_path / "two")]) == 0
+    assert calls == [1, 2]
+    loaded = mujoco.MjModel.from_xml_path(str(model))
+    assert loaded.body("part0").id > 0 and loaded.body("part1").id > 0 and loaded.body("pusher").id > 0
+    csv = np.loadtxt(tmp_path / "two" / "channel.trajectory.csv", delimiter=",", skiprows=1, usecols=range(10))
+    assert loaded.nkey == math.ceil(csv[-1, 0]) + 1
+    parts = {name: loaded.joint(f"part{k}_x").qposadr[0] + np.arange(3) for k, name in enumerate(scene.names)}
+    pusher = loaded.joint("pusher_x").qposadr[0] + np.arange(4)
+    first, last = loaded.key("start").qpos, loaded.key(loaded.nkey - 1).qpos
+    for name, slots in parts.items():
+        assert np.allclose(first[slots], scene.starts[name]) and np.allclose(last[slots], result.finals[name], atol=1e-9)
+    for k in range(loaded.nkey):
+        time, qpos = loaded.key(k).time[0], loaded.key(k).qpos
+        row = csv[np.argmin(np.abs(csv[:, 0] - time))]
+        assert abs(row[0] - time) < 1e-9 and np.allclose(qpos[pusher], row[[1, 2, 7, 3]], atol=1e-9)
+
+
+def test_the_tray_model_has_every_part_on_its_feet_and_every_contact_that_tells():
+    """Every part of the tray a body at its start on its own feet; contacts of the pusher with every
+    part, and of every part with every other part and with the walls."""
+    from planner.execution.mujoco_sim import feet, mjcf
+
+    scene = load_scene(ROOT / "scenes" / "parts" / "tray.yaml")
+    supports = {name: feet(scene.move_scene(name, scene.starts), 1)[0] for name in scene.names}
+    model = mujoco.MjModel.from_xml_string(mjcf(scene, supports))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("start").id)
+    bodies = [model.body(model.geom_bodyid[g]).name for g in range(model.ngeom)]  # walls: the world's
+    pairs = {frozenset((bodies[model.pair_geom1[i]], bodies[model.pair_geom2[i]])) for i in range(model.npair)}
+    for k, name in enumerate(scene.names):
+        assert np.allclose(data.qpos[model.joint(f"part{k}_x").qposadr[0] + np.arange(3)], scene.starts[name])
+        assert sum(model.body(b).name.startswith(f"foot{k}_") for b in range(model.nbody)) == len(supports[name].points)
+        assert {frozenset((f"part{k}", "pusher")), frozenset((f"part{k}", "world"))} <= pairs
+        assert all(frozenset((f"part{k}", f"part{j}")) in pairs for j in range(k + 1, len(scene.parts)))
+
+
+def test_a_start_error_moves_the_part_moved_first_and_a_bump_the_part_the_pusher_is_on(channel):
+    """On the channel, far goes first: a start error moves far alone, a bump during near's move knocks
+    near; one that would put a part onto the other is bad input naming the flag, and the run knocks
+    the part the bump names."""
+    from planner.execution.mujoco_sim import perturbations, simulate
+    from planner.model.fields import SceneError
+    from planner.model.plan import Move
+
+    scene, result = channel
+    first, then = (m.part for m in result.moves)
+    setup = perturbations(scene, result, start_error=(0.0, 0.01, 0.0))
+    assert np.allclose(setup.starts[first], result.starts[first] + [0.0, 0.01, 0.0])
+    assert np.array_equal(setup.starts[then], result.starts[then])
+    later = setup.lead.duration + setup.motion.t[np.flatnonzero(setup.motion.part == then)[0]] + 1.0
+    assert [b[1] for b in perturbations(scene, result, bumps=[(0.0, 0.0, 0.001, 0.0), (later, 0.0, 0.001, 0.0)]).bumps] \
+        == [first, then]
+    onto = (result.starts[then] - result.starts[first])[:2]  # far's start onto near's
+    for field, kwargs in (("start_error", {"start_error": (*onto, 0.0)}), ("bump", {"bumps": [(0.0, *onto, 0.0)]})):
+        with pytest.raises(SceneError) as err:
+            perturbations(scene, result, **kwargs)
+        assert err.value.field == field and "cannot be" in err.value.problem
+    # The first push alone, far knocked 3 mm sideways as the pusher sets off: far is where the knock put it.
+    push = result.moves[0].segments[0]
+    short = replace(result, moves=[Move(first, [push])])
+    (run,) = simulate(scene, short, n=1, bumps=[(0.0, 0.0, 0.003, 0.0)]).runs
+    assert run.tracks[first][0][1] == pytest.approx(result.starts[first][1] + 0.003, abs=5e-4)
+    assert np.abs(run.tracks[then][-1] - result.starts[then]).max() < 1e-4

@@ -1,0 +1,466 @@
+"""Issue 30: parts and obstacles from CAD files (planner.model.cad), against shapes whose area and
+centroid are known in closed form, and the bad files of the issue refused in one line.
+
+Sources of truth: closed forms (a rounded rectangle is its inner box grown by the radius, so a
+point's distance to its boundary is ``|distance to the box - r|``; a regular polygon's area; the
+centroid of a plate less a hole), a dense sampling of a Bézier by its Bernstein form, and the
+files written here by the libraries' writers or by hand.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+import yaml
+
+ezdxf = pytest.importorskip("ezdxf")
+pytest.importorskip("svgelements")
+trimesh = pytest.importorskip("trimesh")
+
+from planner.cli import main  # noqa: E402 (after the skips)
+from planner.model.cad import MAX_FILE_BYTES  # noqa: E402
+from planner.model.fields import SceneError  # noqa: E402
+from planner.model.scene_file import load_scene, parse_scene  # noqa: E402
+from test_cli import assert_nothing_written, error_field  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[3]
+PUSHER = {"width": 0.03, "depth": 0.01, "mu": 0.5}
+#: A rounded rectangle in mm: w x h, corners of radius r, and a hole of radius a at (hx, hy).
+W, H, R, A, HX, HY = 80.0, 50.0, 8.0, 6.0, 20.0, 5.0
+
+
+def scene(slider, obstacles=(), **changes) -> dict:
+    return {"slider": slider, "pusher": PUSHER, "obstacles": list(obstacles),
+            "workspace": {"min": [-1, -1], "max": [1, 1]}, "start": [-0.5, -0.5, 0], "goal": [0.5, 0.5, 0], **changes}
+
+
+def load(folder: Path, data: dict):
+    path = folder / "scene.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return load_scene(path)
+
+
+def rounded_rectangle(msp, layer: str = "PART", centre=(0.0, 0.0), hole: bool = True) -> None:
+    """The rounded rectangle as one LWPOLYLINE with a quarter-circle bulge at each corner, and its hole."""
+    b, (cx, cy) = math.tan(math.pi / 8), centre
+    corners = [(-W / 2 + R, -H / 2, 0), (W / 2 - R, -H / 2, b), (W / 2, -H / 2 + R, 0), (W / 2, H / 2 - R, b),
+               (W / 2 - R, H / 2, 0), (-W / 2 + R, H / 2, b), (-W / 2, H / 2 - R, 0), (-W / 2, -H / 2 + R, b)]
+    msp.add_lwpolyline([(x + cx, y + cy, bulge) for x, y, bulge in corners], format="xyb", close=True,
+                       dxfattribs={"layer": layer})
+    if hole:
+        msp.add_circle((HX + cx, HY + cy), A, dxfattribs={"layer": layer})
+
+
+def dxf_file(folder: Path, draw, name: str = "part.dxf") -> Path:
+    doc = ezdxf.new()
+    draw(doc.modelspace())
+    doc.saveas(folder / name)
+    return folder / name
+
+
+def svg_file(folder: Path, body: str, name: str = "part.svg") -> Path:
+    (folder / name).write_text(f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 200 200">{body}</svg>')
+    return folder / name
+
+
+# --- closed forms ------------------------------------------------------------------------------------
+
+def test_bulged_rounded_rectangle_with_a_hole_has_its_closed_form_area_and_cf(tmp_path):
+    dxf_file(tmp_path, rounded_rectangle)
+    part = load(tmp_path, scene({"file": "part.dxf", "units": "mm"})).slider
+    outline = W * H - (4 - math.pi) * R ** 2  # mm^2
+    footprint = outline - math.pi * A ** 2
+    cf = -math.pi * A ** 2 * np.array([HX, HY]) / footprint  # the plate's centroid is its centre
+    assert part.area * 1e6 == pytest.approx(outline, rel=0.005)
+    assert np.abs(part.cf * 1e3 - cf).max() < 0.05
+    inner = shapely.box(-(W / 2 - R), -(H / 2 - R), W / 2 - R, H / 2 - R)
+    off = [abs(inner.distance(shapely.Point(v)) - R) for v in part.vertices * 1e3]
+    assert max(off) <= 0.1 + 1e-9  # every vertex within the chord tolerance of the drawn curve
+    assert len(part.vertices) < 60  # and simplified: the straight sides are one edge each
+
+
+def test_the_chord_tolerance_is_settable(tmp_path):
+    dxf_file(tmp_path, rounded_rectangle)
+    coarse = load(tmp_path, scene({"file": "part.dxf", "units": "mm", "chord": 0.002})).slider
+    fine = load(tmp_path, scene({"file": "part.dxf", "units": "mm", "chord": 0.00001})).slider
+    inner = shapely.box(-(W / 2 - R), -(H / 2 - R), W / 2 - R, H / 2 - R)
+    for part, chord in ((coarse, 2.0), (fine, 0.01)):
+        assert max(abs(inner.distance(shapely.Point(v)) - R) for v in part.vertices * 1e3) <= chord + 1e-9
+    assert len(coarse.vertices) < len(fine.vertices)
+
+
+@pytest.mark.parametrize("kind", ["ELLIPSE", "POLYLINE", "SPLINE"])
+def test_ellipses_polylines_and_splines_are_outlines(kind, tmp_path):
+    def draw(msp):
+        if kind == "ELLIPSE":  # semi-axes 30 and 12 mm
+            msp.add_ellipse((0, 0), major_axis=(30, 0), ratio=0.4)
+        elif kind == "POLYLINE":  # two half circles of radius 20 mm: bulge 1 each
+            msp.add_polyline2d([(-20, 0, 0, 0, 1), (20, 0, 0, 0, 1)], format="xyseb", close=True)
+        else:  # a spline through points round a square, ending where it starts
+            msp.add_spline([(-20, -20), (20, -20), (20, 20), (-20, 20), (-20, -20)])
+
+    dxf_file(tmp_path, draw)
+    part = load(tmp_path, scene({"file": "part.dxf", "units": "mm"})).slider
+    if kind == "ELLIPSE":
+        assert math.pi * (30 - 0.1) * (12 - 0.1) < part.area * 1e6 < math.pi * 30 * 12
+    elif kind == "POLYLINE":
+        assert math.pi * (20 - 0.1) ** 2 < part.area * 1e6 < math.pi * 20 ** 2
+    else:
+        assert part.area * 1e6 > 0.5 * 40 * 40  # a loop round the square, not a sliver
+        return  # a spline through points need not be symmetric
+    assert part.cf == pytest.approx([0, 0], abs=5e-5)
+
+
+def test_svg_outline_with_a_cubic_side_has_the_area_of_a_dense_reference(tmp_path):
+    controls = np.array([[60, 10], [90, 20], [90, 40], [60, 50]], float)
+    svg_file(tmp_path, '<path d="M 10 10 L 60 10 C 90 20 90 40 60 50 L 10 50 Z"/>')
+    part = load(tmp_path, scene({"file": "part.svg", "units": "mm"})).slider
+    t = np.linspace(0, 1, 100_001)[:, None]
+    bezier = (1 - t) ** 3 * controls[0] + 3 * (1 - t) ** 2 * t * controls[1] + 3 * (1 - t) * t ** 2 * controls[2] \
+        + t ** 3 * controls[3]
+    reference = shapely.Polygon(np.vstack([[10, 10], bezier, [10, 50]])).area
+    assert part.area * 1e6 == pytest.approx(reference, rel=0.01)
+    # y flipped: the drawing's top (y = 10 down the screen) is the part's top on the table (y = -10 mm)
+    assert part.polygon.bounds == pytest.approx((0.01, -0.05, 0.01 + 0.0725, -0.01), abs=2e-4)
+
+
+def prism(ring: list, height: float):
+    """The prism over the convex polygon ``ring`` (counter-clockwise), each face a fan of triangles."""
+    n = len(ring)
+    vertices = [(x, y, 0.0) for x, y in ring] + [(x, y, height) for x, y in ring]
+    faces = [(0, k + 1, k) for k in range(1, n - 1)] + [(n, n + k, n + k + 1) for k in range(1, n - 1)]
+    faces += [face for k in range(n) for face in ((k, (k + 1) % n, n + (k + 1) % n), (k, n + (k + 1) % n, n + k))]
+    return trimesh.Trimesh(vertices, faces)
+
+
+def test_stl_prism_footprint_has_the_area_of_its_regular_polygon(tmp_path):
+    n, radius = 12, 30.0
+    ring = [(radius * math.cos(2 * math.pi * k / n), radius * math.sin(2 * math.pi * k / n)) for k in range(n)]
+    prism(ring, 15.0).export(tmp_path / "prism.stl")
+    part = load(tmp_path, scene({"file": "prism.stl", "units": "mm"})).slider
+    assert part.area * 1e6 == pytest.approx(n / 2 * radius ** 2 * math.sin(2 * math.pi / n), rel=0.005)
+    assert len(part.vertices) == n
+
+
+def test_a_mesh_outline_is_its_projection_and_its_cf_the_footprints_centroid(tmp_path):
+    # A narrow foot (20 x 20 mm, centred at 30, 0) under a wide top (60 x 40 mm, centred at 0, 0).
+    foot = trimesh.creation.box((20, 20, 10)).apply_translation((30, 0, 5))
+    top = trimesh.creation.box((60, 40, 10)).apply_translation((0, 0, 15))
+    trimesh.util.concatenate([foot, top]).export(tmp_path / "mushroom.stl")
+    part = load(tmp_path, scene({"file": "mushroom.stl", "units": "mm"})).slider
+    assert part.polygon.bounds == pytest.approx((-0.03, -0.02, 0.04, 0.02), abs=1e-7)  # the union of both
+    assert part.area == pytest.approx(60 * 40e-6 + 10 * 20e-6, rel=1e-4)
+    assert part.cf == pytest.approx([0.03, 0.0], abs=1e-7)
+
+
+# --- selection, units, placement --------------------------------------------------------------------
+
+def two_parts(msp) -> None:
+    rounded_rectangle(msp, "PART")
+    rounded_rectangle(msp, "SPARE", centre=(200.0, 0.0), hole=False)
+
+
+def test_a_layer_picks_one_part_of_several(tmp_path, monkeypatch, capsys):
+    dxf_file(tmp_path, two_parts)
+    spare = load(tmp_path, scene({"file": "part.dxf", "units": "mm", "layer": "spare"})).slider
+    assert spare.polygon.bounds == pytest.approx((0.16, -0.025, 0.24, 0.025), abs=1e-4)  # within the chord
+    assert spare.cf == pytest.approx([0.2, 0.0], abs=5e-5)  # no hole on that layer
+    part = load(tmp_path, scene({"file": "part.dxf", "units": "mm", "layer": "PART"})).slider
+    assert part.polygon.bounds == pytest.approx((-0.04, -0.025, 0.04, 0.025), abs=1e-4)
+    with pytest.raises(SceneError, match="slider.file: holds 2 parts: pick one with layer or name"):
+        load(tmp_path, scene({"file": "part.dxf", "units": "mm"}))
+
+
+def test_a_block_name_picks_its_drawing(tmp_path):
+    doc = ezdxf.new()
+    rounded_rectangle(doc.blocks.new("BRACKET"), "0", hole=False)
+    doc.modelspace().add_blockref("BRACKET", (100, 100))
+    doc.saveas(tmp_path / "part.dxf")
+    assert load(tmp_path, scene({"file": "part.dxf", "units": "mm", "name": "BRACKET"})).slider.cf == \
+        pytest.approx([0, 0], abs=5e-5)  # the block's own frame
+    placed = load(tmp_path, scene({"file": "part.dxf", "units": "mm"}),).slider  # the reference, expanded
+    assert placed.cf == pytest.approx([0.1, 0.1], abs=5e-5)
+
+
+INKSCAPE = 'xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape"'
+
+
+def test_an_svg_layer_or_element_id_picks_one_part(tmp_path):
+    (tmp_path / "part.svg").write_text(
+        f'<svg xmlns="http://www.w3.org/2000/svg" {INKSCAPE} viewBox="0 0 200 200">'
+        '<g inkscape:groupmode="layer" inkscape:label="Parts" transform="translate(100, 0)">'
+        '<rect id="small" x="0" y="0" width="10" height="10"/><g id="big"><rect x="0" y="50" width="40" height="20"/>'
+        '</g></g><g inkscape:groupmode="layer" inkscape:label="Guides"><circle cx="20" cy="20" r="5"/></g></svg>')
+    guide = load(tmp_path, scene({"file": "part.svg", "units": "mm", "layer": "Guides"})).slider
+    assert guide.cf == pytest.approx([0.02, -0.02], abs=1e-6)
+    small = load(tmp_path, scene({"file": "part.svg", "units": "mm", "name": "small"})).slider
+    assert small.polygon.bounds == pytest.approx((0.1, -0.01, 0.11, 0.0))  # the layer's transform applied
+    big = load(tmp_path, scene({"file": "part.svg", "units": "mm", "name": "big"})).slider
+    assert big.polygon.bounds == pytest.approx((0.1, -0.07, 0.14, -0.05))
+    with pytest.raises(SceneError, match="holds 2 parts"):
+        load(tmp_path, scene({"file": "part.svg", "units": "mm", "layer": "Parts"}))
+    with pytest.raises(SceneError, match=r"no layer labelled 'Cut' \(layers: 'Guides', 'Parts'\)"):
+        load(tmp_path, scene({"file": "part.svg", "units": "mm", "layer": "Cut"}))
+
+
+def test_at_places_the_files_frame_in_the_slider_frame(tmp_path):
+    svg_file(tmp_path, '<rect x="10" y="-30" width="20" height="10"/>')  # x 10..30, y 20..30 mm
+    part = load(tmp_path, scene({"file": "part.svg", "units": "mm", "at": [-0.02, -0.025, 0], "cf": [0.0, 0.001]}))
+    assert part.slider.polygon.bounds == pytest.approx((-0.01, -0.005, 0.01, 0.005))
+    assert part.slider.cf.tolist() == [0.0, 0.001]  # a cf given is in the slider frame, as always
+
+
+@pytest.mark.parametrize("units, metres", [("mm", 1e-3), ("cm", 1e-2), ("m", 1.0), ("in", 0.0254)])
+def test_units_scale_the_drawing(units, metres, tmp_path):
+    svg_file(tmp_path, '<rect x="1" y="2" width="3" height="0.5"/>')
+    part = load(tmp_path, scene({"file": "part.svg", "units": units}, start=[0, 0, 0],
+                                workspace={"min": [-10, -10], "max": [10, 10]}, goal=[1, 0, 0])).slider
+    assert part.polygon.bounds == pytest.approx((metres, -2.5 * metres, 4 * metres, -2 * metres))
+
+
+def test_at_places_the_files_frame_in_the_world(tmp_path):
+    svg_file(tmp_path, '<rect x="10" y="-30" width="20" height="10"/>')  # x 10..30, y 20..30 mm on the table
+    obstacles = load(tmp_path, scene(
+        {"vertices": [[0, 0], [0.01, 0], [0, 0.01]]}, [{"file": "part.svg", "units": "mm", "at": [0.2, 0.1, 90]}])
+    ).obstacles
+    # Turned a quarter turn: (x, y) -> (-y, x), then moved by (0.2, 0.1).
+    assert obstacles[0].bounds == pytest.approx((0.2 - 0.03, 0.1 + 0.01, 0.2 - 0.02, 0.1 + 0.03))
+
+
+def test_every_closed_outline_is_an_obstacle_and_holes_are_left_open(tmp_path):
+    svg_file(tmp_path, '<path d="M 0 0 L 100 0 L 100 100 L 0 100 Z M 20 20 L 80 20 L 80 80 L 20 80 Z"/>'
+                       '<circle cx="150" cy="150" r="10"/><path d="M 0 150 L 20 150"/>')
+    data = scene({"vertices": [[0, 0], [0.01, 0], [0, 0.01]]}, [{"file": "part.svg", "units": "mm"}],
+                 start=[0.045, -0.055, 0], goal=[0.5, 0.5, 0])
+    loaded = load(tmp_path, data)  # the part's start lies in the frame's hole
+    frame = [o for o in loaded.obstacles if o.bounds[2] < 0.12]
+    assert all(not o.interiors for o in loaded.obstacles)
+    assert sum(o.area for o in frame) == pytest.approx((100 ** 2 - 60 ** 2) * 1e-6)
+    post = [o for o in loaded.obstacles if o.bounds[0] > 0.1]
+    assert len(post) == 1 and math.pi * (0.01 - 1e-4) ** 2 < post[0].area < math.pi * 0.01 ** 2  # within the chord
+    assert loaded.notes == ("obstacles[0].file: 1 open subpath(s) are not read",)
+
+
+def test_line_chains_that_close_are_outlines_and_open_ones_a_note(tmp_path):
+    def chain(msp):
+        msp.add_line((0, 0), (40, 0))
+        msp.add_line((40, 0), (40, 20))
+        msp.add_arc((20, 20), 20, 0, 180)  # the top: a half circle from (40, 20) to (0, 20)
+        msp.add_line((0, 20), (0, 0))
+        msp.add_line((60, 0), (80, 10))  # a stray line
+        msp.add_text("tag")
+
+    dxf_file(tmp_path, chain)
+    loaded = load(tmp_path, scene({"file": "part.dxf", "units": "mm"}))
+    assert loaded.slider.area * 1e6 == pytest.approx(40 * 20 + math.pi * 20 ** 2 / 2, rel=0.005)
+    assert loaded.notes == ("slider.file: not read: 1 TEXT",
+                            "slider.file: 1 open chain(s) of lines or arcs do not close and are not read")
+
+
+# --- bad input --------------------------------------------------------------------------------------
+
+def self_crossing(folder: Path) -> None:
+    svg_file(folder, '<path d="M 0 0 L 50 50 L 50 0 L 0 50 Z"/>')
+
+
+def no_footprint(folder: Path) -> None:
+    trimesh.creation.icosphere(radius=20).export(folder / "part.stl")
+
+
+def noise(size: int, suffix: str):
+    def make(folder: Path) -> None:
+        with open(folder / f"part{suffix}", "wb") as f:
+            f.write(np.random.default_rng(1).bytes(min(size, MAX_FILE_BYTES + 1_000_000)))
+            f.truncate(size)  # beyond the cap, the rest need not be written to be refused
+    return make
+
+
+def block_bomb(folder: Path) -> None:
+    """A few hundred bytes of blocks: ten texts, then seven levels of ten references each to the
+    level below, 10 ** 8 texts when expanded."""
+    doc = ezdxf.new()
+    for k in range(10):
+        (doc.blocks.get("B0") or doc.blocks.new("B0")).add_text("x")
+    for level in range(1, 8):
+        block = doc.blocks.new(f"B{level}")
+        for k in range(10):
+            block.add_blockref(f"B{level - 1}", (k, 0))
+    doc.modelspace().add_blockref("B7", (0, 0))
+    doc.saveas(folder / "part.dxf")
+
+
+def part_on_layer(layer: str):
+    return lambda folder: dxf_file(folder, lambda msp: rounded_rectangle(msp, layer))
+
+
+BAD = {
+    # (what to write, the slider's file reference, the field named, words of the problem)
+    "missing file": (lambda folder: None, {"file": "none.dxf", "units": "mm"}, "slider.file", ["cannot read"]),
+    "unreadable file (a folder)": (lambda folder: (folder / "dir.svg").mkdir(), {"file": "dir.svg", "units": "mm"},
+                                   "slider.file", ["not a regular file (a folder)"]),
+    "unknown unit": (part_on_layer("PART"), {"file": "part.dxf", "units": "ft"}, "slider.units",
+                     ["must be one of mm, cm, m, in", "'ft'"]),
+    "a unit that is a list": (part_on_layer("PART"), {"file": "part.dxf", "units": ["mm"]}, "slider.units",
+                              ["must be one of mm, cm, m, in", "['mm']"]),
+    "no closed outline on the layer": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "layer": "CUT"},
+                                       "slider.file", ["holds no closed outline on layer 'CUT'"]),
+    "an open polyline only": (lambda folder: dxf_file(folder, lambda msp: msp.add_lwpolyline([(0, 0), (9, 0), (9, 9)])),
+                              {"file": "part.dxf", "units": "mm"}, "slider.file",
+                              ["no closed outline; 1 open chain(s) of lines or arcs do not close"]),
+    "self-intersecting SVG outline": (self_crossing, {"file": "part.svg", "units": "mm"}, "slider.file",
+                                      ["outline 0 intersects itself"]),
+    "mesh with no footprint": (no_footprint, {"file": "part.stl", "units": "mm"}, "slider.file",
+                               ["no footprint", "only at points or along edges"]),
+    "100 MB of noise": (noise(100_000_000, ".dxf"), {"file": "part.dxf", "units": "mm"}, "slider.file",
+                        [f"larger than {MAX_FILE_BYTES} bytes"]),
+    "noise as DXF": (noise(200_000, ".dxf"), {"file": "part.dxf", "units": "mm"}, "slider.file",
+                     ["not a readable DXF file"]),
+    "noise as SVG": (noise(200_000, ".svg"), {"file": "part.svg", "units": "mm"}, "slider.file",
+                     ["not a readable SVG file"]),
+    "noise as STL": (noise(200_000, ".stl"), {"file": "part.stl", "units": "mm"}, "slider.file", []),
+    "blocks of references to blocks": (block_bomb, {"file": "part.dxf", "units": "mm"}, "slider.file",
+                                       ["draws more than 10000 entities"]),
+    "an unknown kind of file": (noise(10, ".step"), {"file": "part.step", "units": "mm"}, "slider.file",
+                                ["unknown kind of file"]),
+    "a chord below a micron": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "chord": 1e-9},
+                               "slider.chord", ["at least 1e-06 m"]),
+    "a part beyond 1000 m": (part_on_layer("PART"), {"file": "part.dxf", "units": "m"}, "slider.file",
+                             ["beyond the 1000 m limit"]),
+    "two parts and no layer": (lambda folder: dxf_file(folder, two_parts), {"file": "part.dxf", "units": "mm"},
+                               "slider.file", ["holds 2 parts"]),
+    "an unknown key": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "layers": "PART"},
+                       "slider.layers", ["did you mean layer?"]),
+}
+
+
+@pytest.mark.parametrize("case", BAD, ids=str)
+def test_bad_cad_input_exits_1_with_one_line_and_writes_nothing(case, tmp_path, monkeypatch, capsys):
+    make, slider, field, words = BAD[case]
+    if case == "a part beyond 1000 m":
+        slider = {**slider, "at": [0, 0, 0]}
+        make(tmp_path)
+        (tmp_path / "part.dxf").write_bytes((tmp_path / "part.dxf").read_bytes().replace(b"\n40.0\n", b"\n4e6\n", 1))
+    else:
+        make(tmp_path)
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene(slider)))
+    before = {p.name for p in tmp_path.iterdir()}
+    monkeypatch.chdir(tmp_path)
+    tracemalloc.start()
+    clock = time.perf_counter()
+    try:
+        assert main(["scene.yaml", "--out", "out", "--export-scene", "exported.yaml"]) == 1
+        seconds, peak = time.perf_counter() - clock, tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    captured = capsys.readouterr()
+    assert captured.out == "" and error_field(captured.err) == field
+    assert all(word in captured.err for word in words), captured.err
+    assert len(captured.err) <= 301
+    assert_nothing_written(tmp_path, before)
+    assert seconds < 5.0 and peak < 100e6  # bounded by the caps, not by the file (tracemalloc slows it 2-5x)
+
+
+def test_without_the_cad_extra_a_file_is_one_line_naming_it(tmp_path, monkeypatch, capsys):
+    dxf_file(tmp_path, rounded_rectangle)
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene({"file": "part.dxf", "units": "mm"})))
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setitem(sys.modules, "ezdxf", None)  # as if not installed: importing it fails
+    assert main(["scene.yaml", "--out", "out"]) == 1
+    err = capsys.readouterr().err
+    assert error_field(err) == "slider.file" and "needs the cad extra: pip install 'stablepush[cad]'" in err
+    assert_nothing_written(tmp_path, {"scene.yaml", "part.dxf"})
+
+
+@pytest.mark.parametrize("argv, words", [(["--export-scene", "."], "is a folder"),
+                                         (["--export-scene", "x.yaml", "--seeds", "1:2"], "not a batch")])
+def test_bad_export_flag_exits_1(argv, words, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main([str(ROOT / "scenes" / "battery.yaml"), *argv, "--out", "out"]) == 1
+    err = capsys.readouterr().err
+    assert error_field(err) == "--export-scene" and words in err
+    assert_nothing_written(tmp_path, set())
+
+
+def test_an_export_that_cannot_be_written_exits_4_naming_it(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main([str(ROOT / "scenes" / "battery.yaml"), "--out", "out", "--export-scene", "no/scene.yaml"]) == 4
+    assert capsys.readouterr().err.startswith("plan: error: cannot write 'no/scene.yaml': No such file or directory")
+    assert not (tmp_path / "no").exists()
+
+
+def test_the_export_holds_the_options_the_flags_set(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    argv = ["--out", "out", "--export-scene", "again.yaml", "--transit", "lift", "--switch-cost", "0.1", "--seed", "7"]
+    assert main([str(ROOT / "scenes" / "battery.yaml"), *argv]) == 0
+    again = load_scene(tmp_path / "again.yaml")
+    assert again.pusher.transit == "lift" and again.planner.switch_cost == 0.1 and again.planner.seed == 7
+
+
+# --- the example, planned and verified against its exported scene ------------------------------------
+
+def plans_and_verifies_against_its_export(path: Path, tmp_path: Path) -> dict:
+    """Plan ``path`` (seed 1) with --export-scene, then verify the plan against the exported file;
+    return the exported scene."""
+    exported = tmp_path / "exported.yaml"
+    assert main([str(path), "--seed", "1", "--out", str(tmp_path / "out"), "--export-scene", str(exported)]) == 0
+    scene = load_scene(path)
+    plan = tmp_path / "out" / f"{scene.name}.json"
+    assert main([str(exported), "--plan", str(plan), "--verify", "10", "--out", str(tmp_path / "check")]) == 0
+    again = load_scene(exported)
+    assert again.slider.vertices.tolist() == scene.slider.vertices.tolist()
+    assert again.slider.cf.tolist() == scene.slider.cf.tolist()
+    assert [o.exterior.coords[:] for o in again.obstacles] == [o.exterior.coords[:] for o in scene.obstacles]
+    assert again.start.tolist() == scene.start.tolist() and again.goal.tolist() == scene.goal.tolist()
+    return yaml.safe_load(exported.read_text())
+
+
+def test_the_example_scene_plans_and_verifies_against_its_exported_scene(tmp_path, capsys):
+    data = plans_and_verifies_against_its_export(ROOT / "scenes" / "cad" / "bracket.yaml", tmp_path)
+    assert set(data["slider"]) == {"vertices", "cf", "cf_uncertainty"}
+    assert all(set(o) == {"polygon"} for o in data["obstacles"])
+    assert "plan: note: obstacles[0].file: not read: 1 text" in capsys.readouterr().err
+    # The scene pushes edges 0, 7, 13 and 14: the plate's straight sides, the rest being its arcs.
+    vertices = np.array(data["slider"]["vertices"])
+    lengths = np.hypot(*(np.roll(vertices, -1, axis=0) - vertices).T)
+    assert data["pusher"]["edges"] == [0, 7, 13, 14] and sorted(np.flatnonzero(lengths > 0.02)) == [0, 7, 13, 14]
+    # The CF is the plate's centroid moved away from the 12 mm bolt hole at (15, 5) mm.
+    outline = load_scene(ROOT / "scenes" / "cad" / "bracket.yaml").slider.polygon
+    hole = math.pi * 0.006 ** 2
+    cf = (outline.area * np.array(outline.centroid.coords[0]) - hole * np.array([0.015, 0.005])) / (outline.area - hole)
+    assert np.abs(np.array(data["slider"]["cf"]) - cf).max() < 5e-5
+
+
+def test_a_scene_with_an_stl_part_and_an_svg_fixture_plans_and_verifies(tmp_path):
+    foot = trimesh.creation.box((30, 30, 10)).apply_translation((0, 0, 5))
+    top = trimesh.creation.box((50, 30, 5)).apply_translation((5, 0, 12.5))
+    trimesh.util.concatenate([foot, top]).export(tmp_path / "part.stl")
+    svg_file(tmp_path, '<path d="M 0 0 L 40 0 Q 60 30 40 60 L 0 60 L 0 50 L 30 50 Q 40 30 30 10 L 0 10 Z"/>',
+             "fixture.svg")
+    data = {"name": "mushroom", "slider": {"file": "part.stl", "units": "mm"},
+            "pusher": {"width": 0.02, "depth": 0.01, "mu": 0.6},
+            "obstacles": [{"file": "fixture.svg", "units": "cm", "at": [0.1, 0.3, 0]}],
+            "workspace": {"min": [-0.3, -0.3], "max": [0.6, 0.4]}, "start": [-0.2, 0.0, 0], "goal": [0.3, 0.0, 0],
+            "tolerance": {"position": 0.02, "angle": 5}}
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(data))
+    exported = plans_and_verifies_against_its_export(tmp_path / "scene.yaml", tmp_path)
+    assert exported["slider"]["cf"] == pytest.approx([0, 0], abs=1e-7)  # the foot's centre, not the top's
+
+
+def test_a_plain_scene_round_trips_through_its_export(tmp_path):
+    scene = load_scene(ROOT / "scenes" / "nonconvex.yaml")
+    from planner.model.scene_file import write_scene
+
+    write_scene(scene, tmp_path / "again.yaml")
+    again = load_scene(tmp_path / "again.yaml")
+    for name in ("start", "goal"):
+        assert getattr(again, name).tolist() == getattr(scene, name).tolist()
+    assert again.obstacles == scene.obstacles and again.pusher == scene.pusher and again.planner == scene.planner
+    assert parse_scene(yaml.safe_load((tmp_path / "again.yaml").read_text())).slider.cf.tolist() == \
+        scene.slider.cf.tolist()
