@@ -184,12 +184,14 @@ def _summary(scene: Scene, plan: Plan) -> list[str]:
     if not plan.solved:
         return [f"{head}: not solved: {plan.reason}", tree]
     length = plan.path_length(scene.slider.cf)
-    cost = length + plan.switches * scene.planner.switch_cost
+    # The plan's own switch cost; a plan file may not give one, and then its cost is not known.
+    cost = "" if plan.switch_cost is None else (f"; cost {length + plan.switches * plan.switch_cost:.4f} m "
+                                                f"(length + {plan.switch_cost:g} m per switch)")
     times = [f"push time {sum(s.duration for s in plan.segments if s.kind == 'push'):.4f} s"]
     if plan.switches:
         times.append(f"transit time {sum(s.duration for s in plan.segments if s.kind == 'transit'):.4f} s")
     return [f"{head}: solved with {plan.contents(' and ')}",
-            f"CF path length {length:.4f} m; cost {cost:.4f} m (length + {scene.planner.switch_cost:g} m per switch)",
+            f"CF path length {length:.4f} m{cost}",
             f"{', '.join(times)} (every point of the pusher at most 1 m/s)", tree]
 
 
