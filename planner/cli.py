@@ -4,7 +4,8 @@ what it found and exit with its code. Several scenes, or ``--seeds``, make a bat
 
 What each flag asks is the pipeline's option of the same name (:class:`planner.pipeline.RunOptions`;
 ``--plan`` is ``plan_file``, the ``--sim-...`` angles are in degrees here, radians there); the
-planner's own flags change the scene's ``planner:`` options. Errors the library names by an
+planner's own flags change the options the scene file asks for (its ``planner:`` block and
+``pusher.transit``), resolved once into the run's planner options. Errors the library names by an
 option's field are printed with the flag (:mod:`planner.flags`).
 
 Exit codes: 0 solved (and verified, if asked), 1 bad input (one line naming the field), 2 not
@@ -35,6 +36,7 @@ from typing import TYPE_CHECKING, NamedTuple
 from .flags import flag_of, options_of, parser
 
 if TYPE_CHECKING:
+    from .model.options import PlannerOptions
     from .model.scene import Scene
     from .pipeline import RunOptions
 
@@ -56,10 +58,13 @@ def _silence_nanobind_leak_report() -> None:
 
 
 class Inputs(NamedTuple):
-    """A command line, checked: the scene with the planner flags applied, and the run's options."""
+    """A command line, checked: the scene as its file gives it, the run's options and the
+    planner's (the scene's own with the planner flags applied): :func:`planner.pipeline.run`'s
+    arguments."""
 
     scene: Scene
     options: RunOptions
+    planner_options: PlannerOptions
 
 
 def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
@@ -86,8 +91,7 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         raise SceneError("--resume" if args.resume else "scene", "several scenes, --seeds or --resume make a batch, "
                                                                "which the plan command runs itself (planner.batch)")
     scene = load_scene(args.scene[0])
-    # The search, the recording and verify's check of lifts all read the options from the scene as planned.
-    scene = scene.with_options(options_of(args, scene.planner))
+    planner_options = options_of(args, scene.options)
     out = Path(args.out) if args.out else _fresh_folder(Path("logs") / f"{scene.name}-{time.strftime('%Y%m%d-%H%M%S')}")
     options = RunOptions(
         plan_file=args.plan, verify=args.verify, trajectory=args.trajectory, simulate=args.simulate,
@@ -98,7 +102,7 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         closed_loop=args.closed_loop, mjcf=None if args.mjcf is None else Path(args.mjcf), reach=args.reach,
         part=args.part, out=out, export_scene=None if args.export_scene is None else Path(args.export_scene))
     try:
-        return Inputs(scene, options.checked(scene))
+        return Inputs(scene, options.checked(scene), planner_options)
     except SceneError as err:  # the library names its options' fields: the command, their flags
         raise SceneError(flag_of(err.field), err.problem) from None
 
@@ -161,13 +165,13 @@ def _run(args: argparse.Namespace, inputs: Inputs) -> int:
     watches, and print the outcome: its lines, or why there is no plan; the exit code."""
     from .pipeline import run
 
-    scene, options = inputs
+    scene, options, planner_options = inputs
     for note in scene.notes:
         print(f"plan: note: {note}", file=sys.stderr)
     tty = sys.stderr.isatty() and options.plan_file is None  # scripts get just the one line of outcome
     if tty:
-        print(f"planning {scene.name} with {scene.planner.name} (seed {scene.planner.seed}, limit "
-              f"{scene.planner.time_limit:g} s) ...", file=sys.stderr, flush=True)
+        print(f"planning {scene.name} with {planner_options.name} (seed {planner_options.seed}, limit "
+              f"{planner_options.time_limit:g} s) ...", file=sys.stderr, flush=True)
     reach_map = None
     if args.engine is not None or args.jobs is not None:  # the map's headings on the batch executors
         import functools
@@ -175,7 +179,7 @@ def _run(args: argparse.Namespace, inputs: Inputs) -> int:
         from .batch.reach import reachable_set_on
 
         reach_map = functools.partial(_mapped_on, reachable_set_on, (args.engine or "local", args.jobs, args.address))
-    outcome = run(scene, options, progress=_progress if tty else None, reach_map=reach_map)
+    outcome = run(scene, options, planner_options, progress=_progress if tty else None, reach_map=reach_map)
     if tty:
         print("\r\033[K", end="", file=sys.stderr, flush=True)  # clear the progress line
     if outcome.plan.note and outcome.plan.solved:
@@ -187,8 +191,8 @@ def _run(args: argparse.Namespace, inputs: Inputs) -> int:
     return outcome.code
 
 
-def _mapped_on(reachable_set_on, engine: tuple, scene: Scene, pushes: int):
-    return reachable_set_on(scene, pushes, *engine)
+def _mapped_on(reachable_set_on, engine: tuple, scene: Scene, pushes: int, *, regions: str):
+    return reachable_set_on(scene, pushes, *engine, regions=regions)
 
 
 def _progress(k: int, n: int) -> None:

@@ -1,7 +1,7 @@
 """The pushes available on each edge, scaled for planning.
 
 Each allowed edge with a non-empty stable region becomes an :class:`EdgeControls`: its stable region
-(procedure STABLE or the exact region, as the scene's ``planner.regions`` says; :mod:`.region_cache`),
+(procedure STABLE or the exact region, as the ``regions`` option says; :mod:`.region_cache`),
 the steering map from the unit control box onto it, and the body outline used to scale twists so
 that no point of the slider or pusher moves faster than 1 m/s. With that scale, a push's
 ``duration`` bounds how far any point travels, which is what the collision rule of
@@ -22,6 +22,7 @@ from ..model.bodies import body_outline
 from ..model.segments import Push
 from .region_cache import RegionCache, compute_regions, edge_region, is_cached
 from ..model.fields import SceneError
+from ..model.options import DEFAULT_REGIONS
 from ..model.scene import Scene
 
 __all__ = ["EdgeControls", "NoStablePush", "RegionTimeout", "clearance_margin", "controls_or_reason", "edge_controls",
@@ -83,7 +84,7 @@ class RegionTimeout(Exception):
 
 
 def edge_controls(scene: Scene, deadline: float | None = None, progress: Callable[[int, int], None] | None = None,
-                  cache: RegionCache | None = None) -> list[EdgeControls]:
+                  cache: RegionCache | None = None, *, regions: str = DEFAULT_REGIONS) -> list[EdgeControls]:
     """An :class:`EdgeControls` for each allowed edge that has stable pushes.
 
     Parameters
@@ -99,6 +100,8 @@ def edge_controls(scene: Scene, deadline: float | None = None, progress: Callabl
     cache : RegionCache, optional
         Where the exact regions are kept and what computes them
         (default: :func:`~planner.actions.region_cache.default_cache`).
+    regions : str
+        The ``regions`` option: ``'exact'`` (the default) or ``'stable'`` (procedure STABLE).
 
     Raises
     ------
@@ -113,7 +116,7 @@ def edge_controls(scene: Scene, deadline: float | None = None, progress: Callabl
         If ``deadline`` passed first; it holds the pushes of the edges done.
     """
     p, slider = scene.pusher, scene.slider
-    method, rho = scene.planner.regions, scene.cf_uncertainty
+    method, rho = regions, scene.cf_uncertainty
     todo = [e for e in scene.edges if not is_cached(slider, e, p.mu, p.width, method, rho, cache)]
     computed = compute_regions(slider, todo, p.mu, p.width, rho, deadline, progress, cache=cache)
     out, pending = [], []
@@ -152,9 +155,10 @@ class NoStablePush(SceneError):
                                              "the cf)")
 
 
-def controls_or_reason(scene: Scene) -> tuple[list[EdgeControls] | None, str | None]:
-    """``(edge_controls(scene), None)``, or ``(None, why)`` when no allowed edge has a stable push
-    (the problem of the :class:`NoStablePush` it raised); other errors pass through.
+def controls_or_reason(scene: Scene, regions: str = DEFAULT_REGIONS) -> tuple[list[EdgeControls] | None, str | None]:
+    """``(edge_controls(scene, regions=regions), None)``, or ``(None, why)`` when no allowed edge
+    has a stable push (the problem of the :class:`NoStablePush` it raised); other errors pass
+    through.
 
     A CF beyond the end of edge 0, which no force in the contact's friction cone passes through:
 
@@ -167,6 +171,6 @@ def controls_or_reason(scene: Scene) -> tuple[list[EdgeControls] | None, str | N
     (None, 'no allowed edge has a stable push (no contact force can pass through the cf)')
     """
     try:
-        return edge_controls(scene), None
+        return edge_controls(scene, regions=regions), None
     except NoStablePush as err:
         return None, err.problem

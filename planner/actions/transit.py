@@ -11,7 +11,7 @@ in one of two modes:
 * ``'plane'``: walk round the part. The pusher backs off onto the boundary of the part's convex
   hull grown by the standoff, follows it (along the hull's edges, and turning about its corners
   with the face tangent to the grown boundary) the shorter of the two ways round that is free,
-  and moves in. A scene with ``transit: lift`` may use either, whichever is quicker.
+  and moves in. With the ``transit`` option ``lift`` either may be used, whichever is quicker.
 
 Why a walk round never touches the part: at every pose the pushing face lies on a line that
 supports the grown hull, so the whole part lies beyond the face, at least ``standoff x
@@ -186,17 +186,18 @@ class TransitPlanner:
     Parameters
     ----------
     scene : Scene
-        Its ``pusher.transit`` says which modes are allowed.
     edges : sequence of int
         The edges the pusher may be placed on.
     model : CollisionModel
         Checks the pusher's own body against obstacles and walls.
     margin : float
         Clearance every in-plane move must keep.
+    mode : str
+        The ``transit`` option: ``'plane'`` (walks round the part only) or ``'lift'`` (lifts too).
     """
 
-    def __init__(self, scene: Scene, edges, model: CollisionModel, margin: float):
-        self.mode = scene.pusher.transit
+    def __init__(self, scene: Scene, edges, model: CollisionModel, margin: float, mode: str):
+        self.mode = mode
         self.model, self.margin = model, margin
         self.standoff = standoff(scene)
         self.reach = float(np.linalg.norm(pusher_frame_body(scene.pusher.width, scene.pusher.depth), axis=1).max())

@@ -14,6 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..model.options import DEFAULT_REGIONS
 from ..model.scene import Scene
 from ..queries.reachable_set import HEADINGS, ReachableSet, reachable_set
 from .engines import map_ordered
@@ -22,9 +23,9 @@ from ..model.processes import cores
 __all__ = ["merge", "reachable_set_on"]
 
 
-def _part(job: tuple[Scene, int, float | None, int, slice], shared: None) -> ReachableSet:
-    scene, pushes, resolution, headings, among = job
-    return reachable_set(scene, pushes, None, resolution, headings=headings, among=among)
+def _part(job: tuple[Scene, int, float | None, int, slice, str], shared: None) -> ReachableSet:
+    scene, pushes, resolution, headings, among, regions = job
+    return reachable_set(scene, pushes, None, resolution, headings=headings, among=among, regions=regions)
 
 
 def merge(maps: list[ReachableSet], seconds: float) -> ReachableSet:
@@ -41,9 +42,10 @@ def merge(maps: list[ReachableSet], seconds: float) -> ReachableSet:
 
 def reachable_set_on(scene: Scene, pushes: int = 1, engine: str = "local", workers: int | None = None,
                      address: str | None = None, resolution: float | None = None, *,
-                     headings: int = HEADINGS) -> ReachableSet:
-    """:func:`~planner.queries.reachable_set.reachable_set` of ``scene`` for any final heading,
-    its ``headings`` computed on the ``engine`` executor (:func:`planner.batch.executor`).
+                     headings: int = HEADINGS, regions: str = DEFAULT_REGIONS) -> ReachableSet:
+    """:func:`~planner.queries.reachable_set.reachable_set` of ``scene`` for any final heading
+    with the stable pushes of the ``regions`` option, its ``headings`` computed on the ``engine``
+    executor (:func:`planner.batch.executor`).
 
     The headings are cut into one run per worker (``workers``, default: this machine's cores):
     each run builds the collision model and the goal regions once.
@@ -56,6 +58,6 @@ def reachable_set_on(scene: Scene, pushes: int = 1, engine: str = "local", worke
     clock = time.perf_counter()
     parts = min(workers or cores(), headings)
     cuts = np.linspace(0, headings, parts + 1).round().astype(int)
-    jobs = [(scene, pushes, resolution, headings, slice(a, b)) for a, b in zip(cuts[:-1], cuts[1:])]
+    jobs = [(scene, pushes, resolution, headings, slice(a, b), regions) for a, b in zip(cuts[:-1], cuts[1:])]
     maps = map_ordered(_part, jobs, workers, engine, address)
     return merge(maps, time.perf_counter() - clock)

@@ -122,7 +122,7 @@ def run_batch(tasks: Sequence[Task], out: str | Path, executor: Executor | None 
     try:
         with raise_on_sigterm(), Progress(len(tasks), len(reused), stream) as progress:
             shared = shared_regions(setups)
-            timeout = max((stop_after(t.planned_scene().planner.time_limit) for t in setups), default=None)
+            timeout = max((stop_after(t.planned()[1].time_limit) for t in setups), default=None)
             for index, outcome in executor.run(run_task, feed(), shared, retries=retries, timeout=timeout):
                 task = running.pop(index)
                 record = _record(task, outcome, out)

@@ -30,8 +30,8 @@ from mechanics import Slider
 from ..actions.controls import edge_controls
 from ..actions.region_cache import default_cache, is_cached, regions_held
 from ..model.fields import SceneError, number, shown
-from ..model.options import (check_optimize, check_planner, check_regions, check_seed, check_switch_cost,
-                             check_time_limit, check_transit)
+from ..model.options import (PlannerOptions, check_optimize, check_planner, check_regions, check_seed,
+                             check_switch_cost, check_time_limit, check_transit)
 from ..model.scene import Scene
 from ..model.scene_file import load_scene
 from ..pipeline import run
@@ -71,9 +71,11 @@ class Task:
     overrides: Mapping[str, Any] = field(default_factory=dict)
     digest: str | None = None  # SHA-256 of the scene file's bytes (None for a Scene given as such)
 
-    def planned_scene(self) -> Scene:
-        """The scene as planned: the goal and overrides applied (a multi-part scene takes neither
-        a goal, its parts have theirs, nor a CF offset, which is a part's)."""
+    def planned(self) -> tuple[Scene, PlannerOptions]:
+        """The scene as planned, the goal and the scene's overrides (``mu``, ``cf_offset``)
+        applied, and the options it is planned with: the scene's own with the seed and the
+        planner's overrides. A multi-part scene takes neither a goal, its parts have theirs, nor a
+        CF offset, which is a part's."""
         scene, o = self.scene, self.overrides
         if len(scene.parts) > 1:
             for name, given in (("goal", self.goal), ("overrides.cf_offset", o.get("cf_offset"))):
@@ -81,8 +83,8 @@ class Task:
                     raise SceneError(name, "is for one-part scenes: a scene with parts has a goal and a CF per part")
         if self.goal is not None:
             scene = scene.with_part(goal=self.goal)
-        options = {"name" if key == "planner" else key: o[key] for key in _OPTIONS if key in o}
-        scene = scene.with_options(scene.planner.merged({**options, "seed": self.seed}, prefix="overrides."))
+        changes = {"name" if key == "planner" else key: o[key] for key in _OPTIONS if key in o}
+        options = scene.options.merged({**changes, "seed": self.seed}, prefix="overrides.")
         if "mu" in o:
             scene = replace(scene, pusher=replace(scene.pusher, mu=o["mu"]))
         if "cf_offset" in o:
@@ -91,7 +93,7 @@ class Task:
                 scene = scene.with_part(slider=Slider(slider.vertices, slider.cf + np.asarray(o["cf_offset"])))
             except ValueError as err:
                 raise SceneError("overrides.cf_offset", str(err)) from None
-        return scene
+        return scene, options
 
     def record(self) -> dict[str, Any]:
         """What the results file says of the task itself: what it is, and what its plan depends
@@ -190,7 +192,7 @@ class TaskList(Sequence):
             return [self[i] for i in range(len(self))[index]]
         k, s, g, v = _unravel(range(len(self))[index], self._shape)
         scene = self.scenes[k]
-        seed = scene.planner.seed if self.seeds is None else self.seeds[s]
+        seed = scene.options.seed if self.seeds is None else self.seeds[s]
         tag = (f"{self.names[k]}-s{seed}{'' if self.goals is None else f'-g{g}'}"
                f"{'' if len(self.variants) == 1 else f'-o{v}'}")
         return Task(tag, scene, seed, None if self.goals is None else self.goals[g], self.variants[v], self.digests[k])
@@ -302,10 +304,10 @@ def _one_part(scene: Scene) -> list[Scene]:
     return [scene.move_scene(name, scene.starts) for name in scene.names]
 
 
-def _region_keys(scene: Scene) -> tuple:
-    """What a scene's exact regions depend on, to compute them once for all tasks alike."""
+def _region_keys(scene: Scene, regions: str) -> tuple:
+    """What a scene's regions of the ``regions`` option depend on, to compute them once for all tasks alike."""
     p = scene.pusher
-    return (scene.slider.vertices.tobytes(), scene.slider.cf.tobytes(), tuple(scene.edges), p.mu, p.width, scene.cf_uncertainty, scene.planner.regions)
+    return (scene.slider.vertices.tobytes(), scene.slider.cf.tobytes(), tuple(scene.edges), p.mu, p.width, scene.cf_uncertainty, regions)
 
 
 def shared_regions(tasks: Iterable[Task] | TaskList) -> dict[str, Any]:
@@ -316,12 +318,13 @@ def shared_regions(tasks: Iterable[Task] | TaskList) -> dict[str, Any]:
     shared: dict[str, Any] = {}
     seen = set()
     for task in tasks.setups() if isinstance(tasks, TaskList) else tasks:
-        for scene in _one_part(task.planned_scene()):
-            if _region_keys(scene) in seen:
+        planned, options = task.planned()
+        for scene in _one_part(planned):
+            if (key := _region_keys(scene, options.regions)) in seen:
                 continue
-            seen.add(_region_keys(scene))
+            seen.add(key)
             try:
-                edge_controls(scene)
+                edge_controls(scene, regions=options.regions)
             except SceneError:
                 continue
             p = scene.pusher
@@ -339,10 +342,11 @@ def run_task(task: Task, shared: Mapping[str, Any] | None) -> dict[str, Any]:
     for key, region in (shared or {}).items():
         if cache.get(key) is None:
             cache.put(key, region)
-    scene = task.planned_scene()
-    missing = sum(not is_cached(one.slider, e, one.pusher.mu, one.pusher.width, one.planner.regions, one.cf_uncertainty)
+    scene, options = task.planned()
+    missing = sum(not is_cached(one.slider, e, one.pusher.mu, one.pusher.width, options.regions, one.cf_uncertainty)
                   for one in _one_part(scene) for e in one.edges)
-    outcome = run(scene)  # the command's pipeline, writing nothing: the certificates, else the plan
+    # The command's pipeline, writing nothing: the certificates, else the plan.
+    outcome = run(scene, planner_options=options)
     result = outcome.plan
     status = "solved" if result.solved else "unreachable" if outcome.unreachable else "unknown"
     return {"status": status, "cost": result.cost if result.solved else None,

@@ -11,8 +11,8 @@ transfers included):
 * it says it is solved (an unsolved plan holds no way to the goal);
 * its parts and pusher are the scene's: its CFs where the scene's parts have them, every push on
   an edge the scene lets the pusher push with the scene's pusher flush on it, every transit a mode
-  the scene allows, every transfer flush on the part it leaves and on the part it goes to, and
-  the segments chained (:func:`planner.execution.verify.check_chain`);
+  the ``transit`` option allows, every transfer flush on the part it leaves and on the part it
+  goes to, and the segments chained (:func:`planner.execution.verify.check_chain`);
 * every part starts at the scene's start: a plan of one part within the scene's tolerance, a plan
   of several to rounding (its transfers are the pusher's paths between the parts where they
   stand, which would not follow one part moved);
@@ -40,6 +40,7 @@ import numpy as np
 from mechanics import wrap_angle
 
 from ..model.fields import SceneError, pose_text
+from ..model.options import DEFAULT_TRANSIT
 from ..model.plan import Plan
 from ..model.plan_file import part_field
 from ..model.scene import Scene
@@ -69,9 +70,9 @@ def _miss(scene: Scene, pose: np.ndarray, target: np.ndarray) -> str:
             f"{math.degrees(scene.tolerance_angle):g} deg)")
 
 
-def fit_plan(scene: Scene, plan: Plan) -> Plan:
+def fit_plan(scene: Scene, plan: Plan, *, transit: str = DEFAULT_TRANSIT) -> Plan:
     """``plan`` as run in ``scene``: from the scene's starts, with the scene's goals, after checking
-    it is a plan for that scene (module docstring). Any number of parts.
+    it is a plan for that scene and the ``transit`` option (module docstring). Any number of parts.
 
     Raises
     ------
@@ -93,12 +94,12 @@ def fit_plan(scene: Scene, plan: Plan) -> Plan:
     planner.model.fields.SceneError: plan.start: is [0.0000 m, 0.0000 m, 0.0000 rad = 0.00 deg], not the scene's start ...
     """
     with np.errstate(all="ignore"):  # a file's huge numbers overflow to inf, refused below, not warned of
-        return _fit(scene, plan)
+        return _fit(scene, plan, transit)
 
 
-def _fit(scene: Scene, plan: Plan) -> Plan:
+def _fit(scene: Scene, plan: Plan, transit: str) -> Plan:
     check_solved(plan)
-    check_chain(scene, plan)
+    check_chain(scene, plan, transit)
     _check_starts(scene, plan)
     for move, _, first in placed_moves(plan):
         alone = scene.move_scene(move.part, plan.starts, others=False)  # its part and the pusher

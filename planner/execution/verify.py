@@ -35,7 +35,7 @@ part or the pusher between pushes. So before simulating, :func:`verify` checks t
 hangs together (:func:`check_chain`): its parts and their CFs are the scene's, every segment
 starts where the one before it left its part, every push is on the edge the pusher is on, every
 transit starts at the contact pose on that edge, ends at the contact pose on the next push's edge,
-and uses a mode the scene allows (a lift only with ``pusher.transit: lift``), and every transfer
+and uses a mode the ``transit`` option allows (a lift only with ``lift``), and every transfer
 starts at the contact pose on the part it leaves and ends at the one on the edge it goes to. The
 drift treats a transit as the identity. Whether a transit's path is clear of the obstacles is the
 planner's rule (:mod:`planner.actions.transit`), not checked here; a plan read from a file is
@@ -67,6 +67,7 @@ from mechanics.quasistatic import (DEFAULT_STEPS, Contact, ContactMode, PushResu
 
 from ..actions.transit import edge_contact_pose
 from ..model.fields import SceneError, pose_text
+from ..model.options import DEFAULT_TRANSIT
 from ..model.plan import Move, Plan
 from ..model.plan_file import part_field
 from ..model.scene import Part, Pusher, Scene
@@ -358,13 +359,12 @@ def _check_flush(part: Part, edge: int, where: ArrayLike, pose: ArrayLike, name:
                                                 f"{edge_text}: {pose_text(flush)}")
 
 
-def _check_transit(part: Part, pusher: Pusher, transit: Transit, edge: int | None, name: str) -> None:
-    """Refuse a transit the scene does not allow, or one that does not leave from ``edge`` (the
-    edge the pusher is on; None at the plan's start) and reach its own ``to_edge`` flush."""
-    allowed = pusher.transit
+def _check_transit(part: Part, transit: Transit, edge: int | None, name: str, allowed: str) -> None:
+    """Refuse a transit the ``transit`` option ``allowed`` does not allow, or one that does not
+    leave from ``edge`` (the edge the pusher is on; None at the plan's start) and reach its own
+    ``to_edge`` flush."""
     if allowed == "none" or (transit.mode == "lift" and allowed != "lift"):
-        raise SceneError(f"{name}.mode", f"a {transit.mode} transit is not allowed: the scene's pusher.transit "
-                                         f"is {allowed!r}")
+        raise SceneError(f"{name}.mode", f"a {transit.mode} transit is not allowed: the transit option is {allowed!r}")
     if edge is not None and transit.from_edge != edge:
         raise SceneError(f"{name}.from_edge", f"must be {edge}, the edge the pusher is on, got {transit.from_edge}")
     for field, verb, e, pose in (("from_edge", "starts", transit.from_edge, transit.pusher_path[0]),
@@ -394,10 +394,11 @@ def placed_moves(plan: Plan) -> Iterator[tuple[Move, dict[str, np.ndarray], int]
         poses[move.part] = move.end
 
 
-def check_chain(scene: Scene, plan: Plan) -> list[list[tuple[Push, tuple[Contact, ...]]]]:
+def check_chain(scene: Scene, plan: Plan, transit: str) -> list[list[tuple[Push, tuple[Contact, ...]]]]:
     """Per move, each of its pushes with the pusher's contacts for it, after checking that the
-    plan's parts are the scene's and that every segment fits the scene and takes over where the one
-    before left its part and the pusher (module docstring). Errors name the plan's fields as its
+    plan's parts are the scene's and that every segment fits the scene and the ``transit`` option
+    and takes over where the one before left its part and the pusher (module docstring). Errors
+    name the plan's fields as its
     file does (:func:`~planner.model.plan_file.part_field`), segments by their index in
     :attr:`Plan.segments`."""
     if sorted(plan.names) != sorted(scene.names):
@@ -422,14 +423,15 @@ def check_chain(scene: Scene, plan: Plan) -> list[list[tuple[Push, tuple[Contact
             _check_flush(part, to, poses[move.part], move.transfer.pusher_path[-1], after, "ends",
                          f"part {move.part}'s edge {to}")
             edge = to
-        out.append(_check_move(part, scene.pusher, move.segments, poses[move.part], edge, first, after))
+        out.append(_check_move(part, scene.pusher, move.segments, poses[move.part], edge, first, after, transit))
     return out
 
 
 def _check_move(part: Part, pusher: Pusher, segments: list[Push | Transit], pose: np.ndarray, edge: int | None,
-                first: int, after: str) -> list[tuple[Push, tuple[Contact, ...]]]:
+                first: int, after: str, transit: str) -> list[tuple[Push, tuple[Contact, ...]]]:
     """:func:`check_chain` of one move's ``segments`` (plan segments ``first`` on), ``part`` at
-    ``pose`` and the pusher on ``edge`` (None: anywhere) as ``after`` left them."""
+    ``pose`` and the pusher on ``edge`` (None: anywhere) as ``after`` left them, with the
+    ``transit`` option."""
     out = []
     for k, segment in enumerate(segments, first):
         name = f"plan.segments[{k}]"
@@ -440,7 +442,7 @@ def _check_move(part: Part, pusher: Pusher, segments: list[Push | Transit], pose
                              f"the part is at {pose_text(segment.start)}, not where {after} left it: "
                              f"{pose_text(pose)}")
         if isinstance(segment, Transit):
-            _check_transit(part, pusher, segment, edge, name)
+            _check_transit(part, segment, edge, name, transit)
         else:
             if edge is not None and segment.edge != edge:
                 raise SceneError(f"{name}.edge", f"must be {edge}, the edge the pusher is on after {after} "
@@ -464,7 +466,8 @@ def _meets(scene: Scene, move: Move, poses: dict[str, np.ndarray], other: str) -
     return not all(is_clear(only, model, s) for s in move.segments)
 
 
-def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: float = TOLERANCE) -> Verification:
+def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: float = TOLERANCE, *,
+           transit: str = DEFAULT_TRANSIT) -> Verification:
     """Re-simulate every push of ``plan`` under ``n`` support distributions of its part, and sweep
     every move against the other parts (module docstring).
 
@@ -480,6 +483,8 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
         Seed of the random distributions.
     tolerance : float
         Relative tolerance: positions in part radii, angles in radians.
+    transit : str
+        The ``transit`` option the plan was made with: the modes its transits may use.
 
     Returns
     -------
@@ -490,8 +495,8 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
     SceneError
         If the plan is not solved, or is for other parts, or a segment does not fit the scene (an
         edge the scene does not allow, a contact off its edge, a push of no duration, a lift where
-        the pusher must stay on the table) or does not take over where the one before it left its
-        part and the pusher (module docstring), naming the plan field.
+        ``transit`` keeps the pusher on the table) or does not take over where the one before it
+        left its part and the pusher (module docstring), naming the plan field.
     ValueError
         If ``n < 1``.
 
@@ -504,7 +509,7 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
     (True, 1, True)
     """
     check_solved(plan)
-    contacts = check_chain(scene, plan)
+    contacts = check_chain(scene, plan, transit)
     clock = time.perf_counter()
     supports_of, kinds = {}, []
     for part in scene.names:

@@ -1,9 +1,9 @@
 """The planner's options: their choices, defaults and bounds, and the checks that read them.
 
-A scene's ``planner:`` block (:class:`PlannerOptions`, read by :mod:`.scene`), the ``plan``
-command's flags and :func:`planner.plan`'s keywords all take the same options, so each is checked
-here once and reported as a :class:`~planner.model.fields.SceneError` naming the field or flag
-given (``name``):
+A scene file's ``planner:`` block and ``pusher.transit`` (read into a :class:`PlannerOptions` by
+:mod:`.scene_file`), the ``plan`` command's flags and :func:`planner.plan`'s keywords all take the
+same options, so each is checked here once and reported as a
+:class:`~planner.model.fields.SceneError` naming the field or flag given (``name``):
 
 >>> check_seed(7, "--seed"), check_regions("exact", "planner.regions")
 (7, 'exact')
@@ -51,11 +51,11 @@ MAX_TIME_LIMIT = 86400.0
 
 @dataclass(frozen=True)
 class PlannerOptions:
-    """How a scene is planned, apart from what it describes: a scene's ``planner:`` block, the
+    """How a scene is planned, apart from what it describes: what a scene file asks for (its
+    ``planner:`` block and ``pusher.transit``, :attr:`planner.model.scene.Scene.options`), the
     options of a :class:`planner.Planner` session, the ``plan`` command's flags and a batch task's
-    overrides all come down to one of these, made or changed by :meth:`merged` alone.
-
-    ``transit``, where given, replaces the scene's ``pusher.transit`` (None: the scene's).
+    overrides all come down to one of these, made or changed by :meth:`merged` alone. A session
+    resolves them once and passes them down as arguments.
 
     >>> PlannerOptions().merged({"seed": 4, "regions": "stable"}).seed
     4
@@ -75,7 +75,7 @@ class PlannerOptions:
     regions: str = DEFAULT_REGIONS
     switch_cost: float = DEFAULT_SWITCH_COST
     optimize: int = 0  # improvement rounds after the first plan (planner.search.planning.solve)
-    transit: str | None = None
+    transit: str = DEFAULT_TRANSIT  # how the pusher may change edge (TRANSITS)
 
     def merged(self, changes: Mapping[str, Any] | None, prefix: str = "") -> "PlannerOptions":
         """These options with ``changes`` (field name to value) applied, each checked; a

@@ -5,6 +5,10 @@ the :class:`Pusher`, the obstacles, the workspace and the goal tolerance. A file
 ``start:`` and ``goal:`` is a scene of one part, named :data:`ONE_PART`; a file with ``parts:``
 names its own. Everything that plans, checks or draws takes a scene of any number of parts.
 
+How to plan is apart from the scene: the options the file asks for are kept as
+:attr:`Scene.options`, the defaults of a :class:`planner.Planner` session, which resolves its own
+options once and passes them down; what plans, checks or draws below it takes them as arguments.
+
 Moving one part is a problem of one part: :meth:`Scene.move_scene` is the scene of that move,
 every other part an obstacle where it stands. The search works on such scenes of one part, whose
 :meth:`Scene.part` (and its shorthands :attr:`Scene.slider`, :attr:`Scene.start`,
@@ -40,7 +44,7 @@ from mechanics import Slider, wrap_angle
 
 from .bodies import slider_at
 from .fields import SceneError, shown
-from .options import DEFAULT_TRANSIT, PlannerOptions
+from .options import PlannerOptions
 
 __all__ = ["ONE_PART", "Part", "Pusher", "Scene"]
 
@@ -58,7 +62,6 @@ class Pusher:
     depth: float
     mu: float
     mu_high: float | None = None  # top of the friction interval, if one was given
-    transit: str = DEFAULT_TRANSIT  # how it moves between edges (TRANSITS)
 
 
 @dataclass(frozen=True)
@@ -84,7 +87,9 @@ class Scene:
     workspace: tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
     tolerance_position: float = 0.01
     tolerance_angle: float = math.radians(2.0)
-    planner: PlannerOptions = field(default_factory=PlannerOptions)
+    #: The options the file asks for (its ``planner:`` block and ``pusher.transit``): a session's
+    #: defaults (:class:`planner.Planner`); nothing below the session reads them.
+    options: PlannerOptions = field(default_factory=PlannerOptions)
     path: str | None = None  # the file it was read from
     notes: tuple[str, ...] = ()  # what was not read from the CAD files it names (text, open chains)
 
@@ -141,12 +146,6 @@ class Scene:
             if key in changes:
                 changes[key] = np.asarray(changes[key], dtype=float)
         return replace(self, parts=(replace(self.part(), **changes),))
-
-    def with_options(self, options: PlannerOptions) -> "Scene":
-        """This scene as planned with ``options``: its ``planner`` block replaced, and its
-        ``pusher.transit`` where the options name one."""
-        pusher = self.pusher if options.transit is None else replace(self.pusher, transit=options.transit)
-        return replace(self, planner=options, pusher=pusher)
 
     def body(self, name: str, pose: ArrayLike) -> shapely.Polygon:
         """Part ``name``'s outline at ``pose`` (world)."""

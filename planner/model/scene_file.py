@@ -1,12 +1,13 @@
 """Scene files: the parts, the pusher, the table and the task, read from YAML and validated, and
 written back in the plain schema.
 
-The file is read by the hardened YAML reader of :mod:`.yaml_file`, the ``planner:`` block's options
-are checked by :mod:`.options`. Every problem is reported as a :class:`~planner.model.fields.SceneError`
-naming the offending field, so the command line can print one line and exit 1. The format is
-documented in the README. A mapping with ``parts:`` describes several parts (README, "Several
-parts"); one with ``slider:``, ``start:`` and ``goal:`` a scene of one part
-(:data:`~planner.model.scene.ONE_PART`).
+The file is read by the hardened YAML reader of :mod:`.yaml_file`; its ``planner:`` block and
+``pusher.transit`` are checked by :mod:`.options` and read into one
+:class:`~planner.model.options.PlannerOptions`, the scene's :attr:`~planner.model.scene.Scene.options`.
+Every problem is reported as a :class:`~planner.model.fields.SceneError` naming the offending
+field, so the command line can print one line and exit 1. The format is documented in the
+README. A mapping with ``parts:`` describes several parts (README, "Several parts"); one with
+``slider:``, ``start:`` and ``goal:`` a scene of one part (:data:`~planner.model.scene.ONE_PART`).
 
 >>> [load_scene(f).names for f in ("scenes/battery.yaml", "scenes/parts/swap.yaml")]
 [('part',), ('red', 'blue')]
@@ -38,7 +39,7 @@ __all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "PLANNER_KEYS", "Table", "lo
            "placement_fault", "plain_scene", "read_cf_uncertainty", "read_edges", "read_name", "read_pose",
            "read_pusher", "read_slider", "read_table", "write_scene"]
 
-#: The keys of a scene's ``planner:`` block: the options but ``transit``, which is ``pusher.transit``.
+#: The keys of a scene's ``planner:`` block: the options but ``transit``, which a file gives as ``pusher.transit``.
 PLANNER_KEYS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize")
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
 _MAX_NAME_BYTES = 200
@@ -69,11 +70,12 @@ def load_scene(path: str | Path) -> Scene:
     return parse_scene(read_yaml(path, "scene"), default_name=path.stem, path=str(path))
 
 
-def plain_scene(scene: Scene) -> dict[str, Any]:
+def plain_scene(scene: Scene, options: PlannerOptions | None = None) -> dict[str, Any]:
     """``scene`` as :func:`parse_scene` reads it back, in the plain schema: every polygon as its
     vertices in metres (obstacle boxes and CAD files resolved), poses in degrees, the CF and the
     pushed edges written out; a scene of several parts (or of one not named
-    :data:`~planner.model.scene.ONE_PART`) as ``parts:``.
+    :data:`~planner.model.scene.ONE_PART`) as ``parts:``. Its options are ``options`` (default:
+    the scene's own), as a file gives them: the ``planner:`` block and ``pusher.transit``.
 
     >>> scene = load_scene("scenes/battery.yaml")
     >>> data = plain_scene(scene)
@@ -87,12 +89,13 @@ def plain_scene(scene: Scene) -> dict[str, Any]:
     (['red', 'blue'], ('red', 'blue'))
     """
     pusher = scene.pusher
+    options = scene.options if options is None else options
     pusher_data = {"width": pusher.width, "depth": pusher.depth,
-                   "mu": pusher.mu if pusher.mu_high is None else [pusher.mu, pusher.mu_high], "transit": pusher.transit}
+                   "mu": pusher.mu if pusher.mu_high is None else [pusher.mu, pusher.mu_high], "transit": options.transit}
     table = {"obstacles": [{"polygon": np.asarray(o.exterior.coords)[:-1].tolist()} for o in scene.obstacles],
              "workspace": {"min": list(scene.workspace[:2]), "max": list(scene.workspace[2:])},
              "tolerance": {"position": scene.tolerance_position, "angle": _degrees(scene.tolerance_angle)},
-             "planner": {key: getattr(scene.planner, key) for key in PLANNER_KEYS}}
+             "planner": {key: getattr(options, key) for key in PLANNER_KEYS}}
     if scene.names == (ONE_PART,):
         part = scene.part()
         return {"name": scene.name, "slider": _plain_part(part), "pusher": {**pusher_data, "edges": list(part.edges)},
@@ -117,8 +120,9 @@ def _degrees(radians: float) -> float:
     return round(math.degrees(radians), 10) + 0.0  # no -0.0
 
 
-def write_scene(scene: Scene, path: str | Path) -> None:
-    """Write :func:`plain_scene` of ``scene`` to ``path`` as YAML, atomically.
+def write_scene(scene: Scene, path: str | Path, options: PlannerOptions | None = None) -> None:
+    """Write :func:`plain_scene` of ``scene`` and ``options`` (default: the scene's own) to
+    ``path`` as YAML, atomically.
 
     Raises
     ------
@@ -126,7 +130,7 @@ def write_scene(scene: Scene, path: str | Path) -> None:
         Naming ``path``, if it cannot be written.
     """
     source = f" from {scene.path}" if scene.path else ""
-    text = yaml.safe_dump(plain_scene(scene), sort_keys=False, default_flow_style=None, width=120)
+    text = yaml.safe_dump(plain_scene(scene, options), sort_keys=False, default_flow_style=None, width=120)
     write_atomic(path, f"# The scene{source} as planned: plan --export-scene writes what the planner used.\n{text}")
 
 
@@ -236,16 +240,17 @@ def _checked_slider(vertices: np.ndarray, spec: dict, field: str, name: str) -> 
         raise SceneError(f"{name}.cf", str(err)) from None
 
 
-def read_pusher(value: Any, one_part: bool) -> tuple[Pusher, Any]:
-    """The pusher ``value`` describes, and its ``edges`` as listed (None if not: every pushable
+def read_pusher(value: Any, one_part: bool) -> tuple[Pusher, Any, str]:
+    """The pusher ``value`` describes, its ``edges`` as listed (None if not: every pushable
     edge), which only a scene of one part (``one_part``) may give: the parts of a scene with
-    ``parts:`` list their own (:func:`read_edges`)."""
+    ``parts:`` list their own (:func:`read_edges`), and its ``transit``, checked: an option of the
+    scene's (:func:`read_table`) that the file gives with the pusher."""
     spec = keys(value, "pusher", ("width", "depth", "mu"), ("edges", "transit") if one_part else ("transit",))
     width, depth = (_at_least_min_size(number(spec[key], f"pusher.{key}", positive=True, limit=LENGTH),
                                        f"pusher.{key}", spec[key]) for key in ("width", "depth"))
     mu, mu_high = _friction(spec["mu"])
     transit = check_transit(spec.get("transit", DEFAULT_TRANSIT), "pusher.transit")
-    return Pusher(width, depth, mu, mu_high, transit), spec.get("edges")
+    return Pusher(width, depth, mu, mu_high), spec.get("edges"), transit
 
 
 def read_edges(listed: Any, slider: Slider, name: str) -> tuple[int, ...]:
@@ -332,30 +337,32 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     folder, notes = Path(path).parent if path else Path(), []
     slider = read_slider(spec["slider"], folder, notes)
     cf_uncertainty = read_cf_uncertainty(spec["slider"], slider, "slider")
-    pusher, listed = read_pusher(spec["pusher"], True)
+    pusher, listed, transit = read_pusher(spec["pusher"], True)
     edges = read_edges(listed, slider, "pusher.edges")
-    table = read_table(spec, folder, notes)
+    table = read_table(spec, folder, notes, transit)
     start = read_pose(spec["start"], "start", slider, table.obstacles, table.workspace)
     goal = read_pose(spec["goal"], "goal", slider, table.obstacles, table.workspace)
     part = Part(ONE_PART, slider, start, goal, edges, cf_uncertainty)
     return Scene(name, (part,), pusher, table.obstacles, table.workspace, table.tolerance_position,
-                 table.tolerance_angle, table.planner, path, tuple(notes))
+                 table.tolerance_angle, table.options, path, tuple(notes))
 
 
 @dataclass(frozen=True)
 class Table:
     """What every scene has besides its parts and pusher: obstacles, workspace, goal tolerance
-    and planner options."""
+    and the options the file asks for."""
 
     obstacles: tuple[shapely.Polygon, ...]
     workspace: tuple[float, float, float, float]
     tolerance_position: float
     tolerance_angle: float
-    planner: PlannerOptions
+    options: PlannerOptions
 
 
-def read_table(spec: dict, folder: Path, notes: list[str]) -> Table:
-    """The :class:`Table` of a scene's mapping ``spec``, checked; CAD files are relative to ``folder``."""
+def read_table(spec: dict, folder: Path, notes: list[str], transit: str) -> Table:
+    """The :class:`Table` of a scene's mapping ``spec``, checked; CAD files are relative to
+    ``folder``. Its options are the ``planner:`` block's with ``transit`` (the pusher's, checked
+    by :func:`read_pusher`)."""
     obstacles_spec = [] if spec.get("obstacles") is None else spec["obstacles"]  # None: a bare "obstacles:"
     if not isinstance(obstacles_spec, list):
         raise SceneError("obstacles", "must be a list")
@@ -379,7 +386,8 @@ def read_table(spec: dict, folder: Path, notes: list[str]) -> Table:
         raise SceneError("tolerance.angle", f"must be at least {math.degrees(MIN_TOLERANCE):g} degrees (the rounding "
                                             f"of a plan's headings is about 1e-11 rad), got {math.degrees(tol_ang):g}")
     opts = keys(spec.get("planner", {}), "planner", (), PLANNER_KEYS)
-    return Table(obstacles, workspace, tol_pos, tol_ang, PlannerOptions().merged(opts, prefix="planner."))
+    return Table(obstacles, workspace, tol_pos, tol_ang,
+                 PlannerOptions().merged({**opts, "transit": transit}, prefix="planner."))
 
 
 def read_cf_uncertainty(spec: dict, slider: Slider, name: str) -> float:
@@ -410,8 +418,8 @@ def _parse_parts(data: dict, default_name: str, path: str | None) -> Scene:
     spec = keys(data, "scene", ("parts", "pusher", "workspace"), ("name", "obstacles", "tolerance", "planner"))
     name = read_name(spec.get("name", default_name))
     folder, notes = Path(path).parent if path else Path(), []
-    pusher, _ = read_pusher(spec["pusher"], False)
-    table = read_table(spec, folder, notes)
+    pusher, _, transit = read_pusher(spec["pusher"], False)
+    table = read_table(spec, folder, notes, transit)
     listed = spec["parts"]
     if not isinstance(listed, list) or not listed:
         raise SceneError("parts", "must be a non-empty list of parts, each with name, vertices, start and goal")
@@ -431,7 +439,7 @@ def _parse_parts(data: dict, default_name: str, path: str | None) -> Scene:
     for which in ("start", "goal"):
         _apart(parts, which)
     return Scene(name, tuple(parts), pusher, table.obstacles, table.workspace, table.tolerance_position,
-                 table.tolerance_angle, table.planner, path, tuple(notes))
+                 table.tolerance_angle, table.options, path, tuple(notes))
 
 
 def _part_name(value: Any, field_name: str) -> str:

@@ -222,13 +222,16 @@ def _summary(scene: Scene, plan: Plan) -> list[str]:
     if not plan.solved:
         return [f"{head}: not solved: {plan.reason}", last]
     length = sum(path_length(m.segments, scene.part(m.part).slider.cf) for m in plan.moves)
-    cost = length + (plan.switches + plan.transfers) * scene.planner.switch_cost
+    # The plan's own switch cost; a plan file may not give one, and then its cost is not known.
     per = "per switch" + (" and per transfer" if plan.transfers else "")
+    cost = "" if plan.switch_cost is None else (
+        f"; cost {length + (plan.switches + plan.transfers) * plan.switch_cost:.4f} m "
+        f"(length + {plan.switch_cost:g} m {per})")
     times = [f"{word} time {sum(s.duration for s in plan.segments if isinstance(s, kind)):.4f} s"
              for word, kind in (("push", Push), ("transit", Transit), ("transfer", Transfer))
              if kind is Push or any(isinstance(s, kind) for s in plan.segments)]
     return [f"{head}: solved with {' and '.join(plan.contents().rsplit(', ', 1))}",
-            f"CF path length {length:.4f} m; cost {cost:.4f} m (length + {scene.planner.switch_cost:g} m {per})",
+            f"CF path length {length:.4f} m{cost}",
             f"{', '.join(times)} (every point of the pusher at most 1 m/s)", last]
 
 

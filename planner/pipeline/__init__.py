@@ -1,6 +1,7 @@
 """The pipeline: what the ``plan`` command does, as one library call.
 
-:func:`run` takes a scene (of one part or several) and :class:`RunOptions` and does, in order,
+:func:`run` takes a scene (of one part or several), :class:`RunOptions` and the planner's options
+(:class:`~planner.model.options.PlannerOptions`, default: the scene's own) and does, in order,
 what they ask: certify the goal unreachable or plan it (or fit a plan read from a file), verify
 the plan under many support distributions, time it into a trajectory, run it in MuJoCo open loop
 or closed loop, map the reachable set, and write the outputs. It returns an :class:`Outcome`

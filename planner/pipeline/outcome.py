@@ -18,7 +18,7 @@ class OutputError(Exception):
 
 @dataclass(frozen=True)
 class Outcome:
-    """Everything :func:`~planner.pipeline.run` found: the scene as planned, the plan (planned, or
+    """Everything :func:`~planner.pipeline.run` found: the scene it was given, the plan (planned, or
     read from ``loaded`` and fitted to the scene), why the goal is certainly unreachable (if it
     is), and each check's result where it was asked: ``verification``
     (:class:`~planner.execution.verify.Verification`), ``simulation`` (open or closed loop),

@@ -10,36 +10,48 @@ from __future__ import annotations
 
 import tempfile
 from collections.abc import Callable, Iterator
+from collections.abc import Mapping
 from contextlib import contextmanager, nullcontext
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 from ..model.fields import SceneError, shown
 from ..model.files import atomic_path, staged_folder, write_atomic
+from ..model.options import PlannerOptions
 from ..model.plan import Plan
 from ..model.plan_file import load_plan
 from ..model.scene import Scene
 from ..outputs.recorder import RecordingFailed, recorder
 from ..queries.reachability import certify_unreachable
-from ..queries.session import Planner
+from ..queries.session import Planner, session_options
 from .options import RunOptions
 from .outcome import Outcome, OutputError
 
 __all__ = ["check_outputs", "run"]
 
-#: A function mapping a one-part scene's reachable set in at most N pushes (``reach_map(scene, n)``).
-ReachMap = Callable[[Scene, int], object]
+#: A function mapping a one-part scene's reachable set in at most N pushes with the stable pushes of
+#: a ``regions`` option (``reach_map(scene, n, regions=regions)``).
+ReachMap = Callable[..., object]
 
 
-def run(scene: Scene, options: RunOptions = RunOptions(), *, progress: Callable[[int, int], None] | None = None,
-        reach_map: ReachMap | None = None) -> Outcome:
+def run(scene: Scene, options: RunOptions = RunOptions(),
+        planner_options: PlannerOptions | Mapping[str, Any] | None = None, *,
+        progress: Callable[[int, int], None] | None = None, reach_map: ReachMap | None = None) -> Outcome:
     """Run ``scene`` as ``options`` ask (module docstring of :mod:`planner.pipeline`): the plan
     read from ``options.plan_file`` and fitted to the scene, or else the goal's certificate of
     unreachability (one part: the geometry's, at once) or a plan of a :class:`Planner` session
     (``progress(k, n)`` before each region it computes); then the checks, the simulation (closed
     loop on the same session), the map (by ``reach_map``, default: this process) and the outputs
-    in ``options.out``. Seeds: the scene's planner options' seed plans, and draws every random
-    distribution, so a run is repeatable as a whole.
+    in ``options.out``.
+
+    ``planner_options`` are the planner's, resolved once as a session resolves them
+    (:func:`~planner.queries.session.session_options`: a
+    :class:`~planner.model.options.PlannerOptions`, or a mapping of changes to the scene's own;
+    default: the scene's own) and used by every step: the session plans with them, the plan file
+    and the checks allow the transits their ``transit`` allows, the map uses their ``regions``,
+    and ``export_scene`` writes them. Their seed plans and draws every random distribution, so a
+    run is repeatable as a whole.
 
     Raises
     ------
@@ -49,9 +61,10 @@ def run(scene: Scene, options: RunOptions = RunOptions(), *, progress: Callable[
         If an output cannot be written (the message names the file).
     """
     options = options.checked(scene)
+    planner_options = session_options(scene, planner_options)
     if options.out is not None:
         check_outputs(options)
-    loaded = None if options.plan_file is None else _fitted(scene, options.plan_file)
+    loaded = None if options.plan_file is None else _fitted(scene, options.plan_file, planner_options.transit)
     # The recording's process is forked before the search, while this one runs one thread.
     with recorder(scene) if options.out is not None else nullcontext() as write_recording:
         session, unreachable = None, None
@@ -62,53 +75,56 @@ def run(scene: Scene, options: RunOptions = RunOptions(), *, progress: Callable[
             unreachable = certify_unreachable(scene, regions=False) if len(scene.parts) == 1 else None
             if unreachable:
                 result = Plan.of_part(scene.part().name, scene.start, scene.goal, [], scene=scene.path, solved=False,
-                                      planner=scene.planner.name, seed=scene.planner.seed, planning_time_s=0.0,
-                                      reason=unreachable)
+                                      planner=planner_options.name, seed=planner_options.seed,
+                                      planning_time_s=0.0, reason=unreachable)
             else:
-                session = Planner(scene, progress=progress)
+                session = Planner(scene, planner_options, progress=progress)
                 result = session.plan(since=session.clock)  # the time limit bounds the regions too
-        outcome = _checked(scene, options, result, session, reach_map)
+        outcome = _checked(scene, options, planner_options, result, session, reach_map)
         outcome = replace(outcome, loaded=None if loaded is None else str(options.plan_file), unreachable=unreachable)
         if options.out is not None:
-            outcome = replace(outcome, out=options.out, files=_write(outcome, options, write_recording))
+            outcome = replace(outcome, out=options.out,
+                              files=_write(outcome, options, planner_options, write_recording))
     return outcome
 
 
-def _fitted(scene: Scene, path: str | Path) -> Plan:
+def _fitted(scene: Scene, path: str | Path, transit: str) -> Plan:
     from ..execution.fit import fit_plan  # with the re-simulator: only for a plan file
 
-    return fit_plan(scene, load_plan(path))
+    return fit_plan(scene, load_plan(path), transit=transit)
 
 
-def _checked(scene: Scene, options: RunOptions, result: Plan, session: Planner | None,
-             reach_map: ReachMap | None) -> Outcome:
+def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions, result: Plan,
+             session: Planner | None, reach_map: ReachMap | None) -> Outcome:
     """The checks, the simulation and the map that ``options`` ask for of ``result``."""
-    seed = scene.planner.seed
+    seed = planner_options.seed
     check = motion = simulation = reach = None
     if options.verify and result.solved:
         from ..execution.verify import verify  # the re-simulator, loaded only for verify
 
-        check = verify(scene, result, options.verify, seed)
+        check = verify(scene, result, options.verify, seed, transit=planner_options.transit)
     if options.trajectory and result.solved:
         from ..execution.trajectory import trajectory  # loads ruckig, only for a trajectory
 
         motion = trajectory(scene, result)
     if options.simulate and result.solved:
-        simulation = _simulated(scene, options, result, session)
+        simulation = _simulated(scene, options, planner_options, result, session)
     if options.reach:  # the map is about the start, whatever the plan
         mapped = scene if options.part is None else scene.move_scene(options.part, scene.starts)
         if reach_map is None:
             from ..queries.reachable_set import reachable_set
 
             reach_map = reachable_set
-        reach = reach_map(mapped, options.reach)
+        reach = reach_map(mapped, options.reach, regions=planner_options.regions)
     return Outcome(scene, result, verification=check, simulation=simulation, trajectory=motion, reach=reach)
 
 
-def _simulated(scene: Scene, options: RunOptions, result: Plan, session: Planner | None):
+def _simulated(scene: Scene, options: RunOptions, planner_options: PlannerOptions, result: Plan,
+               session: Planner | None):
     """The MuJoCo runs of ``result`` (MuJoCo is loaded only now): open loop, or closed loop on
-    ``session`` (made now for a plan read from a file), whose re-plans join ``result``."""
-    seed, cf_offset = scene.planner.seed, options.sim_cf_offset or (0.0, 0.0)
+    ``session`` (made now, with ``planner_options``, for a plan read from a file), whose re-plans
+    join ``result``."""
+    seed, cf_offset = planner_options.seed, options.sim_cf_offset or (0.0, 0.0)
     start_error = options.start_error or (0.0, 0.0, 0.0)
     if not options.closed_loop:
         from ..execution.mujoco_sim import simulate
@@ -117,7 +133,7 @@ def _simulated(scene: Scene, options: RunOptions, result: Plan, session: Planner
     from ..execution.closed_loop import closed_loop
 
     if session is None:
-        session = Planner(scene)
+        session = Planner(scene, planner_options)
         # A plan for the goal that re-plans are joined to; a tray's move sessions are made as its moves are tracked.
         if len(scene.parts) == 1:
             session.plan(start=result.start)
@@ -151,12 +167,13 @@ def check_outputs(options: RunOptions) -> None:
         raise SceneError("export_scene", f"{shown(str(options.export_scene))} is a folder")
 
 
-def _write(outcome: Outcome, options: RunOptions, write_recording: Callable[..., None]) -> list[str]:
+def _write(outcome: Outcome, options: RunOptions, planner_options: PlannerOptions,
+           write_recording: Callable[..., None]) -> list[str]:
     """Write ``outcome``'s files into ``options.out`` (module docstring): the recording (with the
     verification's ghost, the map and the worst simulated run, or a closed loop's runs on their
     own clocks), the map's PNG, the trajectory's CSV (and a closed loop's executed paths), the
-    first run's MJCF, the scene as planned, and the plan file last. Returns the names written,
-    the plan file first."""
+    first run's MJCF, the scene as planned (with ``planner_options``), and the plan file last.
+    Returns the names written, the plan file first."""
     scene, out, name = outcome.scene, options.out, outcome.scene.name
     simulation, closed = outcome.simulation, options.closed_loop
     files = [f"{name}.json", f"{name}.rrd"]
@@ -164,7 +181,7 @@ def _write(outcome: Outcome, options: RunOptions, write_recording: Callable[...,
         try:
             from ..model.scene_file import write_scene
 
-            write_scene(scene, options.export_scene)
+            write_scene(scene, options.export_scene, planner_options)
         except OSError as err:
             raise OutputError(f"cannot write {shown(str(options.export_scene))}: {err.strerror or err}") from None
     with _writing(out, name) as stage:

@@ -2,8 +2,8 @@
 
 The controls are the extremal stable twists of each allowed edge (the corners of its region,
 whose positive combinations hold the whole region, Prop. 3), decided by
-:func:`mechanics.controllability`. Without switching (``pusher.transit: none``) a plan keeps one
-edge, so each edge counts alone; otherwise the edges' twists are pooled.
+:func:`mechanics.controllability`. Without switching (the ``transit`` option ``none``) a plan
+keeps one edge, so each edge counts alone; otherwise the edges' twists are pooled.
 
 One edge alone is never small-time locally controllable (the paper: it cannot pull back). Every
 stable twist of an edge pushes the contact's midpoint ``m`` into the part, ``a(v) = (v_xy + omega
@@ -23,6 +23,7 @@ from mechanics import Controllability, controllability as twist_controllability
 
 from ..model.fields import SceneError
 from ..actions.controls import edge_controls
+from ..model.options import DEFAULT_REGIONS, DEFAULT_TRANSIT
 from ..model.scene import Scene
 
 __all__ = ["SceneControllability", "controllability"]
@@ -44,7 +45,7 @@ class SceneControllability:
         Edges whose union is STLC: a pair if one is (the first in order), else an inclusion-minimal
         set; empty if even the union is not.
     switching : bool
-        Whether the plan may change edge (``pusher.transit`` is not ``'none'``).
+        Whether the plan may change edge (the ``transit`` option is not ``'none'``).
     opposite : bool
         Whether ``stlc_edges`` are two parallel faces pushed from either side.
     """
@@ -102,12 +103,17 @@ class SceneControllability:
         return line
 
 
-def controllability(scene: Scene) -> SceneControllability:
+def controllability(scene: Scene, *, regions: str = DEFAULT_REGIONS,
+                    transit: str = DEFAULT_TRANSIT) -> SceneControllability:
     """The controllability the scene's allowed edges give by stable pushes.
 
     Parameters
     ----------
     scene : Scene
+    regions : str
+        The ``regions`` option: the stable pushes of ``'exact'`` regions or procedure ``'stable'``.
+    transit : str
+        The ``transit`` option: ``'none'`` keeps one edge per plan.
 
     Returns
     -------
@@ -128,7 +134,7 @@ def controllability(scene: Scene) -> SceneControllability:
     controllable (edges 0, 1, 2, 3); small-time locally controllable with edges 0 and 2 (opposite faces)
     """
     try:
-        pushes = edge_controls(scene)
+        pushes = edge_controls(scene, regions=regions)
     except SceneError as err:
         if err.field == "planner.regions":  # a refused method, not a finding about the edges
             raise
@@ -140,7 +146,7 @@ def controllability(scene: Scene) -> SceneControllability:
     normals = [scene.slider.inward_normal(e) for e in stlc_edges]
     opposite = len(normals) == 2 and float(normals[0] @ normals[1]) < -1.0 + 1e-9
     return SceneControllability(per_edge, tuple(e for e in scene.edges if e not in twists), union,
-                                stlc_edges, scene.pusher.transit != "none", opposite)
+                                stlc_edges, transit != "none", opposite)
 
 
 def _stlc_edges(twists: dict[int, np.ndarray]) -> tuple[int, ...]:

@@ -35,9 +35,9 @@ import shapely
 from ..actions.controls import NoStablePush
 from ..actions.transit import edge_contact_pose
 from ..model.bodies import slider_at
+from ..model.options import PlannerOptions
 from ..model.scene import Scene
 from ..model.plan import Move, Plan
-from ..model.plan import Plan
 from ..search.transfer import TransferPaths
 
 __all__ = ["BUFFER_TRIES", "MOVE_SHARE", "PartSession", "plan_parts"]
@@ -66,12 +66,14 @@ class _Best:
     delivered: int
 
 
-def plan_parts(scene: Scene, session_of: Callable[[str, dict[str, np.ndarray] | None], PartSession],
-               paths: TransferPaths, seed: int, time_limit: float) -> Plan:
+def plan_parts(scene: Scene, options: PlannerOptions,
+               session_of: Callable[[str, dict[str, np.ndarray] | None], PartSession], paths: TransferPaths,
+               seed: int, time_limit: float) -> Plan:
     """Plan every part of ``scene`` from its start to its goal (module docstring) within
     ``time_limit`` seconds, each move planned by ``session_of(part, poses)`` (a one-part session
     of the part with the others at ``poses``; with ``poses`` None, among the obstacles alone) and
-    each transfer by ``paths``, seeded by ``seed``.
+    each transfer by ``paths``, seeded by ``seed``; ``options`` are the sessions' (the plan is
+    costed with their ``switch_cost``).
 
     A part whose goal the certificates show unreachable among the obstacles alone cannot be
     delivered in any order: it is left where it is (an obstacle to the others), the rest are
@@ -87,10 +89,10 @@ def plan_parts(scene: Scene, session_of: Callable[[str, dict[str, np.ndarray] | 
     solved = found is not None and not hopeless
     reason = "" if solved else search.why(delivered) if found is None else "; ".join(
         f"not delivered: {n}: its goal is certified unreachable among the obstacles: {r}" for n, r in hopeless.items())
-    return Plan(scene=scene.path, solved=solved, planner=scene.planner.name, seed=seed,
+    return Plan(scene=scene.path, solved=solved, planner=options.name, seed=seed,
                      planning_time_s=time.perf_counter() - clock, starts=scene.starts, goals=scene.goals,
                      moves=moves, delivered=delivered, reason=reason,
-                     switch_cost=scene.planner.switch_cost, cfs={p.name: p.slider.cf.copy() for p in scene.parts})
+                     switch_cost=options.switch_cost, cfs={p.name: p.slider.cf.copy() for p in scene.parts})
 
 
 class _Search:

@@ -20,6 +20,7 @@ from mechanics import GOALS, SupportModel, classify_goal, log_pose
 from ..model.segments import Push
 from ..actions.controls import clearance_margin, edge_controls
 from ..actions.push import connect
+from ..model.options import DEFAULT_REGIONS
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
@@ -45,15 +46,17 @@ class OneStep:
         return self.segment.twist if self.segment else None
 
 
-def one_step(scene: Scene, start: ArrayLike | None = None, goal: ArrayLike | None = None) -> OneStep:
+def one_step(scene: Scene, start: ArrayLike | None = None, goal: ArrayLike | None = None, *,
+             regions: str = DEFAULT_REGIONS) -> OneStep:
     """Is ``goal`` reachable from ``start`` (default: the scene's, radians) by one constant stable
-    push about ``COR_total`` on some allowed edge, without collision?
+    push about ``COR_total`` on some allowed edge, without collision? The stable pushes are the
+    ``regions`` option's (``'exact'`` or ``'stable'``).
 
     Edges are tried in the order the scene allows them; the first that works is returned.
     """
     start = scene.start if start is None else np.asarray(start, dtype=float)
     goal = scene.goal if goal is None else np.asarray(goal, dtype=float)
-    pushes = edge_controls(scene)
+    pushes = edge_controls(scene, regions=regions)
     model = CollisionModel(scene, [p.edge for p in pushes])
     verdicts = goal_verdicts(scene, start, goal)
     reasons = []

@@ -50,6 +50,7 @@ from ..model.plan import Plan
 from ..model.segments import Push, Transit
 from ..actions.controls import clearance_margin, controls_or_reason
 from ..model.fields import poses
+from ..model.options import PlannerOptions
 from ..model.scene import Scene
 from ..search import PlanningContext, solve_many
 from ..world.free_space import ROUNDING_SHRINK, disk_free_space
@@ -68,9 +69,9 @@ class Reach:
     ``status`` is ``'reachable'`` (``plan`` reaches the goal; ``pushes`` is its number of
     pushes, 1 when one push does), ``'unreachable'`` (``reason`` names the certificate) or
     ``'unknown'`` (``reason`` says what ran out). ``verdicts`` (the one-step Goal1/2/3 label per
-    allowed edge, :func:`planner.queries.one_step.goal_verdicts`) and ``controllability`` (the scene's,
-    :func:`planner.controllability`) are computed when first read: each costs about 0.1 s, as
-    much as finding most plans.
+    allowed edge, :func:`planner.queries.one_step.goal_verdicts`) and ``controllability`` (the scene's
+    with the ``options`` it was asked with, :func:`planner.controllability`) are computed when first
+    read: each costs about 0.1 s, as much as finding most plans.
     """
 
     status: str
@@ -79,6 +80,7 @@ class Reach:
     pushes: int | None
     scene: Scene = field(repr=False, compare=False)
     goal: np.ndarray = field(repr=False, compare=False)
+    options: PlannerOptions = field(repr=False, compare=False)  # the session's
 
     @cached_property
     def verdicts(self) -> dict[int, str]:
@@ -96,7 +98,7 @@ class Reach:
         """
         from .controllability import controllability  # its scipy is not needed for the answer
 
-        return controllability(self.scene)
+        return controllability(self.scene, regions=self.options.regions, transit=self.options.transit)
 
 
 class Certificates:
@@ -145,7 +147,9 @@ class Certificates:
 def certify_unreachable(scene: Scene, goal: ArrayLike | None = None, *, regions: bool = True) -> str | None:
     """The reason ``goal`` (default: the scene's, radians) is certainly unreachable from the
     scene's start, or None if no certificate shows it (see the module's list). With
-    ``regions=False`` certificate 4, the only one needing the stable regions, is skipped.
+    ``regions=False`` certificate 4, the only one needing the stable regions, is skipped. It is
+    decided on the exact regions whatever the ``regions`` option: they are empty exactly where
+    procedure STABLE's are (Prop. 6).
 
     >>> from planner import load_scene
     >>> scene = load_scene("scenes/parking.yaml")
@@ -166,11 +170,12 @@ def _no_stable_push_reason(why: str | None) -> str | None:
     return None if why is None else f"no stable push: {why}"
 
 
-def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | None], goals: np.ndarray,
-            pushes: int | None = None, timings: dict[str, float] | None = None,
+def answers(scene: Scene, options: PlannerOptions, context: PlanningContext | None, reasons: list[str | None],
+            goals: np.ndarray, pushes: int | None = None, timings: dict[str, float] | None = None,
             known: Mapping[tuple[float, ...], list[Push | Transit]] | None = None) -> list[Reach]:
     """One :class:`Reach` per goal (rows ``(x, y, theta)``, radians) from ``scene.start`` (the
-    context's), given each goal's certificate (``reasons``, None where none fired).
+    context's), given each goal's certificate (``reasons``, None where none fired), for a session
+    with ``options``.
 
     The goals left get :func:`~planner.search.planning.solve_many`: first the one- and two-push
     connection from the start (so one stable push, when there is one, gives a 1-push plan), then
@@ -185,7 +190,7 @@ def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | N
     plans: dict[int, Plan] = {}
     if context is None:
         plans = {i: Plan.of_part(scene.part().name, scene.start, goals[i], [], scene=scene.path, solved=True,
-                                 planner=scene.planner.name, seed=scene.planner.seed, planning_time_s=0.0)
+                                 planner=options.name, seed=options.seed, planning_time_s=0.0)
                  for i in open_goals}
     elif open_goals:
         plans = dict(zip(open_goals, solve_many(context, goals[open_goals], shorten=False, timings=timings,
@@ -194,12 +199,12 @@ def answers(scene: Scene, context: PlanningContext | None, reasons: list[str | N
     for i, goal in enumerate(goals):
         found = plans.get(i)
         if found is None:
-            out.append(Reach("unreachable", None, reasons[i], None, scene, goal))
+            out.append(Reach("unreachable", None, reasons[i], None, scene, goal, options))
         elif not found.solved:
-            out.append(Reach("unknown", found, found.reason, None, scene, goal))
+            out.append(Reach("unknown", found, found.reason, None, scene, goal, options))
         elif pushes is not None and found.pushes > pushes:
             out.append(Reach("unknown", found, f"the plan found has {found.pushes} pushes, more than the budget "
-                                               f"of {pushes}", found.pushes, scene, goal))
+                                               f"of {pushes}", found.pushes, scene, goal, options))
         else:
-            out.append(Reach("reachable", found, "", found.pushes, scene, goal))
+            out.append(Reach("reachable", found, "", found.pushes, scene, goal, options))
     return out

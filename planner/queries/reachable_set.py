@@ -48,6 +48,7 @@ from ..model.extras import pyplot
 from ..model.segments import Push
 from ..search.goal_region import GoalRegion
 from ..actions.controls import EdgeControls, clearance_margin, controls_or_reason
+from ..model.options import DEFAULT_REGIONS
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
@@ -107,7 +108,7 @@ class ReachableSet:
 
 def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, resolution: float | None = None,
                   *, headings: int = HEADINGS, among: slice | None = None,
-                  controls: list[EdgeControls] | None = None) -> ReachableSet:
+                  controls: list[EdgeControls] | None = None, regions: str = DEFAULT_REGIONS) -> ReachableSet:
     """The map of goal positions reachable from ``scene.start`` in at most ``pushes`` (1 or 2)
     constant stable collision-free pushes (module docstring).
 
@@ -127,6 +128,7 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
         With ``heading`` None, only these of the ``headings`` (a part of the map, which
         :func:`planner.batch.reach.reachable_set_on` computes on another worker).
     controls : the allowed edges' controls, where the caller has them (a session)
+    regions : the ``regions`` option the controls are computed with where not given (``'exact'`` or ``'stable'``)
     """
     import time
 
@@ -148,7 +150,7 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
     theta = np.full(nx * ny, np.nan)
     blocked = np.ones(nx * ny, dtype=bool)
 
-    edges = controls if controls is not None else controls_or_reason(scene)[0]
+    edges = controls if controls is not None else controls_or_reason(scene, regions)[0]
     if edges is not None:
         model = CollisionModel(scene, [p.edge for p in edges])
         margin = clearance_margin(scene)

@@ -74,11 +74,13 @@ class Planner:
     ----------
     scene : Scene
     options : PlannerOptions or mapping, optional
-        How to plan: a :class:`~planner.model.options.PlannerOptions` replaces the scene's
-        ``planner:`` block; a mapping of option names to values (``{"seed": 3, "transit":
-        "lift"}``) changes only those. ``regions``, ``switch_cost`` and ``transit`` shape the
+        How to plan (:func:`session_options`): a :class:`~planner.model.options.PlannerOptions`
+        in place of the scene's own (:attr:`~planner.model.scene.Scene.options`, what its file
+        asks for); a mapping of option names to values (``{"seed": 3, "transit": "lift"}``)
+        changes only those of the scene's. ``regions``, ``switch_cost`` and ``transit`` shape the
         session itself; ``seed``, ``time_limit``, ``optimize`` and ``name`` are each query's
-        defaults, and a query may give its own.
+        defaults, and a query may give its own. The session keeps them as :attr:`options` and
+        passes them down; :attr:`scene` is the scene given.
     cache : RegionCache, optional
         Where the stable regions are kept (default: the process's, in ``$STABLEPUSH_CACHE``).
     progress : callable, optional
@@ -103,9 +105,10 @@ class Planner:
         self.clock = time.perf_counter()
         if not isinstance(scene, Scene):
             raise SceneError("scene", f"must be a Scene (planner.load_scene), got {type(scene).__name__}")
+        #: The options the session plans with, resolved once (:func:`session_options`).
         self.options = session_options(scene, options)
-        #: The scene as planned: its ``planner`` block is these options.
-        self.scene = scene.with_options(self.options)
+        #: The scene given: its own options are only the defaults of :attr:`options`.
+        self.scene = scene
         self._cache, self._progress = cache, progress
         self.model: CollisionModel | None = None
         self.certificates: Certificates | None = None
@@ -123,13 +126,13 @@ class Planner:
         if len(self.scene.parts) > 1:
             # Each move is set up when the search first asks for it: only the transfers' free space now.
             margin = min(clearance_margin(self.scene.move_scene(n, self.scene.starts)) for n in self.scene.names)
-            self.paths = TransferPaths(self.scene, margin)
+            self.paths = TransferPaths(self.scene, margin, self.options.transit)
         else:
             self.model = CollisionModel(self.scene, self.scene.edges)
             self.certificates = Certificates(self.scene, self.model)
             try:
-                self.world = SearchWorld.build(self.scene, self.clock + self.options.time_limit / 2, progress, cache,
-                                               self.model)
+                self.world = SearchWorld.build(self.scene, self.options, self.clock + self.options.time_limit / 2,
+                                               progress, cache, self.model)
             except NoStablePush as err:
                 self._no_push = err
             except RegionTimeout as timeout:
@@ -213,13 +216,13 @@ class Planner:
         if self._no_push is not None:
             raise self._no_push
         if self.world is None:
-            return plan_result(self.scene, request, clock, start, goal, [], self._timeout)
+            return plan_result(self.scene, request, self.options.switch_cost, clock, start, goal, [], self._timeout)
         context = PlanningContext(self.world, request, start, clock, observed)
         if edges is not None:
             context.starts = [k for k in context.starts if self.world.controls[k].edge in edges]
             context.search_starts = [k for k in context.search_starts if k in context.starts]
             if not context.starts:
-                return plan_result(self.scene, request, clock, start, goal, [],
+                return plan_result(self.scene, request, self.options.switch_cost, clock, start, goal, [],
                                    f"no stable push with room for the pusher at the start on edges {list(edges)}")
         key = tuple(goal.tolist())
         joined = join(self.world, context, goal, self._plans.items(key)) if reuse else None
@@ -265,12 +268,13 @@ class Planner:
         clock = time.perf_counter()
         scene = self.scene if np.array_equal(start, self.scene.start) else self.scene.with_part(start=start)
         if self.world is None and self._no_push is None:  # no region in time: nothing certain but the geometry
-            return [Reach("unreachable", None, r, None, scene, g) if r else Reach("unknown", None, self._timeout, None,
-                                                                                   scene, g)
+            return [Reach("unreachable", None, r, None, scene, g, self.options) if r
+                    else Reach("unknown", None, self._timeout, None, scene, g, self.options)
                     for g, r in zip(rows, reasons)]
         context = None if self.world is None else PlanningContext(self.world, request, start, clock)
         key = tuple(start.tolist())
-        found = answers(scene, context, reasons, rows, pushes, self.timings, self._reached.filed(key) if reuse else None)
+        found = answers(scene, self.options, context, reasons, rows, pushes, self.timings,
+                        self._reached.filed(key) if reuse else None)
         if reuse:
             for answer in found:
                 if answer.plan is not None and answer.plan.solved and answer.plan.segments:
@@ -284,7 +288,7 @@ class Planner:
             if value is not None:
                 raise SceneError(name, "is for a scene of one part: a scene of several plans from each part's start "
                                        "to its goal")
-        return plan_parts(self.scene, self.move_session, self.paths, request.seed, request.time_limit)
+        return plan_parts(self.scene, self.options, self.move_session, self.paths, request.seed, request.time_limit)
 
     def move_session(self, part: str, poses: Mapping[str, np.ndarray] | None) -> "Planner":
         """The one-part session of moving ``part`` of a scene of several with the others at
@@ -334,21 +338,24 @@ class Planner:
         2) stable pushes (:func:`planner.queries.reachable_set.reachable_set`), on this session's
         regions and collision model."""
         return reachable_set(self.scene, pushes, heading, resolution,
-                             controls=None if self.world is None else self.world.controls, **kwargs)
+                             controls=None if self.world is None else self.world.controls, regions=self.options.regions,
+                             **kwargs)
 
 
 def session_options(scene: Scene, options: PlannerOptions | Mapping[str, Any] | None) -> PlannerOptions:
-    """A session's options: a :class:`PlannerOptions` in place of the scene's (checked as any
-    options are: one may be made without its checks), or a mapping of changes to the scene's.
+    """A session's options, resolved once: a :class:`PlannerOptions` in place of the scene's own
+    (checked as any options are: one may be made without its checks), or a mapping of changes to
+    the scene's own (:attr:`~planner.model.scene.Scene.options`: its file's ``planner:`` block and
+    ``pusher.transit``).
 
     >>> from planner import load_scene
-    >>> session_options(load_scene("scenes/battery.yaml"), {"seed": 7}).seed
-    7
+    >>> session_options(load_scene("scenes/narrow_junction.yaml"), {"seed": 7})
+    PlannerOptions(name='rrt', time_limit=10.0, seed=7, regions='exact', switch_cost=0.25, optimize=0, transit='lift')
     """
     if isinstance(options, PlannerOptions):
-        return PlannerOptions().merged({k: v for k, v in asdict(options).items() if v is not None})
+        return PlannerOptions().merged(asdict(options))
     if options is None or isinstance(options, Mapping):
-        return scene.planner.merged(options)
+        return scene.options.merged(options)
     raise SceneError("options", f"must be PlannerOptions or a mapping, got {type(options).__name__}")
 
 
@@ -359,7 +366,8 @@ def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = No
     """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``: a fresh
     :class:`Planner` session asked once.
 
-    Arguments left as None take the scene's options (``planner:`` block, ``pusher.transit``):
+    Arguments left as None take the scene's own options (its file's ``planner:`` block and
+    ``pusher.transit``):
     ``regions`` is ``'stable'`` (procedure STABLE) or ``'exact'`` (the default); ``transit``
     ``'plane'``, ``'lift'`` or ``'none'``; ``switch_cost`` in metres; ``optimize`` a number of
     improvement rounds. With a given seed, a run that solves within the time limit returns the

@@ -1,7 +1,7 @@
 """What a planning run is asked (:class:`PlanRequest`, checked once), what every run on one scene
 shares (:class:`SearchWorld`: the edges' controls, the collision model, the transits and the
-shortcuts, built once) and what one run adds to it (:class:`PlanningContext`: its clock, start
-and start edges).
+shortcuts, built once for a scene and the session's options) and what one run adds to it
+(:class:`PlanningContext`: its clock, start and start edges).
 """
 
 from __future__ import annotations
@@ -75,9 +75,9 @@ def length(scene: Scene, segments: list[Push | Transit]) -> float:
     return path_length(segments, scene.slider.cf)
 
 
-def cost(scene: Scene, segments: list[Push | Transit]) -> float:
-    """Length of the centre of friction's path plus the switch cost per switch."""
-    return path_cost(segments, scene.slider.cf, scene.planner.switch_cost)
+def cost(scene: Scene, segments: list[Push | Transit], switch_cost: float) -> float:
+    """Length of the centre of friction's path plus ``switch_cost`` (metres) per switch."""
+    return path_cost(segments, scene.slider.cf, switch_cost)
 
 
 class SearchWorld:
@@ -87,28 +87,35 @@ class SearchWorld:
     Parameters
     ----------
     scene : Scene
-        With the options it is planned with (``scene.planner``, ``scene.pusher.transit``).
-    controls : the edges' controls, or None to compute them (:meth:`build`)
+    options : PlannerOptions
+        The session's: its ``transit`` and ``switch_cost`` shape the transits and the shortcuts
+        (and its ``regions`` the controls, :meth:`build`); a run's own are its
+        :class:`PlanRequest`.
+    controls : the edges' controls (:meth:`build` computes them)
     model : collision model with a body for each allowed edge
     note : what the user should know of the controls (edges left out at a time-out)
     """
 
-    def __init__(self, scene: Scene, controls: list[EdgeControls], model: CollisionModel, note: str = ""):
-        self.scene, self.controls, self.model, self.note = scene, controls, model, note
+    def __init__(self, scene: Scene, options: PlannerOptions, controls: list[EdgeControls], model: CollisionModel,
+                 note: str = ""):
+        self.scene, self.options, self.controls, self.model, self.note = scene, options, controls, model, note
         self.step, self.margin = step_length(scene), clearance_margin(scene)
-        switching = scene.pusher.transit != "none" and len(controls) > 1
-        self.transits = TransitPlanner(scene, [c.edge for c in controls], model, self.margin) if switching else None
+        switching = options.transit != "none" and len(controls) > 1
+        self.transits = (TransitPlanner(scene, [c.edge for c in controls], model, self.margin, options.transit)
+                         if switching else None)
         self._joined: Shortcut = JoinShortcut(controls, model, self.margin, self.transits)
         self._dubins = DubinsShortcut(scene, controls, model, self.margin)
         self._grid = Grid()
         self._switches: Shortcut | None = SwitchShortcut(scene, self._dubins.curves, model, self.transits,
-                                        scene.planner.switch_cost, self._grid) if switching else None
+                                        options.switch_cost, self._grid) if switching else None
 
     @classmethod
-    def build(cls, scene: Scene, deadline: float | None = None, progress: Callable[[int, int], None] | None = None,
-              cache: RegionCache | None = None, model: CollisionModel | None = None) -> "SearchWorld":
-        """The world of ``scene``, its regions computed (or read from ``cache``) by ``deadline``
-        (perf_counter); ``progress(k, n)`` hears of the ``k``-th of ``n`` regions computed.
+    def build(cls, scene: Scene, options: PlannerOptions, deadline: float | None = None,
+              progress: Callable[[int, int], None] | None = None, cache: RegionCache | None = None,
+              model: CollisionModel | None = None) -> "SearchWorld":
+        """The world of ``scene`` planned with ``options``, its regions (``options.regions``)
+        computed (or read from ``cache``) by ``deadline`` (perf_counter); ``progress(k, n)`` hears
+        of the ``k``-th of ``n`` regions computed.
 
         Raises
         ------
@@ -124,12 +131,12 @@ class SearchWorld:
             raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
         note = ""
         try:
-            controls = edge_controls(scene, deadline, progress, cache)
+            controls = edge_controls(scene, deadline, progress, cache, regions=options.regions)
         except RegionTimeout as timeout:
             if not timeout.controls:
                 raise
             controls, note = timeout.controls, str(timeout)
-        return cls(scene, controls, model, note)
+        return cls(scene, options, controls, model, note)
 
     def start_edges(self, start: np.ndarray, room: float | None = None) -> list[int]:
         """The indices of the controls whose edge has room for the pusher at ``start``: a
@@ -169,7 +176,7 @@ class SearchWorld:
         refining grid of the improvement rounds."""
         grid = self._grid.refined(level)
         refined = SwitchShortcut(self.scene, self._dubins.curves, self.model, self.transits,
-                                 self.scene.planner.switch_cost, grid, via=True, deadline=deadline)(segments)
+                                 self.options.switch_cost, grid, via=True, deadline=deadline)(segments)
         return self._dubins(refined)
 
 
@@ -213,8 +220,8 @@ class PlanningContext:
     def result(self, goal: np.ndarray, segments: list[Push | Transit], reason: str = "",
                tree: np.ndarray | None = None, improvements: list[tuple[float, float, float]] | None = None) -> Plan:
         """The plan for ``goal`` (solved if no ``reason``), timed from the start of the run."""
-        return plan_result(self.scene, self.request, self.clock, self.start, goal, segments, reason, self.world.note,
-                           tree, improvements)
+        return plan_result(self.scene, self.request, self.world.options.switch_cost, self.clock, self.start, goal,
+                           segments, reason, self.world.note, tree, improvements)
 
     def goal_region(self, goals: ArrayLike) -> GoalRegion:
         return self.world.goal_region(goals)
@@ -236,19 +243,20 @@ class PlanningContext:
         for k in self.starts:
             for g, pushes in region.pushes_to(self.start, k, goals).items():
                 found.setdefault(g, []).append(self.world.shortcut(pushes) if shorten else pushes)
-        return {g: min(options, key=lambda d: cost(self.scene, d)) for g, options in found.items()}
+        switch_cost = self.world.options.switch_cost
+        return {g: min(options, key=lambda d: cost(self.scene, d, switch_cost)) for g, options in found.items()}
 
 
-def plan_result(scene: Scene, request: PlanRequest, clock: float, start: np.ndarray, goal: np.ndarray,
-                segments: list[Push | Transit], reason: str = "", note: str = "", tree: np.ndarray | None = None,
-                improvements: list[tuple[float, float, float]] | None = None) -> Plan:
-    """The plan for ``goal`` from ``start`` (solved if no ``reason``), timed from ``clock``
-    (perf_counter)."""
+def plan_result(scene: Scene, request: PlanRequest, switch_cost: float, clock: float, start: np.ndarray,
+                goal: np.ndarray, segments: list[Push | Transit], reason: str = "", note: str = "",
+                tree: np.ndarray | None = None, improvements: list[tuple[float, float, float]] | None = None) -> Plan:
+    """The plan for ``goal`` from ``start`` (solved if no ``reason``), costed with ``switch_cost``
+    per switch and timed from ``clock`` (perf_counter)."""
     elapsed = time.perf_counter() - clock
     if not improvements and not reason:  # a plan found at once: its one improvement is itself
-        improvements = [(elapsed, cost(scene, segments), length(scene, segments))]
+        improvements = [(elapsed, cost(scene, segments, switch_cost), length(scene, segments))]
     return Plan.of_part(scene.part().name, start, goal, segments, scene=scene.path, solved=not reason,
                         planner=request.planner, seed=request.seed, planning_time_s=elapsed,
                         reason=f"{reason}; {note}" if reason and note else reason, note=note,
-                        switch_cost=scene.planner.switch_cost, cf=scene.slider.cf, improvements=list(improvements or []),
+                        switch_cost=switch_cost, cf=scene.slider.cf, improvements=list(improvements or []),
                         **({} if tree is None else {"tree": tree}))

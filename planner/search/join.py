@@ -36,14 +36,14 @@ def join(world: SearchWorld, context: PlanningContext, goal: np.ndarray, known: 
     Poses are tried cheapest first by a lower bound (the straight line from the start's CF to
     theirs, plus the rest of their plan), until no pose left can beat the best join by more
     than :data:`JOIN_SLACK`."""
-    scene = world.scene
+    scene, switch_cost = world.scene, world.options.switch_cost
     anchors = [a for p in known[:JOINED_PLANS] for a in _anchors(p.segments)]
     if not anchors:
         return None
     region = world.goal_region([pose for pose, _, _ in anchors], aim=False)
     cf = scene.slider.cf
     here, there = transform_points(cf, context.start), transform_points(cf, np.array([a[0] for a in anchors]))
-    bounds = np.linalg.norm(there - here, axis=1) + [cost(scene, rest) for _, _, rest in anchors]
+    bounds = np.linalg.norm(there - here, axis=1) + [cost(scene, rest, switch_cost) for _, _, rest in anchors]
     best, best_cost = None, np.inf
     for a in np.argsort(bounds, kind="stable").tolist():
         if bounds[a] * (1.0 + JOIN_SLACK) >= best_cost:
@@ -60,7 +60,7 @@ def join(world: SearchWorld, context: PlanningContext, goal: np.ndarray, known: 
                     continue
                 joint.append(transit)
             candidate = rechain(joint + rest)
-            if (c := cost(scene, candidate)) < best_cost:
+            if (c := cost(scene, candidate, switch_cost)) < best_cost:
                 best, best_cost = candidate, c
     if best is None:
         return None

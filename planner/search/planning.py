@@ -89,7 +89,7 @@ def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
     the plan if it costs less, and rounds stop early at the deadline). A plan of one or two
     pushes from the start (found before any search) is not searched again.
     """
-    request, scene = context.request, context.scene
+    request, scene, switch_cost = context.request, context.scene, context.world.options.switch_cost
     if scene.within_tolerance(context.start, goal):
         return context.result(goal, [])
     region = context.goal_region(goal)
@@ -107,9 +107,10 @@ def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
     if any(isinstance(s, Transit) for s in segments):
         budget = max(ONE_EDGE_ITERATIONS * iterations, ONE_EDGE_MIN_ITERATIONS)
         plain, _, _ = search.run(region.without_switches(), budget)
-        if plain is not None and cost(scene, plain := context.shortcut(plain)) <= cost(scene, segments):
+        if (plain is not None
+                and cost(scene, plain := context.shortcut(plain), switch_cost) <= cost(scene, segments, switch_cost)):
             segments = plain
-    improvements = [(time.perf_counter() - context.clock, cost(scene, segments), length(scene, segments))]
+    improvements = [(time.perf_counter() - context.clock, cost(scene, segments, switch_cost), length(scene, segments))]
     budget = max(ROUND_ITERATIONS * iterations, ROUND_MIN_ITERATIONS)
     refined: tuple[int, int] | None = None  # the grid level and plan last refined
     for r in range(1, request.optimize + 1):
@@ -124,9 +125,10 @@ def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
         else:
             other, _, _ = search.run(region, budget, (request.seed + r * _ROUND_SEEDS) % MAX_SEED + 1)
             other = context.shortcut(other) if other is not None else None
-        if other is not None and cost(scene, other) < cost(scene, segments):
+        if other is not None and cost(scene, other, switch_cost) < cost(scene, segments, switch_cost):
             segments = other
-            improvements.append((time.perf_counter() - context.clock, cost(scene, segments), length(scene, segments)))
+            improvements.append((time.perf_counter() - context.clock, cost(scene, segments, switch_cost),
+                                 length(scene, segments)))
     return context.result(goal, segments, tree=tree, improvements=improvements)
 
 

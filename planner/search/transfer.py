@@ -6,8 +6,8 @@ edge, and moves straight in, every part standing still. Backing off is checked a
 the part it leaves, moving in against all but the part it reaches (each touches only its own
 part, at its end), the way between against everything: obstacles, walls and every part.
 
-The way between is flown in ``'lift'`` mode, where the scene allows it (as a lift transit: the
-airborne piece is not checked). On the table it is the straight move if that is free, else a
+The way between is flown in ``'lift'`` mode, where the session's ``transit`` option allows it (as
+a lift transit: the airborne piece is not checked). On the table it is the straight move if that is free, else a
 path of OMPL's RRT-Connect in the pusher's SE(2) whose every move is checked by conservative
 advancement (:meth:`~planner.world.validity.CollisionModel.pusher_move_is_free`), shortened by
 OMPL's path simplifier. The search is seeded and capped by iterations, so a seed decides it.
@@ -39,10 +39,11 @@ TRANSFER_ITERATIONS = 4000
 
 
 class TransferPaths:
-    """Transfers of ``scene``'s pusher, keeping ``margin`` of clearance on the table."""
+    """Transfers of ``scene``'s pusher, keeping ``margin`` of clearance on the table, as the
+    ``transit`` option ``mode`` allows (``'lift'``: flown; else on the table)."""
 
-    def __init__(self, scene: Scene, margin: float):
-        self.scene, self.margin = scene, margin
+    def __init__(self, scene: Scene, margin: float, mode: str):
+        self.scene, self.margin, self.mode = scene, margin, mode
         self.reach = float(np.linalg.norm(pusher_frame_body(scene.pusher.width, scene.pusher.depth), axis=1).max())
 
     def _model(self, poses: Mapping[str, ArrayLike], without: tuple[str, ...]) -> CollisionModel:
@@ -60,7 +61,7 @@ class TransferPaths:
         if not (self._model(poses, (from_part,)).pusher_move_is_free(leave, out, self.margin)
                 and self._model(poses, (to_part,)).pusher_move_is_free(into, reach, self.margin)):
             return None
-        if self.scene.pusher.transit == "lift":
+        if self.mode == "lift":
             path = [leave, out, into, reach]
             return Transfer(from_part, to_part, to_edge, "lift", np.array(path), path_duration(path, self.reach))
         model = self._model(poses, ())

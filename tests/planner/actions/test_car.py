@@ -78,7 +78,7 @@ def test_a_cars_memo_keeps_no_region_alive(tmp_path):
     car = edge_car(first, scene.slider.cf)
     again = edge_car(replace(first), scene.slider.cf)
     assert again.push is not first and (again.heading == car.heading).all() and again.radius == car.radius
-    stable = edge_controls(replace(scene, planner=replace(scene.planner, regions="stable")))[0]
+    stable = edge_controls(scene, regions="stable")[0]
     stable_car = edge_car(stable, scene.slider.cf)
     assert stable.region.contains(stable_car.twist(np.linspace(-1.0, 1.0, 21) / stable_car.radius)).all()
     region = weakref.ref(first.region)

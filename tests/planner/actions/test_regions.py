@@ -27,7 +27,7 @@ def test_bad_regions_option_names_the_field():
     with pytest.raises(SceneError, match=r"planner\.regions.*stable, exact.*'fuzzy'"):
         parse_scene(spec)
     spec["planner"]["regions"] = "stable"
-    assert parse_scene(spec).planner.regions == "stable"
+    assert parse_scene(spec).options.regions == "stable"
 
 
 def refuse(*args, **kwargs):

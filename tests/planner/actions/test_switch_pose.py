@@ -48,7 +48,7 @@ def junction():
     model = CollisionModel(scene, list(controls))
     margin = clearance_margin(scene)
     curves = {e: DubinsCurves(scene, edge_car(c, scene.slider.cf), model, margin) for e, c in controls.items()}
-    transits = TransitPlanner(scene, list(controls), model, margin)
+    transits = TransitPlanner(scene, list(controls), model, margin, scene.options.transit)
     return scene, controls, model, margin, curves, transits
 
 
@@ -108,7 +108,7 @@ def _grid_optimum(junction, below: float) -> tuple[float, np.ndarray]:
 def test_a_long_switching_plan_is_brought_within_5_percent_of_the_grid_optimum(junction):
     scene, controls, model, margin, curves, transits = junction
     long = _long_plan(junction, 0.75)
-    shortcut = SwitchShortcut(scene, curves, model, transits, scene.planner.switch_cost)
+    shortcut = SwitchShortcut(scene, curves, model, transits, scene.options.switch_cost)
     better = shortcut(long)
     optimum, pose = _grid_optimum(junction, _length(scene, long))
     assert _length(scene, long) > 1.3 * optimum  # the test starts far from the optimum
@@ -125,7 +125,7 @@ def test_a_needless_switch_is_dropped_and_a_needed_one_kept(junction):
     """A switch and back onto the first edge costs a switch for nothing: replaced by one edge. The
     junction's branch cannot be entered on the first edge alone: that switch stays."""
     scene, controls, model, margin, curves, transits = junction
-    shortcut = SwitchShortcut(scene, curves, model, transits, scene.planner.switch_cost)
+    shortcut = SwitchShortcut(scene, curves, model, transits, scene.options.switch_cost)
     a = scene.start + [0.2, 0.02, 0.0]
     b = a + [0.2, 0.0, 0.0]
     there = connect(scene.start, a, controls[PUSH_EAST], model, margin)
@@ -154,7 +154,7 @@ def test_a_finer_via_grid_finds_a_way_the_plan_did_not_take():
     margin = clearance_margin(scene)
     curves = {c.edge: DubinsCurves(scene, edge_car(c, scene.slider.cf), model, margin) for c in controls}
     fine = Grid(spacing=0.25, heading=2.5, checks=60, candidates=200_000)
-    via = SwitchShortcut(scene, curves, model, None, scene.planner.switch_cost, fine, via=True)
+    via = SwitchShortcut(scene, curves, model, None, scene.options.switch_cost, fine, via=True)
     better = via(first.segments)
     assert _length(scene, better) < 0.9 * _length(scene, first.segments)
     assert _length(scene, better) >= geodesic_bound(scene) - 1e-9
@@ -162,7 +162,7 @@ def test_a_finer_via_grid_finds_a_way_the_plan_did_not_take():
     better_plan = Plan.of_part("part", scene.start, scene.goal, better,
                                scene=str(path), solved=True, planner="rrt", seed=1, planning_time_s=0.0)
     replay_plan(yaml.safe_load(path.read_text()), better_plan.to_dict())
-    late = SwitchShortcut(scene, curves, model, None, scene.planner.switch_cost, fine, via=True,
+    late = SwitchShortcut(scene, curves, model, None, scene.options.switch_cost, fine, via=True,
                           deadline=time.perf_counter())
     given = first.segments
     assert late(given) is given

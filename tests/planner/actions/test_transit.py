@@ -34,7 +34,7 @@ def scene(vertices, obstacles=(), transit="plane", start=(0.0, 0.0, 0.3)):
 
 def planner_for(sc) -> TransitPlanner:
     edges = sc.edges
-    return TransitPlanner(sc, edges, CollisionModel(sc, edges), sc.slider.radius / 40)
+    return TransitPlanner(sc, edges, CollisionModel(sc, edges), sc.slider.radius / 40, sc.options.transit)
 
 
 def pusher_at(pose) -> shapely.Polygon:

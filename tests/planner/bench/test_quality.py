@@ -45,7 +45,7 @@ def test_improvement_rounds_only_shorten_and_repeat():
     first = plan(scene, seed=1, time_limit=30)
     better = plan(scene, seed=1, time_limit=30, optimize=2)
     again = plan(scene, seed=1, time_limit=30, optimize=2)
-    cost = [p.path_length(scene.slider.cf) + scene.planner.switch_cost * p.switches for p in (first, better)]
+    cost = [p.path_length(scene.slider.cf) + scene.options.switch_cost * p.switches for p in (first, better)]
     assert better.improvements[0][1:] == pytest.approx((cost[0], first.path_length(scene.slider.cf)), abs=1e-12)
     assert better.improvements[-1][1:] == pytest.approx((cost[1], better.path_length(scene.slider.cf)), abs=1e-12)
     assert len(better.improvements) >= 2 and cost[1] < cost[0]

@@ -79,8 +79,9 @@ def check_plan(folder: Path, name: str, content: bytes) -> None:
     began = time.monotonic()
     with inside(folder):
         try:
-            scene, options = read_inputs([str(ROOT / "scenes" / f"{name}.yaml"), "--verify=2", "--plan=plan.json"])
-            given = fit_plan(scene, load_plan(options.plan_file))  # what the run does first
+            scene, options, planner_options = read_inputs([str(ROOT / "scenes" / f"{name}.yaml"), "--verify=2",
+                                                           "--plan=plan.json"])
+            given = fit_plan(scene, load_plan(options.plan_file), transit=planner_options.transit)  # the run's first step
             assert given.solved and (given.start == scene.start).all()
         except SceneError as err:
             assert_one_line_naming_a_field(err)

@@ -48,7 +48,7 @@ def refused(tmp_path: Path, capsys, scene: Path, plan: Path, *flags: str) -> str
 @pytest.mark.parametrize("name", sorted(p.stem for p in BEST.glob("*.json")))
 def test_every_best_known_plan_fits_its_scene_and_runs_from_its_start(name):
     scene, plan = load_scene(ROOT / "scenes" / f"{name}.yaml"), load_plan(BEST / f"{name}.json")
-    fitted = fit_plan(scene, plan)
+    fitted = fit_plan(scene, plan, transit=scene.options.transit)
     assert np.array_equal(fitted.start, scene.start) and scene.within_tolerance(fitted.final)
     assert [s.kind for s in fitted.segments] == [s.kind for s in plan.segments]
 

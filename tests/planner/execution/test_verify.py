@@ -74,7 +74,7 @@ def all_stick(check) -> bool:
 def test_every_shipped_plan_sticks_under_every_distribution(name):
     scene, plan = planned(name)
     assert plan.solved
-    check = verify(scene, plan, n=30)
+    check = verify(scene, plan, n=30, transit=scene.options.transit)
     assert check.passed and all_stick(check), "\n".join(check.lines())
     position, angle = check.worst
     # One exact exponential per step: rounding grows with the distance travelled (a long straight
@@ -200,7 +200,7 @@ def test_a_switching_plan_verifies_with_a_line_for_its_transit(name, mode):
     scene, plan, k = switching(name)
     transit = plan.segments[k]
     assert transit.mode == mode and plan.segments[k - 1].edge == transit.from_edge != transit.to_edge
-    check = verify(scene, plan, n=6)
+    check = verify(scene, plan, n=6, transit=scene.options.transit)
     assert check.passed, "\n".join(check.lines())
     assert check.lines()[k] == (f"segment {k + 1}/{len(plan.segments)}: transit 1/{plan.switches} (edge {transit.from_edge} -> {transit.to_edge}, {mode}, "
                                 f"{transit.duration:.3f} s): part still, flush on both edges: ok")
@@ -255,13 +255,12 @@ def test_a_change_of_edge_needs_a_transit():
 
 
 @pytest.mark.parametrize("allowed, name", [("none", "junction"), ("plane", "narrow_junction")])
-def test_a_transit_the_scene_does_not_allow_names_its_mode(allowed, name):
+def test_a_transit_the_options_do_not_allow_names_its_mode(allowed, name):
     scene, plan, k = switching(name)
-    strict = dataclasses.replace(scene, pusher=dataclasses.replace(scene.pusher, transit=allowed))
     with pytest.raises(planner.SceneError) as err:
-        verify(strict, plan, n=2)
+        verify(scene, plan, n=2, transit=allowed)
     assert err.value.field == f"plan.segments[{k}].mode" and repr(allowed) in str(err.value)
-    assert verify(scene, plan, n=2).passed  # the scene as it is allows it
+    assert verify(scene, plan, n=2, transit=scene.options.transit).passed  # the scene's file allows it
 
 
 # -- recording ---------------------------------------------------------------------------------------

@@ -400,7 +400,7 @@ def test_the_export_holds_the_options_the_flags_set(tmp_path, monkeypatch):
     argv = ["--out", "out", "--export-scene", "again.yaml", "--transit", "lift", "--switch-cost", "0.1", "--seed", "7"]
     assert main([str(ROOT / "scenes" / "battery.yaml"), *argv]) == 0
     again = load_scene(tmp_path / "again.yaml")
-    assert again.pusher.transit == "lift" and again.planner.switch_cost == 0.1 and again.planner.seed == 7
+    assert again.options.transit == "lift" and again.options.switch_cost == 0.1 and again.options.seed == 7
 
 
 # --- the example, planned and verified against its exported scene ------------------------------------
@@ -461,6 +461,6 @@ def test_a_plain_scene_round_trips_through_its_export(tmp_path):
     again = load_scene(tmp_path / "again.yaml")
     for name in ("start", "goal"):
         assert getattr(again, name).tolist() == getattr(scene, name).tolist()
-    assert again.obstacles == scene.obstacles and again.pusher == scene.pusher and again.planner == scene.planner
+    assert again.obstacles == scene.obstacles and again.pusher == scene.pusher and again.options == scene.options
     assert parse_scene(yaml.safe_load((tmp_path / "again.yaml").read_text())).slider.cf.tolist() == \
         scene.slider.cf.tolist()

@@ -170,7 +170,7 @@ def test_aliases_a_yaml_writer_makes_for_shared_values_are_read(tmp_path):
 def test_yaml_1_2_integers(tmp_path):
     # YAML 1.1 read 017 as octal 15; YAML 1.2 reads it as 17 and writes octal as 0o17.
     scene = load_scene(write(tmp_path, BATTERY_TEXT + "planner: {seed: 017, time_limit: 0o17}\n"))
-    assert (scene.planner.seed, scene.planner.time_limit) == (17, 15.0)
+    assert (scene.options.seed, scene.options.time_limit) == (17, 15.0)
 
 
 @pytest.mark.filterwarnings("ignore:overflow encountered in is_simple:RuntimeWarning")  # GEOS's own products

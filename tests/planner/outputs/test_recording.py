@@ -406,8 +406,7 @@ def test_the_analysis_shows_the_pushed_edge_in_the_slider_frame(turn):
 
 def test_the_analysis_shows_the_exact_region_even_when_planning_with_stable(turn, tmp_path):
     scene, _, _ = turn
-    scene = replace(scene, planner=replace(scene.planner, regions="stable"))
-    plan = planner.plan(scene)
+    plan = planner.plan(scene, regions="stable")
     assert plan.solved
     recording.write_recording(tmp_path / "stable.rrd", scene, plan)
     for side in ("ccw", "cw"):

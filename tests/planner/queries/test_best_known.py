@@ -29,11 +29,11 @@ def test_each_best_known_plan_is_sound_and_costs_what_it_says(path):
     scene = load_scene(path)
     best = load_plan(ROOT / "scenes" / "best" / f"{scene.name}.json")
     assert best.solved and best.scene == f"scenes/{path.name}"
-    assert np.allclose(best.cf, scene.slider.cf) and best.switch_cost == scene.planner.switch_cost
+    assert np.allclose(best.cf, scene.slider.cf) and best.switch_cost == scene.options.switch_cost
     assert np.allclose(best.start, scene.start) and scene.within_tolerance(best.final)
     length = sum(s.cf_path_length(scene.slider.cf) for s in best.segments)
-    assert best.cost == pytest.approx(length + scene.planner.switch_cost * best.switches, abs=1e-12)
+    assert best.cost == pytest.approx(length + scene.options.switch_cost * best.switches, abs=1e-12)
     assert best.length >= geodesic_bound(scene) - 1e-9  # no plan beats the lower bound
     replay_plan(yaml.safe_load(path.read_text()), best.to_dict())
-    check = verify(scene, best, n=6)
+    check = verify(scene, best, n=6, transit=scene.options.transit)
     assert check.passed, check.summary()

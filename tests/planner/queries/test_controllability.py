@@ -5,7 +5,6 @@ programmes: the Lie bracket computed by finite differences for Prop. 1, the conv
 twists for Sussmann's Thm. 1, and pictures of rotation centres for Prop. 4 (Fig. 7).
 """
 
-import dataclasses
 import re
 
 import numpy as np
@@ -25,10 +24,6 @@ def ccw(c):
 def cw(c):
     """Clockwise rotation about centre ``c``."""
     return [-c[1], c[0], -1.0]
-
-
-def with_pusher(scene, **changes):
-    return dataclasses.replace(scene, pusher=dataclasses.replace(scene.pusher, **changes))
 
 
 # A parallelogram whose short edges 0 and 2 have their CF beyond the contact and too little friction
@@ -203,9 +198,8 @@ def test_two_opposite_edges_of_a_rectangle_are_stlc(parking, edges):
 
 def test_stable_regions_too(parking):
     """Thm. 7 is about procedure STABLE's pushes, inside the exact ones."""
-    scene = dataclasses.replace(parking, planner=dataclasses.replace(parking.planner, regions="stable"))
-    assert controllability(scene.with_part(edges=(0, 2))).stlc
-    assert not controllability(scene.with_part(edges=(0,))).stlc
+    assert controllability(parking.with_part(edges=(0, 2)), regions="stable").stlc
+    assert not controllability(parking.with_part(edges=(0,)), regions="stable").stlc
 
 
 def test_an_edge_with_no_stable_push_is_skipped():
@@ -222,10 +216,8 @@ def test_no_stable_push_at_all_is_not_accessible():
 
 
 def test_refused_method_is_not_reported_as_no_push(parking):
-    scene = dataclasses.replace(parking.with_part(cf_uncertainty=0.001),
-                                planner=dataclasses.replace(parking.planner, regions="stable"))
     with pytest.raises(SceneError, match="planner.regions"):
-        controllability(scene)
+        controllability(parking.with_part(cf_uncertainty=0.001), regions="stable")
 
 
 @pytest.mark.parametrize("name", ["parking", "nonconvex", "battery"])
@@ -234,9 +226,8 @@ def test_one_edge_lies_in_a_half_space(name, regions):
     """Every stable twist of an edge moves the contact's midpoint m into the part:
     ``a = (v_xy + omega k x m) . n > 0``, so its cone holds no line and the edge alone is not STLC."""
     scene = load_scene(f"scenes/{name}.yaml")
-    scene = dataclasses.replace(scene, planner=dataclasses.replace(scene.planner, regions=regions))
-    c = controllability(with_pusher(scene, transit="none"))
-    twists = {p.edge: p.region.extremal_twists() for p in edge_controls(scene)}
+    c = controllability(scene, regions=regions, transit="none")
+    twists = {p.edge: p.region.extremal_twists() for p in edge_controls(scene, regions=regions)}
     assert set(twists) == set(c.per_edge)
     for edge, alone in c.per_edge.items():
         n = scene.slider.inward_normal(edge)
@@ -251,12 +242,12 @@ def test_one_edge_lies_in_a_half_space(name, regions):
 # --- the shipped scenes -------------------------------------------------------------------------
 
 def test_parking_is_stlc_with_switching_and_no_edge_alone_is(parking):
-    c = controllability(parking)
-    assert parking.pusher.transit == "plane" and set(c.per_edge) == {0, 1, 2, 3}
+    c = controllability(parking, transit=parking.options.transit)
+    assert parking.options.transit == "plane" and set(c.per_edge) == {0, 1, 2, 3}
     assert c.controllable and c.stlc and c.stlc_edges == (0, 2) and c.union.lineality == 3
     assert c.summary() == ("controllable (edges 0, 1, 2, 3); small-time locally controllable with edges 0 and 2 "
                            "(opposite faces)")
-    none = controllability(with_pusher(parking, transit="none"))
+    none = controllability(parking, transit="none")
     assert none.controllable and not none.stlc
     assert all(e.controllable and not e.stlc for e in none.per_edge.values())
     assert "transit none keeps to one edge" in none.summary()

@@ -17,6 +17,7 @@ import yaml
 
 import planner
 from planner import Planner, PlannerOptions, SceneError, certify_unreachable, load_scene, plan, reachability
+from planner.queries.session import session_options
 from replay import replay_plan
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -112,10 +113,19 @@ def test_without_reuse_a_session_plans_as_the_one_shot_plan_does(parking):
 
 def test_options_given_as_a_mapping_or_as_options(parking):
     stable = Planner(parking, {"regions": "stable", "switch_cost": 0.5})
-    assert (stable.scene.planner.regions, stable.scene.planner.switch_cost) == ("stable", 0.5)
-    assert stable.scene.planner.seed == parking.planner.seed  # the rest is the scene's
+    assert (stable.options.regions, stable.options.switch_cost) == ("stable", 0.5)
+    assert stable.options.seed == parking.options.seed  # the rest is the scene's
     lift = Planner(parking, PlannerOptions(transit="lift", seed=9))
-    assert (lift.scene.pusher.transit, lift.options.seed) == ("lift", 9)
+    assert (lift.options.transit, lift.options.seed) == ("lift", 9)
+    # The session plans the scene given, whose own options stay what its file asks for.
+    assert stable.scene is parking and lift.scene is parking and parking.options == PlannerOptions()
+
+
+def test_a_scene_files_transit_is_one_of_its_options():
+    narrow = load_scene("scenes/narrow_junction.yaml")  # pusher.transit: lift
+    assert narrow.options.transit == "lift" and not hasattr(narrow.pusher, "transit")
+    assert session_options(narrow, {"seed": 2}).transit == "lift"  # changes keep the rest of the scene's
+    assert session_options(narrow, PlannerOptions(seed=2)).transit == "plane"  # options in place of the scene's
 
 
 # --- reachability ---------------------------------------------------------------------------------
