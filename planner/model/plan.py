@@ -244,10 +244,15 @@ class Plan:
             return None
         return length + self.switch_cost * (self.switches + self.transfers)
 
+    @property
+    def format(self) -> str:
+        """The file format the plan is written in: ``plan/1`` for the one part of a ``slider:``
+        scene (as the tools reading those files expect), else ``plan/2`` (:mod:`.plan_file` reads both)."""
+        return FORMATS[0] if self.names == (ONE_PART,) else FORMATS[1]
+
     def to_dict(self) -> dict:
-        """The plan as its file holds it: ``plan/1`` for the one part of a ``slider:`` scene, else
-        ``plan/2`` (:mod:`.plan_file`, which reads both)."""
-        return _one_part_dict(self) if self.names == (ONE_PART,) else _parts_dict(self)
+        """The plan as its file holds it, in :attr:`format`."""
+        return _one_part_dict(self) if self.format == FORMATS[0] else _parts_dict(self)
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=1)

@@ -62,7 +62,7 @@ def part_field(plan: Plan, part: str, key: str) -> str:
     ...     scene=None, solved=True, planner="rrt", seed=1, planning_time_s=0.0).to_dict()), ONE_PART, "start")
     ('plan.parts.red.start', 'plan.start')
     """
-    return f"plan.{key}" if plan.names == (ONE_PART,) else f"plan.parts.{part}.{key}"
+    return f"plan.{key}" if plan.format == FORMATS[0] else f"plan.parts.{part}.{key}"
 
 
 def _check(plan: Plan, spec: dict) -> Plan:
