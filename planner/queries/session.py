@@ -110,6 +110,9 @@ class Planner:
         #: The scene given: its own options are only the defaults of :attr:`options`.
         self.scene = scene
         self._cache, self._progress = cache, progress
+        #: A scene of one part's collision model (the part and the pusher on each allowed edge), the
+        #: certificates of unreachability and the search's world (regions, transits, shortcuts);
+        #: None for a scene of several parts, whose moves' sessions hold their own.
         self.model: CollisionModel | None = None
         self.certificates: Certificates | None = None
         self.world: SearchWorld | None = None
@@ -119,6 +122,7 @@ class Planner:
         # start (their segments), and the sessions of a scene of several parts' moves.
         self._plans, self._reached, self._moves = Memory(REMEMBERED_PLANS), Memory(REMEMBERED_GOALS), Memory(REMEMBERED_PLANS)
         self._filings = itertools.count()
+        #: A scene of several parts' transfers between parts (None for one part).
         self.paths: TransferPaths | None = None
         #: Seconds the last :meth:`reachability` spent on the certificates, the direct connections
         #: and the tree's growth.
