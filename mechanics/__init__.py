@@ -32,7 +32,7 @@ from .kinematics import (
     relative_mode,
 )
 from .possible_motions import ModeMotions, mode_possible, possible_motions
-from .se2 import compose, exp_twist, inverse, log_pose, relative_pose, transform_points, wrap_angle
+from .se2 import compose, exp_twist, inverse, log_pose, pose_error, relative_pose, transform_points, wrap_angle
 from .slider import Slider
 from .regions import METHODS, PushRegion, stable_region
 from .stable import DEFAULT_TIP_FACTOR, StableRegion, procedure_stable
@@ -82,6 +82,7 @@ __all__ = [
     "kinematic_cone",
     "kinematic_cones",
     "log_pose",
+    "pose_error",
     "mode_possible",
     "modes_of_motion",
     "moment_labels",

@@ -8,10 +8,13 @@ The functions are vectorised over leading axes.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["compose", "exp_twist", "inverse", "log_pose", "relative_pose", "transform_points", "wrap_angle"]
+__all__ = ["compose", "exp_twist", "inverse", "log_pose", "pose_error", "relative_pose", "transform_points",
+           "wrap_angle"]
 
 def wrap_angle(theta: ArrayLike) -> np.ndarray:
     """Angle in ``[-pi, pi)``.
@@ -134,3 +137,14 @@ def log_pose(q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
     vx = (a * d[..., 0] + b * d[..., 1]) / det
     vy = (-b * d[..., 0] + a * d[..., 1]) / det
     return np.stack([vx, vy, phi], axis=-1)
+
+
+def pose_error(pose: ArrayLike, target: ArrayLike) -> tuple[float, float]:
+    """How far ``pose`` is from ``target``: the distance between their origins and the size of
+    their heading difference (wrapped), as goal tolerances and trackers measure it.
+
+    >>> distance, turn = pose_error([3.0, 4.0, np.pi - 0.1], [0.0, 0.0, -np.pi + 0.1])
+    >>> distance, round(turn, 12)
+    (5.0, 0.2)
+    """
+    return math.hypot(pose[0] - target[0], pose[1] - target[1]), abs(float(wrap_angle(pose[2] - target[2])))

@@ -46,7 +46,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import wrap_angle
+from mechanics import pose_error, wrap_angle
 
 from ..actions.transit import edge_contact_pose
 from ..model.fields import SceneError
@@ -55,7 +55,7 @@ from ..model.scene import Scene
 from ..model.segments import Transit
 from ..queries.session import Planner
 from .approach import first_edge, lead_in_pose
-from .mujoco_sim import (SETTLE, TABLE_MU, ByPart, Feet, Runs, World, _error, _one, _worst, foot_sets, needs_mujoco,
+from .mujoco_sim import (SETTLE, TABLE_MU, ByPart, Feet, Runs, World, _one, _worst, foot_sets, needs_mujoco,
                          perturbations, write_mjcf)
 from .tracker import BUDGET, CONFIRM, Replan, Tracker, mean_pose
 from .tracker import SETTLE as AT_REST  # observations of the parts at rest (mujoco_sim's SETTLE is seconds)
@@ -263,7 +263,7 @@ class _Loop:
             if name == self.moving:
                 continue
             planned = self.plan.starts[name]  # where the plan has it until it is moved
-            error = (math.hypot(*(pose[:2] - planned[:2])), abs(float(wrap_angle(pose[2] - planned[2]))))
+            error = pose_error(pose, planned)
             beyond = error[0] > self.tracker.threshold[0] or error[1] > self.tracker.threshold[1]
             self._strikes[name] = self._strikes.get(name, 0) + 1 if beyond else 0
             if self._strikes[name] >= CONFIRM:
@@ -371,7 +371,7 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
     tracks = {n: table[:, 10 + 3 * j:13 + 3 * j] for j, n in enumerate(scene.names)}
     ends = {n: world.pose(n) for n in scene.names}
     reason = loop.reason or ("" if loop.done else f"not done after {limit:.0f} s")
-    return ClosedRun(dict(supports), {n: _error(end, scene.part(n).goal) for n, end in ends.items()},
+    return ClosedRun(dict(supports), {n: pose_error(end, scene.part(n).goal) for n, end in ends.items()},
                      {n: scene.delivered(n, end) for n, end in ends.items()}, tuple(loop.replans), reason, collisions,
                      time.perf_counter() - clock, float(table[-1, 0]), executed, tracks, tuple(loop.carried),
                      tuple((t, what) for what, t in faults.items()))

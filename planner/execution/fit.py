@@ -37,7 +37,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from mechanics import wrap_angle
+from mechanics import pose_error
 
 from ..model.fields import SceneError, pose_text
 from ..model.options import DEFAULT_TRANSIT
@@ -64,8 +64,8 @@ class _TooMany(Exception):
 
 
 def _miss(scene: Scene, pose: np.ndarray, target: np.ndarray) -> str:
-    gap = math.hypot(pose[0] - target[0], pose[1] - target[1])
-    turn = abs(math.degrees(float(wrap_angle(pose[2] - target[2]))))
+    gap, turn = pose_error(pose, target)
+    turn = math.degrees(turn)
     return (f"{gap:.4f} m and {turn:.2f} deg from it (tolerance {scene.tolerance_position:g} m, "
             f"{math.degrees(scene.tolerance_angle):g} deg)")
 

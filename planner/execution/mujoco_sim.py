@@ -72,7 +72,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import Slider, relative_pose, transform_points, wrap_angle
+from mechanics import Slider, pose_error, relative_pose, transform_points, wrap_angle
 from mechanics.quasistatic import grid_support, tripod_supports
 
 from ..actions.transit import edge_contact_pose
@@ -690,8 +690,8 @@ def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], 
                  axis=0)
     deviations = tuple(float(gap[motion.segment == k].max(initial=0.0)) for k in range(len(steps)))
     ends = {name: track[-1] for name, track in tracks.items()}
-    return Run(dict(supports), {name: _error(end, scene.part(name).goal) for name, end in ends.items()},
-               {name: _error(end, plan.finals[name]) for name, end in ends.items()},
+    return Run(dict(supports), {name: pose_error(end, scene.part(name).goal) for name, end in ends.items()},
+               {name: pose_error(end, plan.finals[name]) for name, end in ends.items()},
                {name: scene.delivered(name, end) for name, end in ends.items()}, float(gap.max()),
                float(slips.max(initial=0.0)), collisions, tuple(faults), time.perf_counter() - clock,
                float(motion.duration + lead.duration), tracks, deviations, tuple(float(v) for v in slips))
@@ -700,10 +700,6 @@ def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], 
 def _cf_gap(cf: np.ndarray, poses: np.ndarray, planned: np.ndarray) -> np.ndarray:
     """The distance of the CF (part frame) at each of ``poses`` from where it is at ``planned``'s."""
     return np.linalg.norm(transform_points(cf, poses) - transform_points(cf, planned), axis=1)
-
-
-def _error(end: np.ndarray, target: np.ndarray) -> tuple[float, float]:
-    return math.hypot(end[0] - target[0], end[1] - target[1]), abs(float(wrap_angle(end[2] - target[2])))
 
 
 def _first_move(scene: Scene, plan: Plan) -> tuple[Scene, Plan]:

@@ -69,7 +69,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import wrap_angle
+from mechanics import pose_error, wrap_angle
 
 from ..model.bodies import pusher_frame_body, slider_at
 from ..model.fields import SceneError, poses
@@ -308,7 +308,7 @@ class Tracker:
         u = now - self._since
         k = min(int(np.searchsorted(self.motion.t, u)), len(self.motion.t) - 1)
         planned = self.expected[k]
-        return math.hypot(*(pose[:2] - planned[:2])), abs(float(wrap_angle(pose[2] - planned[2])))
+        return pose_error(pose, planned)
 
     def observe(self, now: float, pose: ArrayLike) -> Command:
         """Take the part's observed pose at ``now`` and say what the pusher does (module docstring).

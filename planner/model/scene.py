@@ -40,7 +40,7 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import Slider, wrap_angle
+from mechanics import Slider, pose_error
 
 from .bodies import slider_at
 from .fields import SceneError, shown
@@ -183,9 +183,8 @@ class Scene:
         >>> scene.within_tolerance([0.5, 0.0, math.radians(1.9)]), scene.within_tolerance([0.5, 0.0, math.radians(2.1)])
         (True, False)
         """
-        g = self.goal if goal is None else goal
-        return (math.hypot(pose[0] - g[0], pose[1] - g[1]) <= self.tolerance_position
-                and abs(float(wrap_angle(pose[2] - g[2]))) <= self.tolerance_angle)
+        distance, turn = pose_error(pose, self.goal if goal is None else goal)
+        return distance <= self.tolerance_position and turn <= self.tolerance_angle
 
     def delivered(self, name: str, pose: ArrayLike) -> bool:
         """Whether part ``name`` at ``pose`` is within tolerance of its goal."""
