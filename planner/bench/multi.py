@@ -17,7 +17,6 @@ from pathlib import Path
 import numpy as np
 
 from ..actions.controls import edge_controls
-from ..model.scene import Scene
 from ..model.scene_file import load_scene
 from ..queries.session import Planner
 

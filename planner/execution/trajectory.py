@@ -63,7 +63,6 @@ from mechanics import Slider, compose, exp_twist, inverse, point_velocity, trans
 from ..actions.transit import AIRBORNE, edge_contact_pose, piece_times
 from ..model.bodies import place, pusher_frame_body
 from ..model.files import write_atomic
-from ..model.scene import Scene
 from ..model.plan import Plan
 from ..model.segments import Push, Transfer, Transit
 from ..model.scene import Pusher, Scene

@@ -16,7 +16,6 @@ README. A mapping with ``parts:`` describes several parts (README, "Several part
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any

@@ -21,7 +21,6 @@ from planner import load_scene, plan
 from planner.actions.transit import AIRBORNE, edge_contact_pose, transit_poses
 from planner.cli import main
 from planner.execution.trajectory import trajectory
-from planner.model.scene import Scene
 from planner.model.bodies import pusher_frame_body
 from planner.model.plan import Plan
 from planner.model.segments import Push

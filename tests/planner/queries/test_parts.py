@@ -13,7 +13,6 @@ import yaml
 
 from planner import Planner, load_scene, parse_scene
 from planner.model.fields import SceneError
-from planner.model.scene import Scene
 from planner.model.plan import Plan
 from planner.model.plan_file import read_plan
 from planner.queries import multi_part
