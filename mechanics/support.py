@@ -312,6 +312,20 @@ class SupportModel:
             return cls.footprint(slider.vertices, slider.cf, resolution, cf_radius)
         raise ValueError(f"support model must be 'disk' or 'footprint', got {kind!r}")
 
+    def with_cf_radius(self, cf_radius: float) -> SupportModel:
+        """The same support with the CF known only within ``cf_radius``, sharing this model's
+        sample cells (they do not depend on the CF's uncertainty, and building the finer levels
+        costs more than a batch of LPs); its LPs and warm bases are its own.
+
+        >>> block = SupportModel.of_slider(Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]]))
+        >>> loose = block.with_cf_radius(0.1)
+        >>> loose.cf_radius, loose.cells(1) is block.cells(1)
+        (0.1, True)
+        """
+        other = SupportModel(self.kind, self.cf, self.radius, self.polygon, self.resolution, cf_radius)
+        other._cells, other._triangle = self._cells, self._triangle
+        return other
+
     def covers(self, points: ArrayLike) -> np.ndarray:
         """Whether each point lies in the support region (boundary included)."""
         p = np.asarray(points, dtype=float)
