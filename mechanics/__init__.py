@@ -10,7 +10,7 @@ solved by the batched simplex of :mod:`.simplex`),
 :mod:`.force_status` (P/U/I, §3.3-3.4), :mod:`.possible_motions` (the combined analysis, §4),
 :mod:`.stable_pushing` (guaranteed-stable pushes and one-step goals, §4-5.1),
 :mod:`.exact_region` (the exact stable pushes of an edge, containing STABLE's), :mod:`.regions`
-(either method of an edge's stable pushes),
+(either method of an edge's stable pushes), :mod:`.stability_margin` (how far each push is from slipping),
 :mod:`.contact_synthesis` (which edges realise a motion, §5.2), :mod:`.controllability`
 (accessibility and STLC of a set of twists, 1996 §2), :mod:`.figures` (the paper's
 figures redrawn). :mod:`.quasistatic` is an independent simulator that checks pushes without any
@@ -34,6 +34,7 @@ from .kinematics import (
 from .possible_motions import ModeMotions, mode_possible, possible_motions
 from .se2 import compose, exp_twist, inverse, log_pose, pose_error, relative_pose, transform_points, wrap_angle
 from .slider import Slider
+from .stability_margin import PushMargins, push_margins
 from .regions import METHODS, PushRegion, stable_region
 from .stable import DEFAULT_TIP_FACTOR, StableRegion, procedure_stable
 from .stable_pushing import GOALS, classify_goal
@@ -52,6 +53,7 @@ __all__ = [
     "GOALS",
     "LoadBatch",
     "METHODS",
+    "PushMargins",
     "PushRegion",
     "ModeMotions",
     "ExactRegion",
@@ -90,6 +92,7 @@ __all__ = [
     "point_wrench",
     "possible_motions",
     "procedure_stable",
+    "push_margins",
     "ray_twist",
     "relative_cone",
     "relative_mode",
