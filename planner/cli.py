@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, NamedTuple
 from .flags import flag_of, options_of, parser
 
 if TYPE_CHECKING:
+    from .model.margin import Margin
     from .model.options import PlannerOptions
     from .model.scene import Scene
     from .pipeline import RunOptions
@@ -191,8 +192,8 @@ def _run(args: argparse.Namespace, inputs: Inputs) -> int:
     return outcome.code
 
 
-def _mapped_on(reachable_set_on, engine: tuple, scene: Scene, pushes: int, *, regions: str):
-    return reachable_set_on(scene, pushes, *engine, regions=regions)
+def _mapped_on(reachable_set_on, engine: tuple, scene: Scene, pushes: int, *, regions: str, margin: Margin):
+    return reachable_set_on(scene, pushes, *engine, regions=regions, margin=margin)
 
 
 def _progress(k: int, n: int) -> None:

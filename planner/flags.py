@@ -16,7 +16,7 @@ __all__ = ["ARGUMENTS", "FLAGS", "flag_of", "options_of", "parser"]
 
 #: The flag of each planner option (:class:`~planner.model.options.PlannerOptions`' fields).
 FLAGS = {"name": "--planner", "time_limit": "--time-limit", "seed": "--seed", "regions": "--regions",
-         "switch_cost": "--switch-cost", "optimize": "--optimize", "transit": "--transit"}
+         "switch_cost": "--switch-cost", "optimize": "--optimize", "transit": "--transit", "margin": "--margin"}
 #: The arguments the library names as fields (its errors never name a flag), with their flags
 #: (the options' are :data:`FLAGS`, turned by :func:`options_of`: ``name`` is also a scene's field).
 ARGUMENTS = {"seed": "--seed", "cf_offset": "--sim-cf-offset", "sim_cf_offset": "--sim-cf-offset",
@@ -78,6 +78,11 @@ $STABLEPUSH_CACHE, else $XDG_CACHE_HOME/stablepush or ~/.cache/stablepush (here:
                         "rounds search again, each with its own seed drawn from --seed; even rounds move the plan's "
                         "switch poses (or a via pose) on ever finer grids; the cheapest plan is kept (default: the "
                         "scene's planner.optimize, else 0)")
+    p.add_argument("--margin", type=float, nargs="+", metavar="F",
+                   help="the stability margin every push keeps: MU CF, each a fraction in [0, 1): the pushes hold for "
+                        "a pusher friction MU lower than the scene's and a CF anywhere within CF times the part's "
+                        "radius (at least 1 mm) of the scene's; 0 plans at the regions' exact limit (default: the "
+                        f"scene's planner.margin, else {PlannerOptions.margin.mu:g} {PlannerOptions.margin.cf:g})")
     p.add_argument("--out", metavar="DIR", help="output folder (default: logs/<name>-<timestamp>/)")
     p.add_argument("--verify", type=int, metavar="N",
                    help="re-simulate the plan under N support distributions; exit 3 if a push slips")

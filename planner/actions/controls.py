@@ -22,11 +22,12 @@ from ..model.bodies import body_outline
 from ..model.segments import Push
 from .region_cache import RegionCache, compute_regions, edge_region, is_cached
 from ..model.fields import SceneError
+from ..model.margin import EXACT, Margin
 from ..model.options import DEFAULT_REGIONS
 from ..model.scene import Scene
 
-__all__ = ["EdgeControls", "NoStablePush", "RegionTimeout", "clearance_margin", "controls_or_reason", "edge_controls",
-           "step_length"]
+__all__ = ["EdgeControls", "NoStablePush", "RegionTimeout", "certified_for", "clearance_margin", "controls_or_reason",
+           "edge_controls", "step_length"]
 
 
 def step_length(scene: Scene) -> float:
@@ -84,8 +85,10 @@ class RegionTimeout(Exception):
 
 
 def edge_controls(scene: Scene, deadline: float | None = None, progress: Callable[[int, int], None] | None = None,
-                  cache: RegionCache | None = None, *, regions: str = DEFAULT_REGIONS) -> list[EdgeControls]:
-    """An :class:`EdgeControls` for each allowed edge that has stable pushes.
+                  cache: RegionCache | None = None, *, regions: str = DEFAULT_REGIONS,
+                  margin: Margin = EXACT) -> list[EdgeControls]:
+    """An :class:`EdgeControls` for each allowed edge that has stable pushes, stable with
+    ``margin`` to spare (:func:`certified_for`).
 
     Parameters
     ----------
@@ -116,16 +119,16 @@ def edge_controls(scene: Scene, deadline: float | None = None, progress: Callabl
         If ``deadline`` passed first; it holds the pushes of the edges done.
     """
     p, slider = scene.pusher, scene.slider
-    method, rho = regions, scene.cf_uncertainty
-    todo = [e for e in scene.edges if not is_cached(slider, e, p.mu, p.width, method, rho, cache)]
-    computed = compute_regions(slider, todo, p.mu, p.width, rho, deadline, progress, cache=cache)
+    method, (mu, rho) = regions, certified_for(scene, margin, regions)
+    todo = [e for e in scene.edges if not is_cached(slider, e, mu, p.width, method, rho, cache)]
+    computed = compute_regions(slider, todo, mu, p.width, rho, deadline, progress, cache=cache)
     out, pending = [], []
     for e in scene.edges:
         if e in todo and e not in computed:
             pending.append(e)
             continue
         try:  # read from the cache, or computed again if its file turned out unreadable
-            region = edge_region(slider, e, p.mu, p.width, method, rho, deadline, cache)
+            region = edge_region(slider, e, mu, p.width, method, rho, deadline, cache)
         except DeadlineExceeded:
             pending.append(e)
             continue
@@ -134,19 +137,42 @@ def edge_controls(scene: Scene, deadline: float | None = None, progress: Callabl
     if pending:
         raise RegionTimeout(out, tuple(pending))
     if not out:
-        raise NoStablePush(scene)
+        raise NoStablePush(scene, margin, regions)
     return out
 
 
-class NoStablePush(SceneError):
-    """No allowed edge of ``scene`` has a stable push. The field blamed is the CF's uncertainty if
-    the CF known exactly would leave one (procedure STABLE's region, cheap and inside the exact
-    one, has pushes), else the edges."""
+def certified_for(scene: Scene, margin: Margin, regions: str = DEFAULT_REGIONS) -> tuple[float, float]:
+    """The friction and the CF disk's radius that the pushes of ``scene``'s part are certified
+    for with ``margin`` (:mod:`planner.model.margin`). Procedure STABLE knows one CF only, so with
+    ``regions='stable'`` the margin's CF disk is left out (its friction is kept).
 
-    def __init__(self, scene: Scene):
+    >>> from planner import load_scene
+    >>> scene = load_scene("scenes/battery.yaml")
+    >>> certified_for(scene, EXACT) == (scene.pusher.mu, 0.0)
+    True
+    >>> mu, rho = certified_for(scene, Margin(0.1, 0.02))  # 2 % of the part's 28 mm is less than the 1 mm floor
+    >>> round(mu / scene.pusher.mu, 12), round(rho, 12), round(scene.slider.radius, 4)
+    (0.9, 0.001, 0.0276)
+    """
+    p = scene.pusher
+    applied = margin if regions == "exact" else Margin(margin.mu, 0.0)
+    return applied.friction(p.mu, p.mu_high), applied.cf_radius(scene.slider.radius, scene.cf_uncertainty)
+
+
+class NoStablePush(SceneError):
+    """No allowed edge of ``scene`` has a stable push with ``margin``. The field blamed is the
+    margin if the exact limit would leave one, the CF's uncertainty if the CF known exactly would
+    (procedure STABLE's region, cheap and inside the exact one, has pushes), else the edges."""
+
+    def __init__(self, scene: Scene, margin: Margin = EXACT, regions: str = DEFAULT_REGIONS):
         p = scene.pusher
-        if scene.cf_uncertainty > 0 and any(not stable_region(scene.slider, e, p.mu, p.width).is_empty
-                                            for e in scene.edges):
+        mu, rho = certified_for(scene, margin, regions)
+        some = any(not stable_region(scene.slider, e, p.mu, p.width).is_empty for e in scene.edges)
+        if (mu, rho) != certified_for(scene, EXACT, regions) and some and scene.cf_uncertainty == 0:
+            super().__init__("planner.margin", f"no allowed edge has a push stable with the margin ({margin}: "
+                                               f"friction {mu:.4g}, CF within {rho * 1e3:.3g} mm), though at the "
+                                               "exact limit (margin 0) some have")
+        elif scene.cf_uncertainty > 0 and some:
             super().__init__("slider.cf_uncertainty", f"is too large: no allowed edge has a push stable for every CF "
                                                       f"within {scene.cf_uncertainty:g} m of the cf, though with the "
                                                       "cf known exactly some have")
@@ -155,8 +181,9 @@ class NoStablePush(SceneError):
                                              "the cf)")
 
 
-def controls_or_reason(scene: Scene, regions: str = DEFAULT_REGIONS) -> tuple[list[EdgeControls] | None, str | None]:
-    """``(edge_controls(scene, regions=regions), None)``, or ``(None, why)`` when no allowed edge
+def controls_or_reason(scene: Scene, regions: str = DEFAULT_REGIONS,
+                       margin: Margin = EXACT) -> tuple[list[EdgeControls] | None, str | None]:
+    """``(edge_controls(scene, regions=regions, margin=margin), None)``, or ``(None, why)`` when no allowed edge
     has a stable push (the problem of the :class:`NoStablePush` it raised); other errors pass
     through.
 
@@ -171,6 +198,6 @@ def controls_or_reason(scene: Scene, regions: str = DEFAULT_REGIONS) -> tuple[li
     (None, 'no allowed edge has a stable push (no contact force can pass through the cf)')
     """
     try:
-        return edge_controls(scene, regions=regions), None
+        return edge_controls(scene, regions=regions, margin=margin), None
     except NoStablePush as err:
         return None, err.problem

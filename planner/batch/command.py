@@ -41,7 +41,8 @@ def run_command(args: argparse.Namespace) -> int:
              else None if args.seed is None else [check_seed(args.seed, "seed")])
     overrides = {key: value for key, value in (("planner", args.planner), ("time_limit", args.time_limit),
                                                ("regions", args.regions), ("transit", args.transit),
-                                               ("switch_cost", args.switch_cost), ("optimize", args.optimize))
+                                               ("switch_cost", args.switch_cost), ("optimize", args.optimize),
+                                               ("margin", args.margin))
                   if value is not None}
     tasks = make_tasks(args.scene, seeds, overrides=overrides)
     out = Path(args.out) if args.out else Path("logs") / f"batch-{time.strftime('%Y%m%d-%H%M%S')}"

@@ -14,6 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..model.margin import EXACT, Margin
 from ..model.options import DEFAULT_REGIONS
 from ..model.scene import Scene
 from ..queries.reachable_set import HEADINGS, ReachableSet, reachable_set
@@ -23,9 +24,10 @@ from ..model.processes import cores
 __all__ = ["merge", "reachable_set_on"]
 
 
-def _part(job: tuple[Scene, int, float | None, int, slice, str], shared: None) -> ReachableSet:
-    scene, pushes, resolution, headings, among, regions = job
-    return reachable_set(scene, pushes, None, resolution, headings=headings, among=among, regions=regions)
+def _part(job: tuple[Scene, int, float | None, int, slice, str, Margin], shared: None) -> ReachableSet:
+    scene, pushes, resolution, headings, among, regions, margin = job
+    return reachable_set(scene, pushes, None, resolution, headings=headings, among=among, regions=regions,
+                         margin=margin)
 
 
 def merge(maps: list[ReachableSet], seconds: float) -> ReachableSet:
@@ -42,9 +44,9 @@ def merge(maps: list[ReachableSet], seconds: float) -> ReachableSet:
 
 def reachable_set_on(scene: Scene, pushes: int = 1, engine: str = "local", workers: int | None = None,
                      address: str | None = None, resolution: float | None = None, *,
-                     headings: int = HEADINGS, regions: str = DEFAULT_REGIONS) -> ReachableSet:
+                     headings: int = HEADINGS, regions: str = DEFAULT_REGIONS, margin: Margin = EXACT) -> ReachableSet:
     """:func:`~planner.queries.reachable_set.reachable_set` of ``scene`` for any final heading
-    with the stable pushes of the ``regions`` option, its ``headings`` computed on the ``engine``
+    with the stable pushes of the ``regions`` option keeping ``margin``, its ``headings`` computed on the ``engine``
     executor (:func:`planner.batch.executor`).
 
     The headings are cut into one run per worker (``workers``, default: this machine's cores):
@@ -58,6 +60,6 @@ def reachable_set_on(scene: Scene, pushes: int = 1, engine: str = "local", worke
     clock = time.perf_counter()
     parts = min(workers or cores(), headings)
     cuts = np.linspace(0, headings, parts + 1).round().astype(int)
-    jobs = [(scene, pushes, resolution, headings, slice(a, b), regions) for a, b in zip(cuts[:-1], cuts[1:])]
+    jobs = [(scene, pushes, resolution, headings, slice(a, b), regions, margin) for a, b in zip(cuts[:-1], cuts[1:])]
     maps = map_ordered(_part, jobs, workers, engine, address)
     return merge(maps, time.perf_counter() - clock)

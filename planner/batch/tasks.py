@@ -27,9 +27,10 @@ import numpy as np
 
 from mechanics import Slider
 
-from ..actions.controls import edge_controls
+from ..actions.controls import certified_for, edge_controls
 from ..actions.region_cache import default_cache, is_cached, regions_held
 from ..model.fields import SceneError, number, shown
+from ..model.margin import check_margin
 from ..model.options import (PlannerOptions, check_optimize, check_planner, check_regions, check_seed,
                              check_switch_cost, check_time_limit, check_transit)
 from ..model.scene import Scene
@@ -44,12 +45,13 @@ OVERRIDES = {
     "regions": check_regions, "switch_cost": check_switch_cost, "optimize": check_optimize,
     "mu": lambda value, name: number(value, name, positive=True),
     "cf_offset": lambda value, name: _pair(value, name),
+    "margin": lambda value, name: check_margin(value, name).to_dict(),  # kept as plain data, as tasks are
 }
 
 
 #: The overrides that are planner options (:class:`~planner.model.options.PlannerOptions`;
 #: ``planner`` is its ``name``).
-_OPTIONS = ("planner", "time_limit", "transit", "regions", "switch_cost", "optimize")
+_OPTIONS = ("planner", "time_limit", "transit", "regions", "switch_cost", "optimize", "margin")
 
 
 def _pair(value: Any, name: str) -> tuple[float, float]:
@@ -304,10 +306,11 @@ def _one_part(scene: Scene) -> list[Scene]:
     return [scene.move_scene(name, scene.starts) for name in scene.names]
 
 
-def _region_keys(scene: Scene, regions: str) -> tuple:
-    """What a scene's regions of the ``regions`` option depend on, to compute them once for all tasks alike."""
+def _region_keys(scene: Scene, options: PlannerOptions) -> tuple:
+    """What a scene's regions of ``options`` depend on, to compute them once for all tasks alike."""
     p = scene.pusher
-    return (scene.slider.vertices.tobytes(), scene.slider.cf.tobytes(), tuple(scene.edges), p.mu, p.width, scene.cf_uncertainty, regions)
+    return (scene.slider.vertices.tobytes(), scene.slider.cf.tobytes(), tuple(scene.edges), p.width,
+            certified_for(scene, options.margin, options.regions), options.regions)
 
 
 def shared_regions(tasks: Iterable[Task] | TaskList) -> dict[str, Any]:
@@ -320,15 +323,15 @@ def shared_regions(tasks: Iterable[Task] | TaskList) -> dict[str, Any]:
     for task in tasks.setups() if isinstance(tasks, TaskList) else tasks:
         planned, options = task.planned()
         for scene in _one_part(planned):
-            if (key := _region_keys(scene, options.regions)) in seen:
+            if (key := _region_keys(scene, options)) in seen:
                 continue
             seen.add(key)
             try:
-                edge_controls(scene, regions=options.regions)
+                edge_controls(scene, regions=options.regions, margin=options.margin)
             except SceneError:
                 continue
-            p = scene.pusher
-            shared |= regions_held(scene.slider, scene.edges, p.mu, p.width, scene.cf_uncertainty)
+            mu, rho = certified_for(scene, options.margin, options.regions)
+            shared |= regions_held(scene.slider, scene.edges, mu, scene.pusher.width, rho)
     return shared
 
 
@@ -343,8 +346,9 @@ def run_task(task: Task, shared: Mapping[str, Any] | None) -> dict[str, Any]:
         if cache.get(key) is None:
             cache.put(key, region)
     scene, options = task.planned()
-    missing = sum(not is_cached(one.slider, e, one.pusher.mu, one.pusher.width, options.regions, one.cf_uncertainty)
-                  for one in _one_part(scene) for e in one.edges)
+    missing = sum(not is_cached(one.slider, e, mu, one.pusher.width, options.regions, rho)
+                  for one in _one_part(scene) for e in one.edges
+                  for mu, rho in [certified_for(one, options.margin, options.regions)])
     # The command's pipeline, writing nothing: the certificates, else the plan.
     outcome = run(scene, planner_options=options)
     result = outcome.plan

@@ -65,9 +65,11 @@ from mechanics.quasistatic import (DEFAULT_STEPS, Contact, ContactMode, PushResu
                                    dipod_supports, edge_contacts, grid_support, random_support, simulate_push,
                                    tripod_supports)
 
+from ..actions.margins import keeps, with_margins
 from ..actions.transit import edge_contact_pose
 from ..model.fields import SceneError, pose_text
-from ..model.options import DEFAULT_TRANSIT
+from ..model.margin import Margin, PushMargin
+from ..model.options import DEFAULT_REGIONS, DEFAULT_TRANSIT
 from ..model.plan import Move, Plan
 from ..model.plan_file import part_field
 from ..model.scene import Part, Pusher, Scene
@@ -150,6 +152,8 @@ class PushCheck:
     position_error: np.ndarray
     angle_error: np.ndarray
     tolerance: tuple[float, float]
+    margin: PushMargin | None = None  # the push's own, certified (planner.actions.margins)
+    keeps: bool | None = None  # whether it lies in the regions of its plan's margin (None: the plan claims none)
 
     @property
     def slipped(self) -> np.ndarray:
@@ -159,7 +163,7 @@ class PushCheck:
 
     @property
     def passed(self) -> bool:
-        return not self.slipped.any()
+        return not self.slipped.any() and self.keeps is not False
 
     @property
     def worst(self) -> int:
@@ -208,6 +212,7 @@ class Verification:
     kinds: tuple[str, ...]
     relative_tolerance: float  # positions in part radii, angles in radians
     seconds: float
+    margin: Margin | None = None  # the margin the plan claims to keep
 
     @property
     def pushes(self) -> tuple[PushCheck, ...]:
@@ -299,9 +304,12 @@ class Verification:
             notes.append(f"{ambiguous} ambiguous")
         if (modes := p.non_sticking_modes()):
             notes.append(f"modes {', '.join(modes)}")
+        if p.margin is not None:
+            notes.append(f"margin {p.margin}")
+        verdict = "ok" if p.passed else "SLIPS" if p.slipped.any() else "BELOW THE PLAN'S MARGIN"
         return (f"push {count} (edge {p.segment.edge}, {p.segment.duration:.3f} s): "
                 f"worst {p.position_error.max():.2e} m, {p.angle_error.max():.2e} rad "
-                f"({self.kinds[p.worst]} run {p.worst}); {', '.join(notes)}: {'ok' if p.passed else 'SLIPS'}")
+                f"({self.kinds[p.worst]} run {p.worst}); {', '.join(notes)}: {verdict}")
 
     def summary(self) -> str:
         """One line: the verdict, the distributions, the worst deviation and the chained drift; with
@@ -316,10 +324,17 @@ class Verification:
             pushes += f" of {len(self.moves)} move{'' if len(self.moves) == 1 else 's'}"
             limits = f"{self.relative_tolerance:.1e} part radii"
             met = "; " + (f"parts met: {', '.join(parts)}" if parts else "every move clear of the other parts")
+        margins = [p.margin for p in self.pushes if p.margin is not None]
+        least = "" if not margins else (f"; smallest margin friction -{min(m.mu for m in margins) * 100:.0f} %, "
+                                        f"CF {min(m.cf for m in margins) * 1e3:.2g} mm")
+        if (below := sum(p.keeps is False for p in self.pushes)):
+            least += f" ({below} push{'' if below == 1 else 'es'} below the plan's margin, {self.margin})"
+        elif self.margin is not None:
+            least += f" (planned: {self.margin})"
         return (f"verify: {'passed' if self.passed else 'FAILED'}: {pushes} x "
                 f"{len(self.kinds)} distributions ({mix}); worst deviation {position:.2e} m, {angle:.2e} rad; "
                 f"chained drift {self.drift[0]:.2e} m, {self.drift[1]:.2e} rad "
-                f"(tolerance {limits}, {self.relative_tolerance:.1e} rad){met}")
+                f"(tolerance {limits}, {self.relative_tolerance:.1e} rad){least}{met}")
 
 
 def _allowed_edge(part: Part, edge: int, field: str) -> None:
@@ -467,9 +482,11 @@ def _meets(scene: Scene, move: Move, poses: dict[str, np.ndarray], other: str) -
 
 
 def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: float = TOLERANCE, *,
-           transit: str = DEFAULT_TRANSIT) -> Verification:
+           transit: str = DEFAULT_TRANSIT, regions: str = DEFAULT_REGIONS) -> Verification:
     """Re-simulate every push of ``plan`` under ``n`` support distributions of its part, and sweep
-    every move against the other parts (module docstring).
+    every move against the other parts (module docstring); certify each push's own stability
+    margin, and check that it lies in the ``regions`` of the margin the plan claims
+    (:mod:`planner.actions.margins`).
 
     Parameters
     ----------
@@ -485,6 +502,8 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
         Relative tolerance: positions in part radii, angles in radians.
     transit : str
         The ``transit`` option the plan was made with: the modes its transits may use.
+    regions : str
+        The ``regions`` option it was made with (``'exact'`` or ``'stable'``).
 
     Returns
     -------
@@ -511,6 +530,9 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
     check_solved(plan)
     contacts = check_chain(scene, plan, transit)
     clock = time.perf_counter()
+    own = iter((plan if plan.margins else with_margins(scene, plan)).margins)
+    claimed = plan.margin is not None and not plan.margin.exact
+    kept = iter(keeps(scene, plan, plan.margin, regions) if claimed else [])
     supports_of, kinds = {}, []
     for part in scene.names:
         supports, kinds = distributions(scene.move_scene(part, scene.starts, others=False), n, seed)
@@ -526,10 +548,11 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
                                           start_pose=segment.start) for s in supports_of[move.part])
             ends = np.array([r.final_pose for r in results])
             checks.append(PushCheck(segment, move.part, fingers, results, *_deviation(part.slider, ends, segment.end),
-                                    limits))
+                                    limits, next(own), next(kept) if claimed else None))
             # chained * (start^-1 end): each run's own relative motion, from where it got to.
             chained = exp_twist(chained, log_pose(segment.start, ends))
         drift = _deviation(part.slider, chained, move.end)
         met = tuple(other for other in scene.names if other != move.part and _meets(scene, move, poses, other))
         moves.append(MoveCheck(move, tuple(checks), (float(drift[0].max()), float(drift[1].max())), met))
-    return Verification(scene, tuple(moves), supports_of, tuple(kinds), tolerance, time.perf_counter() - clock)
+    return Verification(scene, tuple(moves), supports_of, tuple(kinds), tolerance, time.perf_counter() - clock,
+                        plan.margin)

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from .fields import LENGTH, SceneError, integer, number, shown
+from .margin import DEFAULT_MARGIN, Margin, check_margin
 
 __all__ = ["DEFAULT_PLANNER", "DEFAULT_REGIONS", "DEFAULT_SWITCH_COST", "DEFAULT_TRANSIT", "MAX_OPTIMIZE",
            "MAX_SEED", "MAX_TIME_LIMIT", "PLANNERS", "REGIONS", "TRANSITS", "PlannerOptions", "check_optimize",
@@ -66,7 +67,7 @@ class PlannerOptions:
     >>> PlannerOptions().merged({"speed": 2}, prefix="planner.")
     Traceback (most recent call last):
     ...
-    planner.model.fields.SceneError: planner.speed: is not an option (name, time_limit, seed, regions, switch_cost, optimize, transit)
+    planner.model.fields.SceneError: planner.speed: is not an option (name, time_limit, seed, regions, switch_cost, optimize, transit, margin)
     """
 
     name: str = DEFAULT_PLANNER
@@ -76,6 +77,7 @@ class PlannerOptions:
     switch_cost: float = DEFAULT_SWITCH_COST
     optimize: int = 0  # improvement rounds after the first plan (planner.search.planning.solve)
     transit: str = DEFAULT_TRANSIT  # how the pusher may change edge (TRANSITS)
+    margin: Margin = DEFAULT_MARGIN  # the stability margin every push keeps (planner.model.margin)
 
     def merged(self, changes: Mapping[str, Any] | None, prefix: str = "") -> "PlannerOptions":
         """These options with ``changes`` (field name to value) applied, each checked; a
@@ -160,4 +162,5 @@ def check_time_limit(value: Any, name: str) -> float:
 
 
 _CHECKS = {"name": check_planner, "time_limit": check_time_limit, "seed": check_seed, "regions": check_regions,
-           "switch_cost": check_switch_cost, "optimize": check_optimize, "transit": check_transit}
+           "switch_cost": check_switch_cost, "optimize": check_optimize, "transit": check_transit,
+           "margin": check_margin}

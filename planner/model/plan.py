@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .fields import SceneError
+from .margin import Margin, PushMargin
 from .scene import ONE_PART
 from .segments import Push, Transfer, Transit, floats, path_length
 
@@ -102,6 +103,11 @@ class Plan:
     #: ``(planning time s, cost m, length m)`` of the first plan found and of each better one after it.
     improvements: list[tuple[float, float, float]] = field(default_factory=list)
     tree: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 2)), repr=False)  # search tree, world xy
+    #: The stability margin the pushes were planned to keep (None: not known, as in older plan files).
+    margin: Margin | None = None
+    #: Each push's own certified margin, in the order of :attr:`steps` (empty: not computed;
+    #: :func:`planner.actions.margins.with_margins`).
+    margins: tuple[PushMargin, ...] = ()
 
     @classmethod
     def of_part(cls, part: str, start: ArrayLike, goal: ArrayLike, segments: list[Segment], *,
@@ -260,13 +266,27 @@ class Plan:
 
 def _head(plan: Plan, format: str) -> dict:
     return {"format": format, "scene": plan.scene, "solved": bool(plan.solved), "planner": plan.planner,
-            "seed": int(plan.seed), "planning_time_s": round(float(plan.planning_time_s), 4)}
+            "seed": int(plan.seed), "planning_time_s": round(float(plan.planning_time_s), 4)} | (
+        {} if plan.margin is None else {"margin": plan.margin.to_dict()})
+
+
+def _segment_dicts(plan: Plan, named: bool) -> list[dict]:
+    """The plan's segments as its file holds them, each push with its own margin where known and
+    (``named``) each push and transit with its part's name."""
+    margins = iter(plan.margins)
+    out = []
+    for part, s in plan.steps:
+        item = s.to_dict() | ({"part": part} if named and not isinstance(s, Transfer) else {})
+        if isinstance(s, Push) and plan.margins:
+            item["margin"] = next(margins).to_dict()
+        out.append(item)
+    return out
 
 
 def _one_part_dict(plan: Plan) -> dict:
     out = _head(plan, FORMATS[0]) | {
         "start": floats(plan.start), "goal": floats(plan.goal), "final": floats(plan.final),
-        "segments": [s.to_dict() for s in plan.segments]}
+        "segments": _segment_dicts(plan, named=False)}
     if plan.reason and not plan.solved:
         out["reason"] = plan.reason
     if not plan.solved:  # an unsolved plan's segments are not a way to the goal: no cost is said
@@ -288,8 +308,7 @@ def _parts_dict(plan: Plan) -> dict:
     parts = {n: {"start": floats(plan.starts[n]), "goal": floats(plan.goals[n]), "final": floats(finals[n]),
                  "delivered": n in plan.delivered} | ({"cf": floats(plan.cfs[n])} if n in plan.cfs else {})
              for n in plan.names}
-    segments = [s.to_dict() if isinstance(s, Transfer) else {**s.to_dict(), "part": part} for part, s in plan.steps]
-    out = _head(plan, FORMATS[1]) | {"parts": parts, "segments": segments}
+    out = _head(plan, FORMATS[1]) | {"parts": parts, "segments": _segment_dicts(plan, named=True)}
     if plan.reason and not plan.solved:
         out["reason"] = plan.reason
     if plan.switch_cost is not None:

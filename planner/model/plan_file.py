@@ -31,6 +31,7 @@ import numpy as np
 
 from .fields import SceneError, integer, keys, number, shown, vector
 from .json_file import read_json
+from .margin import check_margin
 from .plan import FORMAT, FORMATS, Move, Plan
 from .scene import ONE_PART
 from .segments import Push, Transfer, Transit
@@ -89,14 +90,15 @@ def _fields(spec: dict) -> dict[str, Any]:
             "planner": str(spec["planner"]), "seed": integer(spec["seed"], "plan.seed"),
             "planning_time_s": number(spec["planning_time_s"], "plan.planning_time_s"),
             "reason": str(spec.get("reason", "")),
-            "switch_cost": number(spec["switch_cost"], "plan.switch_cost") if "switch_cost" in spec else None}
+            "switch_cost": number(spec["switch_cost"], "plan.switch_cost") if "switch_cost" in spec else None,
+            "margin": check_margin(spec["margin"], "plan.margin") if "margin" in spec else None}
 
 
 def _read_one_part(data: dict) -> Plan:
     """A ``plan/1`` file's plan: of :data:`~planner.model.scene.ONE_PART`."""
     spec = keys(data, "plan", ("format", "scene", "solved", "planner", "seed", "planning_time_s", "start",
                                "goal", "final", "segments"),
-                ("reason", "cf", "length", "switch_cost", "cost", "improvements"))
+                ("reason", "cf", "length", "switch_cost", "cost", "improvements", "margin"))
     fields = _fields(spec)
     start = vector(spec["start"], "plan.start", 3)
     at = {ONE_PART: start}
@@ -136,7 +138,7 @@ def _read_parts(data: dict) -> Plan:
     from the part just moved to the part moved next, and what the file says of finals, length and
     cost is what its segments make."""
     spec = keys(data, "plan", ("format", "scene", "solved", "planner", "seed", "planning_time_s", "parts", "segments"),
-                ("reason", "switch_cost", "length", "cost"))
+                ("reason", "switch_cost", "length", "cost", "margin"))
     fields = _fields(spec)
     listed = spec["parts"]
     if not isinstance(listed, dict) or not listed:

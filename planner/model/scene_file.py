@@ -39,7 +39,7 @@ __all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "PLANNER_KEYS", "Table", "lo
            "read_pusher", "read_slider", "read_table", "write_scene"]
 
 #: The keys of a scene's ``planner:`` block: the options but ``transit``, which a file gives as ``pusher.transit``.
-PLANNER_KEYS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize")
+PLANNER_KEYS = ("name", "time_limit", "seed", "regions", "switch_cost", "optimize", "margin")
 #: Longest scene name in bytes: it names files, which most file systems cap at 255 bytes.
 _MAX_NAME_BYTES = 200
 #: The pusher's width and depth and a box's sides, in metres (a micron): thinner is no body.
@@ -94,7 +94,7 @@ def plain_scene(scene: Scene, options: PlannerOptions | None = None) -> dict[str
     table = {"obstacles": [{"polygon": np.asarray(o.exterior.coords)[:-1].tolist()} for o in scene.obstacles],
              "workspace": {"min": list(scene.workspace[:2]), "max": list(scene.workspace[2:])},
              "tolerance": {"position": scene.tolerance_position, "angle": _degrees(scene.tolerance_angle)},
-             "planner": {key: getattr(options, key) for key in PLANNER_KEYS}}
+             "planner": {key: getattr(options, key) for key in PLANNER_KEYS} | {"margin": options.margin.to_dict()}}
     if scene.names == (ONE_PART,):
         part = scene.part()
         return {"name": scene.name, "slider": _plain_part(part), "pusher": {**pusher_data, "edges": list(part.edges)},

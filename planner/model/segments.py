@@ -67,7 +67,8 @@ class Push:
     @classmethod
     def from_dict(cls, data: Any, name: str) -> "Push":
         """Read a segment of a plan file, checking every field (errors name ``name``.field)."""
-        spec = keys(data, name, ("kind", "edge", "contact", "twist", "duration", "start", "end"))
+        # A push's "margin" is what the planner certified; it is certified again where it is shown.
+        spec = keys(data, name, ("kind", "edge", "contact", "twist", "duration", "start", "end"), ("margin",))
         if spec["kind"] != "push":
             raise SceneError(f"{name}.kind", f"must be 'push', got {spec['kind']!r}")
         contact = spec["contact"]

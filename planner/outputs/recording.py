@@ -30,7 +30,11 @@ Static (no timeline, always visible)
 * ``/log`` -- ``TextLog``, the summary panel's rows (``WARN`` when not solved): what was solved
   with how many parts, moves, pushes, switches and transfers, the CF path length and the cost
   (length plus ``switch_cost`` per switch and per transfer), the push, transit and transfer
-  times, and last, for several parts which were delivered, for one part the search tree's size.
+  times, the stability margin the plan was made for and the least its pushes keep
+  (:mod:`planner.actions.margins`), and last, for several parts which were delivered, for one
+  part the search tree's size.
+* ``/log/pushes`` -- ``TextLog``, a row per push at its first frame on both timelines: its own
+  certified margin (how much lower the friction, and how far the CF, may be before it may slip).
   They are on both timelines at 0, not static: a text log view lists only rows of its timeline.
 
 Animated, one row per frame on the timelines ``time`` (plan time in seconds, pushes, transits and
@@ -130,6 +134,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import twist_to_cor
 
+from ..actions.margins import smallest
 from ..actions.region_cache import RegionCache
 from ..actions.transit import transit_pieces
 from ..model.bodies import place, pusher_frame_body
@@ -230,9 +235,15 @@ def _summary(scene: Scene, plan: Plan) -> list[str]:
     times = [f"{word} time {sum(s.duration for s in plan.segments if isinstance(s, kind)):.4f} s"
              for word, kind in (("push", Push), ("transit", Transit), ("transfer", Transfer))
              if kind is Push or any(isinstance(s, kind) for s in plan.segments)]
-    return [f"{head}: solved with {' and '.join(plan.contents().rsplit(', ', 1))}",
+    rows = [f"{head}: solved with {' and '.join(plan.contents().rsplit(', ', 1))}",
             f"CF path length {length:.4f} m{cost}",
-            f"{', '.join(times)} (every point of the pusher at most 1 m/s)", last]
+            f"{', '.join(times)} (every point of the pusher at most 1 m/s)"]
+    if plan.margin is not None or plan.margins:
+        least = smallest(plan)
+        rows.append("stability margin: " + ", ".join(
+            ([f"planned for {plan.margin}"] if plan.margin is not None else [])
+            + ([f"the pushes keep at least {least} (each on its own)"] if least is not None else [])))
+    return [*rows, last]
 
 
 def _log_text(rec: rr.RecordingStream, entity: str, lines: list[str], level: str) -> None:
@@ -418,7 +429,22 @@ def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan, look: dict[st
     rec.log("world/pusher_lifted", rr.LineStrips3D.from_fields(colors=_LIFTED, radii=_THIN, labels=["lifted"]),
             static=True)
     rec.log("world/cor", rr.Points3D.from_fields(colors=_COR, radii=_DOT, labels=["COR"]), static=True)
+    _log_margins(rec, plan, shown)
     return shown
+
+
+def _log_margins(rec: rr.RecordingStream, plan: Plan, shown: Frames) -> None:
+    """``/log/pushes``: a row per push at its first frame, with its own certified margin."""
+    pushes = [(k, name, s) for k, (name, s) in enumerate(plan.steps) if isinstance(s, Push)]
+    if not plan.margins or not pushes:
+        return
+    first = np.array([np.argmax(shown.index == k) for k, _, _ in pushes])
+    several = len(plan.names) > 1
+    lines = [f"push {j}/{len(pushes)} ({f'{name}, ' if several else ''}edge {s.edge}): margin {m}"
+             for j, ((_, name, s), m) in enumerate(zip(pushes, plan.margins), 1)]
+    rec.send_columns("log/pushes", indexes=[rr.TimeColumn("step", sequence=first),
+                                            rr.TimeColumn("time", duration=shown.times[first])],
+                     columns=rr.TextLog.columns(text=lines, level=["INFO"] * len(lines)))
 
 
 def _log_reach(rec: rr.RecordingStream, reach: ReachableSet) -> None:

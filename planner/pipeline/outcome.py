@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..actions.margins import smallest
 from ..model.plan import Plan
 from ..model.scene import Scene
 
@@ -59,10 +60,12 @@ class Outcome:
     def headline(self) -> str:
         """The first line the command prints of a plan: what it is and what was written."""
         plan = self.plan
+        least = "" if (m := smallest(plan)) is None else f", smallest margin {m}"
         if self.loaded is not None:
-            head = f"loaded {self.loaded}: {plan.contents()}"
+            head = f"loaded {self.loaded}: {plan.contents()}{least}"
         else:
-            head = f"solved: {plan.headline()}, planning time {plan.planning_time_s:.2f} s{_first_found(plan)}"
+            head = (f"solved: {plan.headline()}{least}, planning time {plan.planning_time_s:.2f} s"
+                    f"{_first_found(plan)}")
         if self.out is None:
             return head
         shown = [f"{self.out}/{self.files[0]}", *self.files[1:]] if self.files else [str(self.out)]

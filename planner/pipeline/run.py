@@ -16,6 +16,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from ..actions.margins import with_margins
 from ..model.fields import SceneError, shown
 from ..model.files import atomic_path, staged_folder, write_atomic
 from ..model.options import PlannerOptions
@@ -80,7 +81,7 @@ def run(scene: Scene, options: RunOptions = RunOptions(),
             else:
                 session = Planner(scene, planner_options, progress=progress)
                 result = session.plan(since=session.clock)  # the time limit bounds the regions too
-        outcome = _checked(scene, options, planner_options, result, session, reach_map)
+        outcome = _checked(scene, options, planner_options, with_margins(scene, result), session, reach_map)
         outcome = replace(outcome, loaded=None if loaded is None else str(options.plan_file), unreachable=unreachable)
         if options.out is not None:
             outcome = replace(outcome, out=options.out,
@@ -102,7 +103,8 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
     if options.verify and result.solved:
         from ..execution.verify import verify  # the re-simulator, loaded only for verify
 
-        check = verify(scene, result, options.verify, seed, transit=planner_options.transit)
+        check = verify(scene, result, options.verify, seed, transit=planner_options.transit,
+                       regions=planner_options.regions)
     if options.trajectory and result.solved:
         from ..execution.trajectory import trajectory  # loads ruckig, only for a trajectory
 
@@ -115,7 +117,7 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
             from ..queries.reachable_set import reachable_set
 
             reach_map = reachable_set
-        reach = reach_map(mapped, options.reach, regions=planner_options.regions)
+        reach = reach_map(mapped, options.reach, regions=planner_options.regions, margin=planner_options.margin)
     return Outcome(scene, result, verification=check, simulation=simulation, trajectory=motion, reach=reach)
 
 

@@ -23,6 +23,7 @@ from mechanics import Controllability, controllability as twist_controllability
 
 from ..model.fields import SceneError
 from ..actions.controls import edge_controls
+from ..model.margin import EXACT, Margin
 from ..model.options import DEFAULT_REGIONS, DEFAULT_TRANSIT
 from ..model.scene import Scene
 
@@ -104,7 +105,7 @@ class SceneControllability:
 
 
 def controllability(scene: Scene, *, regions: str = DEFAULT_REGIONS,
-                    transit: str = DEFAULT_TRANSIT) -> SceneControllability:
+                    transit: str = DEFAULT_TRANSIT, margin: Margin = EXACT) -> SceneControllability:
     """The controllability the scene's allowed edges give by stable pushes.
 
     Parameters
@@ -114,6 +115,8 @@ def controllability(scene: Scene, *, regions: str = DEFAULT_REGIONS,
         The ``regions`` option: the stable pushes of ``'exact'`` regions or procedure ``'stable'``.
     transit : str
         The ``transit`` option: ``'none'`` keeps one edge per plan.
+    margin : Margin
+        The stability margin the pushes keep (the ``margin`` option; default: none).
 
     Returns
     -------
@@ -134,7 +137,7 @@ def controllability(scene: Scene, *, regions: str = DEFAULT_REGIONS,
     controllable (edges 0, 1, 2, 3); small-time locally controllable with edges 0 and 2 (opposite faces)
     """
     try:
-        pushes = edge_controls(scene, regions=regions)
+        pushes = edge_controls(scene, regions=regions, margin=margin)
     except SceneError as err:
         if err.field == "planner.regions":  # a refused method, not a finding about the edges
             raise

@@ -19,6 +19,7 @@ from mechanics import GOALS, SupportModel, classify_goal, log_pose
 
 from ..model.segments import Push
 from ..actions.controls import clearance_margin, edge_controls
+from ..model.margin import EXACT, Margin
 from ..actions.push import connect
 from ..model.options import DEFAULT_REGIONS
 from ..model.scene import Scene
@@ -47,16 +48,16 @@ class OneStep:
 
 
 def one_step(scene: Scene, start: ArrayLike | None = None, goal: ArrayLike | None = None, *,
-             regions: str = DEFAULT_REGIONS) -> OneStep:
+             regions: str = DEFAULT_REGIONS, margin: Margin = EXACT) -> OneStep:
     """Is ``goal`` reachable from ``start`` (default: the scene's, radians) by one constant stable
     push about ``COR_total`` on some allowed edge, without collision? The stable pushes are the
-    ``regions`` option's (``'exact'`` or ``'stable'``).
+    ``regions`` option's (``'exact'`` or ``'stable'``), with ``margin`` to spare (default: none).
 
     Edges are tried in the order the scene allows them; the first that works is returned.
     """
     start = scene.start if start is None else np.asarray(start, dtype=float)
     goal = scene.goal if goal is None else np.asarray(goal, dtype=float)
-    pushes = edge_controls(scene, regions=regions)
+    pushes = edge_controls(scene, regions=regions, margin=margin)
     model = CollisionModel(scene, [p.edge for p in pushes])
     verdicts = goal_verdicts(scene, start, goal)
     reasons = []

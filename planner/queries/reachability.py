@@ -98,7 +98,8 @@ class Reach:
         """
         from .controllability import controllability  # its scipy is not needed for the answer
 
-        return controllability(self.scene, regions=self.options.regions, transit=self.options.transit)
+        return controllability(self.scene, regions=self.options.regions, transit=self.options.transit,
+                               margin=self.options.margin)
 
 
 class Certificates:

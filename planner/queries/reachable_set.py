@@ -48,6 +48,7 @@ from ..model.extras import pyplot
 from ..model.segments import Push
 from ..search.goal_region import GoalRegion
 from ..actions.controls import EdgeControls, clearance_margin, controls_or_reason
+from ..model.margin import EXACT, Margin
 from ..model.options import DEFAULT_REGIONS
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
@@ -108,7 +109,8 @@ class ReachableSet:
 
 def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, resolution: float | None = None,
                   *, headings: int = HEADINGS, among: slice | None = None,
-                  controls: list[EdgeControls] | None = None, regions: str = DEFAULT_REGIONS) -> ReachableSet:
+                  controls: list[EdgeControls] | None = None, regions: str = DEFAULT_REGIONS,
+                  margin: Margin = EXACT) -> ReachableSet:
     """The map of goal positions reachable from ``scene.start`` in at most ``pushes`` (1 or 2)
     constant stable collision-free pushes (module docstring).
 
@@ -129,6 +131,7 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
         :func:`planner.batch.reach.reachable_set_on` computes on another worker).
     controls : the allowed edges' controls, where the caller has them (a session)
     regions : the ``regions`` option the controls are computed with where not given (``'exact'`` or ``'stable'``)
+    margin : the stability margin they keep (the ``margin`` option; default: none)
     """
     import time
 
@@ -150,10 +153,10 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
     theta = np.full(nx * ny, np.nan)
     blocked = np.ones(nx * ny, dtype=bool)
 
-    edges = controls if controls is not None else controls_or_reason(scene, regions)[0]
+    edges = controls if controls is not None else controls_or_reason(scene, regions, margin)[0]
     if edges is not None:
         model = CollisionModel(scene, [p.edge for p in edges])
-        margin = clearance_margin(scene)
+        clearance = clearance_margin(scene)
         start = np.asarray(scene.start, dtype=float)
         free = []  # per heading: the cells where the part fits
         for th in thetas:
@@ -163,12 +166,12 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
         for th, ok in zip(thetas, free):  # one push, every heading first: a 1 beats any 2
             todo = np.flatnonzero(ok & (count == 0))
             goals = np.column_stack([xy[todo], np.full(todo.size, th)])
-            hit = _one_push(start, goals, edges, model, margin)
+            hit = _one_push(start, goals, edges, model, clearance)
             count[todo[hit]], theta[todo[hit]] = 1, th
         if pushes == 2:
             for th, ok in zip(thetas, free):  # the cells of a heading as the goals of one region
                 todo = np.flatnonzero(ok & (count == 0))
-                region = GoalRegion(scene, np.column_stack([xy[todo], np.full(todo.size, th)]), edges, model, margin,
+                region = GoalRegion(scene, np.column_stack([xy[todo], np.full(todo.size, th)]), edges, model, clearance,
                                     aim=False)
                 hit: set[int] = set()
                 for k in range(len(edges)):

@@ -208,12 +208,19 @@ class Planner:
         """
         request = self._request(seed, time_limit, optimize, planner)
         if self.paths is not None:
-            return self._plan_parts(start, goal, request, edges)
-        start = self._pose(start, "start", self.scene.start)
-        goal = self._pose(goal, "goal", self.scene.goal)
-        if edges is not None and not all(isinstance(e, int) and e in self.scene.edges for e in edges):
-            raise SceneError("edges", f"must be allowed edges of the pusher {list(self.scene.edges)}, got {edges}")
-        return self._plan(start, goal, request, time.perf_counter() if since is None else since, reuse, edges, observed)
+            found = self._plan_parts(start, goal, request, edges)
+        else:
+            start = self._pose(start, "start", self.scene.start)
+            goal = self._pose(goal, "goal", self.scene.goal)
+            if edges is not None and not all(isinstance(e, int) and e in self.scene.edges for e in edges):
+                raise SceneError("edges", f"must be allowed edges of the pusher {list(self.scene.edges)}, got {edges}")
+            found = self._plan(start, goal, request, time.perf_counter() if since is None else since, reuse, edges,
+                               observed)
+        if not found.solved and found.reason and not self.options.margin.exact:
+            # The margin shrinks every region: a user at the limit of what is reachable should know.
+            found = replace(found, reason=f"{found.reason} (with the stability margin: {self.options.margin}; "
+                                          "margin 0 plans at the regions' exact limit)")
+        return replace(found, margin=self.options.margin)
 
     def _plan(self, start: np.ndarray, goal: np.ndarray, request: PlanRequest, clock: float,
               reuse: bool = False, edges: Sequence[int] | None = None, observed: bool = False) -> Plan:
@@ -343,6 +350,7 @@ class Planner:
         regions and collision model."""
         return reachable_set(self.scene, pushes, heading, resolution,
                              controls=None if self.world is None else self.world.controls, regions=self.options.regions,
+                             margin=self.options.margin,
                              **kwargs)
 
 
@@ -354,7 +362,7 @@ def session_options(scene: Scene, options: PlannerOptions | Mapping[str, Any] | 
 
     >>> from planner import load_scene
     >>> session_options(load_scene("scenes/narrow_junction.yaml"), {"seed": 7})
-    PlannerOptions(name='rrt', time_limit=10.0, seed=7, regions='exact', switch_cost=0.25, optimize=0, transit='lift')
+    PlannerOptions(name='rrt', time_limit=10.0, seed=7, regions='exact', switch_cost=0.25, optimize=0, transit='lift', margin=Margin(mu=0.1, cf=0.02))
     """
     if isinstance(options, PlannerOptions):
         return PlannerOptions().merged(asdict(options))

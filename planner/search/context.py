@@ -131,7 +131,7 @@ class SearchWorld:
             raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
         note = ""
         try:
-            controls = edge_controls(scene, deadline, progress, cache, regions=options.regions)
+            controls = edge_controls(scene, deadline, progress, cache, regions=options.regions, margin=options.margin)
         except RegionTimeout as timeout:
             if not timeout.controls:
                 raise

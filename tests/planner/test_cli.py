@@ -40,9 +40,10 @@ BATTERY_TEXT = (SCENES / "battery.yaml").read_text()
 BATTERY = yaml.safe_load(BATTERY_TEXT)  # a one-step plan: solved at once
 VERTICES = BATTERY["slider"]["vertices"]
 ERROR = re.compile(r"plan: error: (.+?): (.+)")
-PLAN_KEYS = {"format", "scene", "solved", "planner", "seed", "planning_time_s", "start", "goal", "final", "segments"}
+PLAN_KEYS = {"format", "scene", "solved", "planner", "seed", "planning_time_s", "start", "goal", "final", "segments",
+             "margin"}
 COST_KEYS = {"cf", "length", "switch_cost", "cost", "improvements"}  # a solved plan's
-SEGMENT_KEYS = {"push": {"kind", "edge", "contact", "twist", "duration", "start", "end"},
+SEGMENT_KEYS = {"push": {"kind", "edge", "contact", "twist", "duration", "start", "end", "margin"},
                 "transit": {"kind", "from_edge", "to_edge", "mode", "pusher_path", "duration"}}
 L_SHAPE = [[0.0, 0.0], [0.09, 0.0], [0.09, 0.035], [0.035, 0.035], [0.035, 0.09], [0.0, 0.09]]  # edges 2, 3 concave
 
@@ -227,6 +228,11 @@ BAD_SCENES = {
     "switch cost negative": (battery(planner={"switch_cost": -0.01}), "planner.switch_cost", ">= 0"),
     "switch cost a string": (battery(planner={"switch_cost": "high"}), "planner.switch_cost", "number"),
     "switch cost infinite": (battery(planner={"switch_cost": float("inf")}), "planner.switch_cost", "finite"),
+    "margin negative": (battery(planner={"margin": {"mu": -0.1}}), "planner.margin", "[0, 1)"),
+    "margin NaN": (battery(planner={"margin": [0.1, float("nan")]}), "planner.margin", "cf must be"),
+    "margin larger than the part": (battery(planner={"margin": {"cf": 1.5}}), "planner.margin", "part's radius"),
+    "margin a lone fraction": (battery(planner={"margin": 0.1}), "planner.margin", "{mu: M, cf: C}"),
+    "margin unknown key": (battery(planner={"margin": {"friction": 0.1}}), "planner.margin", "no key"),
     "optimize negative": (battery(planner={"optimize": -1}), "planner.optimize", "0..100"),
     "optimize fractional": (battery(planner={"optimize": 1.5}), "planner.optimize", "integer"),
     "optimize a string": (battery(planner={"optimize": "lots"}), "planner.optimize", "integer"),
@@ -252,6 +258,11 @@ BAD_FLAGS = {
     "--seed beyond 32 bits": (["--seed", str(2**64)], "--seed"),  # OMPL's binding raises TypeError on it
     "--optimize -1": (["--optimize", "-1"], "--optimize"),
     "--optimize 1000": (["--optimize", "1000"], "--optimize"),
+    "--margin negative": (["--margin", "-0.1", "0.02"], "--margin"),
+    "--margin nan": (["--margin", "nan", "0.02"], "--margin"),
+    "--margin beyond the part": (["--margin", "0.1", "1"], "--margin"),
+    "--margin three values": (["--margin", "0.1", "0.02", "0.3"], "--margin"),
+    "--margin one nonzero value": (["--margin", "0.1"], "--margin"),
 }
 
 
@@ -629,10 +640,13 @@ def test_every_planner_setting_has_its_flag_and_the_flag_sets_it():
     from planner.model.options import PlannerOptions
 
     assert set(FLAGS) == {f.name for f in dataclasses.fields(PlannerOptions)}
+    from planner.model.margin import Margin
+
     given = {"name": "kpiece", "time_limit": 3.0, "seed": 7, "regions": "stable", "switch_cost": 0.5, "optimize": 2,
-             "transit": "lift"}
+             "transit": "lift", "margin": Margin(0.2, 0.05)}
+    typed = {"margin": ["0.2", "0.05"]}
     base = PlannerOptions()
     for field, flag in FLAGS.items():
-        changed = options_of(_parser().parse_args(["s.yaml", flag, str(given[field])]), base)
+        changed = options_of(_parser().parse_args(["s.yaml", flag, *typed.get(field, [str(given[field])])]), base)
         assert getattr(changed, field) == given[field] != getattr(base, field)
         assert {f.name for f in dataclasses.fields(base) if getattr(changed, f.name) != getattr(base, f.name)} == {field}

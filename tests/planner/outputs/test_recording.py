@@ -24,6 +24,7 @@ from rerun.chunk import RrdReader
 
 import planner
 from mechanics import exp_twist
+from planner.actions.margins import smallest, with_margins
 from planner.actions.region_cache import RegionCache
 from planner.model.segments import Push, Transfer
 from planner.outputs import analysis, frames, recording
@@ -208,6 +209,8 @@ def test_the_viewer_shows_the_plan_from_above_y_up_beside_a_summary(straight):
     assert summary_rows(path) == ["straight: planner rrt, seed 1: solved with 1 push",
                                   "CF path length 0.1200 m; cost 0.1200 m (length + 0.25 m per switch)",
                                   "push time 0.1200 s (every point of the pusher at most 1 m/s)",
+                                  "stability margin: planned for friction -10 %, CF within 2 % of the part radius "
+                                  "(>= 1 mm)",
                                   f"search tree: {len(plan.tree)} edges"]
     timelines = {}
     for chunk in RrdReader(str(path)).store().stream():
@@ -612,7 +615,7 @@ def test_a_half_turn_of_the_part_gives_the_twin_edges_analysis(tmp_path):
 def swap(tmp_path_factory):
     """The shipped swap (two parts trading places), planned and recorded."""
     scene = planner.load_scene(SCENES / "parts" / "swap.yaml")
-    result = planner.Planner(scene).plan()
+    result = with_margins(scene, planner.Planner(scene).plan())
     assert result.solved and result.transfers == 2
     path = tmp_path_factory.mktemp("swap") / "swap.rrd"
     recording.write_recording(path, scene, result)
@@ -688,7 +691,22 @@ def test_a_multi_part_summary_counts_moves_transfers_and_their_times(swap):
         "swap: planner rrt, seed 1: solved with 2 parts, 3 moves (1 buffer), 4 pushes and 2 transfers",
         f"CF path length {result.length:.4f} m; cost {result.cost:.4f} m (length + 0.25 m per switch and per transfer)",
         f"push time {pushes:.4f} s, transfer time {transfers:.4f} s (every point of the pusher at most 1 m/s)",
+        "stability margin: planned for friction -10 %, CF within 2 % of the part radius (>= 1 mm), the pushes keep "
+        f"at least {smallest(result)} (each on its own)",
         "delivered: 2 of 2 parts"]
+
+
+def test_each_push_s_own_margin_is_logged_when_it_begins(swap):
+    """/log/pushes: a row per push, in plan order, on both timelines at the push's first frame,
+    naming the part, the edge and the push's own certified margin."""
+    scene, result, path = swap
+    pushes = [(name, s) for name, s in result.steps if isinstance(s, Push)]
+    rows = rrd_rows(path, "/log/pushes", "TextLog:text", "time")
+    assert [text for _, (text,) in rows] == [f"push {k}/{len(pushes)} ({name}, edge {s.edge}): margin {m}"
+                                           for k, ((name, s), m) in enumerate(zip(pushes, result.margins), 1)]
+    times = [t for t, _ in rows]
+    assert times == sorted(times) and times[0] == 0
+    assert all(m.mu >= 0.1 - 1 / 64 and m.cf > 0 for m in result.margins)
 
 
 def test_an_unsolved_multi_part_plan_records_the_moves_it_made_and_who_was_not_delivered(swap, tmp_path):
