@@ -142,7 +142,15 @@ def flag_of(field: str) -> str:
 
     >>> flag_of("jobs"), flag_of("cf_offset"), flag_of("slider.cf")
     ('--jobs', '--sim-cf-offset', 'slider.cf')
+
+    A batch's tasks name what the flags change of each scene ``overrides.<option>``:
+
+    >>> flag_of("overrides.margin"), flag_of("overrides.planner")
+    ('--margin', '--planner')
     """
+    if field.startswith("overrides."):
+        key = field.removeprefix("overrides.")
+        return FLAGS.get("name" if key == "planner" else key, field)
     return ARGUMENTS.get(field, field)
 
 

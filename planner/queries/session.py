@@ -373,7 +373,7 @@ def session_options(scene: Scene, options: PlannerOptions | Mapping[str, Any] | 
 
 def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = None,
          planner: str | None = None, regions: str | None = None, transit: str | None = None,
-         switch_cost: float | None = None, optimize: int | None = None,
+         switch_cost: float | None = None, optimize: int | None = None, margin: Any = None,
          progress: Callable[[int, int], None] | None = None) -> Plan:
     """Plan guaranteed-stable pushes from ``scene.start`` to ``scene.goal``: a fresh
     :class:`Planner` session asked once.
@@ -382,7 +382,8 @@ def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = No
     ``pusher.transit``):
     ``regions`` is ``'stable'`` (procedure STABLE) or ``'exact'`` (the default); ``transit``
     ``'plane'``, ``'lift'`` or ``'none'``; ``switch_cost`` in metres; ``optimize`` a number of
-    improvement rounds. With a given seed, a run that solves within the time limit returns the
+    improvement rounds; ``margin`` the stability margin (a :class:`~planner.model.margin.Margin`,
+    ``{"mu": ..., "cf": ...}``, ``[mu, cf]`` or 0 for the exact limit). With a given seed, a run that solves within the time limit returns the
     same plan every time; a scene of several parts is planned as a whole (:meth:`Planner.plan`).
     The time limit bounds the stable regions (which may take half of it; edges not done are left
     out, as ``Plan.note`` says) and the search together.
@@ -393,7 +394,8 @@ def plan(scene: Scene, *, seed: int | None = None, time_limit: float | None = No
         Naming the argument at fault, or if no allowed edge can start pushing.
     """
     options = {k: v for k, v in (("time_limit", time_limit), ("seed", seed), ("regions", regions),
-                                 ("switch_cost", switch_cost), ("optimize", optimize), ("transit", transit))
+                                 ("switch_cost", switch_cost), ("optimize", optimize), ("transit", transit),
+                                 ("margin", margin))
                if v is not None}
     if planner is not None:
         options["name"] = check_planner(planner, "planner")

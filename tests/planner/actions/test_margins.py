@@ -148,3 +148,35 @@ def test_a_larger_margin_shrinks_the_regions_and_a_friction_interval_counts_from
     # 10 % below the middle (0.5) is the interval's low end: the interval is the margin.
     assert certified_for(interval, Margin())[0] == pytest.approx(0.45)
     assert certified_for(interval, Margin(0.2, 0.0))[0] == pytest.approx(0.4)
+
+
+def test_the_margin_survives_the_scene_and_plan_files(tmp_path):
+    """--export-scene writes the margin the run used and reading it back gives the same; a plan
+    file keeps the margin it was planned with (an older file without one has none)."""
+    from planner.model.plan_file import load_plan, read_plan
+    from planner.model.scene_file import load_scene as load, write_scene
+
+    scene = load_scene(ROOT / "scenes" / "parts" / "swap.yaml")
+    options = scene.options.merged({"margin": [0.25, 0.04]})
+    write_scene(scene, tmp_path / "s.yaml", options)
+    assert load(tmp_path / "s.yaml").options.margin == Margin(0.25, 0.04)
+    plan = with_margins(scene, Planner(scene, options).plan())
+    (tmp_path / "p.json").write_text(plan.to_json())
+    again = load_plan(tmp_path / "p.json")
+    assert again.margin == Margin(0.25, 0.04) and again.margins == ()  # certified again where shown
+    older = plan.to_dict()
+    del older["margin"]
+    assert read_plan(older).margin is None
+    older["margin"] = {"mu": 2}
+    with pytest.raises(SceneError) as err:
+        read_plan(older)
+    assert err.value.field == "plan.margin"
+
+
+def test_a_bad_margin_for_a_batch_names_the_flag(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    battery = str(ROOT / "scenes" / "battery.yaml")
+    assert main([battery, battery, "--margin", "0.1", "-0.02", "--jobs", "1", "--out", "b"]) == 1
+    captured = capsys.readouterr()
+    assert captured.err.startswith("plan: error: --margin: cf must be a fraction in [0, 1)")
+    assert captured.err.count("\n") == 1 and not (tmp_path / "b").exists()
