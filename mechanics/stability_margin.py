@@ -123,6 +123,7 @@ def push_margins(
     cf_radius: float = 0.0,
     rungs: int = RUNGS,
     refinements: int = 3,
+    mu_rung: float | None = None,
 ) -> PushMargins:
     """The certified friction and CF margins of pushing ``edge`` with each of ``twists``.
 
@@ -140,6 +141,9 @@ def push_margins(
         Steps of the ladders (module docstring).
     refinements : int
         Finer support levels the certificate may try (:func:`~.exact_region.exact_region`'s).
+    mu_rung : float, optional
+        One more rung of the friction ladder, in ``(0, mu]``: a friction a push was planned to
+        hold at is then reported exactly where it is certified, not at the rung above it.
     """
     if not mu > 0:
         raise ValueError(f"mu must be > 0, got {mu}")
@@ -147,6 +151,8 @@ def push_margins(
         raise ValueError(f"cf_radius must be >= 0, got {cf_radius}")
     if rungs < 1:
         raise ValueError(f"rungs must be at least 1, got {rungs}")
+    if mu_rung is not None and not 0 < mu_rung <= mu:
+        raise ValueError(f"mu_rung must be in (0, mu], got {mu_rung}")
     v = np.asarray(twists, dtype=float).reshape(-1, 3)
     stable = procedure_stable(slider, edge, mu, width)
     points = stable.plane.points(v)
@@ -169,8 +175,8 @@ def push_margins(
     if inside.any():
         ok[inside] = certified(np.flatnonzero(inside), mu, nominal)
     # That batch settles each ladder's rung of the nominal values.
-    frictions = mu * np.arange(rungs, 0, -1) / rungs
-    lowest = _last_certified(np.where(ok, 0, -1), np.where(ok, rungs, 0),
+    frictions = np.unique(np.r_[mu * np.arange(1, rungs + 1) / rungs, [] if mu_rung is None else [mu_rung]])[::-1]
+    lowest = _last_certified(np.where(ok, 0, -1), np.where(ok, len(frictions), 0),
                              lambda rung, which: certified(which, float(frictions[rung]), nominal))
 
     step = slider.radius / rungs

@@ -57,11 +57,12 @@ def with_margins(scene: Scene, plan: Plan) -> Plan:
         groups.setdefault((part, s.edge), []).append((k, s))
     for (name, edge), items in groups.items():
         one = scene.move_scene(name, plan.starts)
-        # The friction margin is found with the CF disk the plan was made for, which is also a rung
-        # of the CF search: a push certified for it says so exactly, not to the ladder's step below.
-        _, rho = certified_for(one, plan.margin or EXACT)
+        # The friction margin is found with the CF disk the plan was made for; that disk and that
+        # friction are rungs of the searches, so a push certified for them says so exactly, not to
+        # the ladders' step below.
+        mu, rho = certified_for(one, plan.margin or EXACT)
         twists = np.array([s.twist for _, s in items])
-        got = push_margins(one.slider, edge, twists, p.mu, p.width, cf_radius=rho)
+        got = push_margins(one.slider, edge, twists, p.mu, p.width, cf_radius=rho, mu_rung=mu)
         for (k, _), low, radius in zip(items, got.mu_low, got.cf_radius):
             found[k] = PushMargin(max(0.0, 1.0 - float(low) / nominal) if np.isfinite(low) else 0.0,
                                   float(radius) if np.isfinite(radius) else 0.0)

@@ -167,3 +167,17 @@ def test_rejects_bad_arguments():
                             (dict(mu=0.5, rungs=0), "rungs")]:
         with pytest.raises(ValueError, match=message):
             push_margins(part, 0, [[0, 1, 0]], **kwargs)
+
+
+def test_a_friction_rung_of_its_own_is_reported_exactly_where_it_is_certified():
+    """A push tilted by tan = 0.2 on the square's face needs mu >= 0.2 (its load, a force along
+    the motion, leaves the cone below): an extra rung at 0.201 is certified and reported, one at
+    0.199 is not, and the ladder's own rung above (26/128) is."""
+    from mechanics import Slider, push_margins
+
+    square = Slider([[-1, 0], [1, 0], [1, 2], [-1, 2]])
+    tilted = [[-0.2, 1, 0]]
+    assert push_margins(square, 0, tilted, 0.5, width=0.5, mu_rung=0.201).mu_low.tolist() == [0.201]
+    assert push_margins(square, 0, tilted, 0.5, width=0.5, mu_rung=0.199).mu_low.tolist() == [26 / 128]
+    with pytest.raises(ValueError):
+        push_margins(square, 0, tilted, 0.5, mu_rung=0.6)

@@ -706,7 +706,7 @@ def test_each_push_s_own_margin_is_logged_when_it_begins(swap):
                                            for k, ((name, s), m) in enumerate(zip(pushes, result.margins), 1)]
     times = [t for t, _ in rows]
     assert times == sorted(times) and times[0] == 0
-    assert all(m.mu >= 0.1 - 1 / 64 and m.cf > 0 for m in result.margins)
+    assert all(m.mu >= 0.1 - 1e-9 and m.cf >= 0.001 for m in result.margins)
 
 
 def test_an_unsolved_multi_part_plan_records_the_moves_it_made_and_who_was_not_delivered(swap, tmp_path):
