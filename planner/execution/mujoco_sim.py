@@ -60,6 +60,7 @@ in (:func:`.approach.lead_in_pose`), and may be perturbed (:func:`perturbations`
 
 from __future__ import annotations
 
+import importlib
 import math
 import time
 from collections.abc import Callable, Collection, Mapping
@@ -360,7 +361,7 @@ def write_mjcf(path: str | Path, scene: Scene, supports: Mapping[str, Feet], mu:
 def needs_mujoco() -> None:
     """Import MuJoCo, or raise :class:`SceneError` naming ``--simulate`` with :data:`MISSING`."""
     try:
-        import mujoco  # noqa: F401 (only checked here)
+        importlib.import_module("mujoco")
     except ImportError:
         raise SceneError("simulate", MISSING) from None
 
