@@ -29,6 +29,7 @@ from collections.abc import Callable
 from functools import cache
 from pathlib import Path
 
+from ..actions.margins import smallest, with_margins
 from ..model.extras import have, needs
 from ..model.plan import Plan
 from ..model.segments import Transit
@@ -81,8 +82,9 @@ def quick_subset() -> str:
 
 def summary_line() -> str:
     """The ``summary-line`` block: what ``plan scenes/junction.yaml`` prints, less its times."""
-    _, result = seed_one("junction")
-    return f"```text\nsolved: {result.headline()}, planning time ...\n```\n"
+    scene, result = seed_one("junction")
+    least = smallest(with_margins(scene, result))
+    return f"```text\nsolved: {result.headline()}, smallest margin {least}, planning time ...\n```\n"
 
 
 def caption(name: str) -> str:
