@@ -64,7 +64,8 @@ def with_margins(scene: Scene, plan: Plan) -> Plan:
         twists = np.array([s.twist for _, s in items])
         got = push_margins(one.slider, edge, twists, p.mu, p.width, cf_radius=rho, mu_rung=mu)
         for (k, _), low, radius in zip(items, got.mu_low, got.cf_radius):
-            found[k] = PushMargin(max(0.0, 1.0 - float(low) / nominal) if np.isfinite(low) else 0.0,
+            # Rounded: a friction certified at exactly 90 % of the scene's is a 10 % margin, not 9.99...
+            found[k] = PushMargin(max(0.0, round(1.0 - float(low) / nominal, 12)) if np.isfinite(low) else 0.0,
                                   float(radius) if np.isfinite(radius) else 0.0)
     return replace(plan, margins=tuple(found[k] for k in sorted(found)))
 

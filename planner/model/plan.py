@@ -128,8 +128,8 @@ class Plan:
                             planner=self.planner, seed=self.seed, planning_time_s=0.0)
 
     def with_segments(self, segments: list[Segment]) -> "Plan":
-        """This plan of one part, by ``segments`` instead of its own."""
-        return replace(self, moves=[Move(self.part, list(segments))] if segments else [])
+        """This plan of one part, by ``segments`` instead of its own (whose pushes' margins it drops)."""
+        return replace(self, moves=[Move(self.part, list(segments))] if segments else [], margins=())
 
     @property
     def names(self) -> tuple[str, ...]:

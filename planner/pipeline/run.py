@@ -77,7 +77,7 @@ def run(scene: Scene, options: RunOptions = RunOptions(),
             if unreachable:
                 result = Plan.of_part(scene.part().name, scene.start, scene.goal, [], scene=scene.path, solved=False,
                                       planner=planner_options.name, seed=planner_options.seed,
-                                      planning_time_s=0.0, reason=unreachable)
+                                      planning_time_s=0.0, reason=unreachable, margin=planner_options.margin)
             else:
                 session = Planner(scene, planner_options, progress=progress)
                 result = session.plan(since=session.clock)  # the time limit bounds the regions too

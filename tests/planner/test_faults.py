@@ -166,7 +166,9 @@ def _regular(n: int, radius: float) -> list[list[float]]:
 
 def test_a_part_of_a_thousand_edges_ends_within_its_time_limit(tmp_path):
     """Cache keys, symmetry, collision bodies and regions for 1000 edges all count against the
-    limit: a 2 s run ends in under 5 s (it used to run past a minute), with the usual answer."""
+    limit: a 2 s run ends in under 5 s (it used to run past a minute), with the usual answer: a
+    plan, none in time, or (each edge 0.3 mm long, far shorter than the default margin's 1 mm CF
+    disk, which such a contact cannot hold) the margin named."""
     spec = {"slider": {"vertices": _regular(1000, 0.05)}, "pusher": {"width": 0.02, "depth": 0.01, "mu": 0.5},
             "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]}, "start": [-0.3, 0.0, 0.0], "goal": [0.3, 0.1, 0.0]}
     (tmp_path / "gon.yaml").write_text(yaml.safe_dump(spec))
@@ -174,7 +176,7 @@ def test_a_part_of_a_thousand_edges_ends_within_its_time_limit(tmp_path):
     run = start(tmp_path, "gon.yaml", "--time-limit", "2", "--out", "out", cache=tmp_path / "cache")
     stdout, stderr = run.communicate(timeout=60)
     assert time.perf_counter() - began < 5.0
-    assert run.returncode in (0, 2), stderr
+    assert run.returncode in (0, 2) or stderr.startswith("plan: error: planner.margin: "), stderr
     assert len((stdout + stderr).strip().splitlines()) == 1
 
 

@@ -148,7 +148,7 @@ def test_a_finer_via_grid_finds_a_way_the_plan_did_not_take():
     leaves the plan as it is."""
     path = ROOT / "scenes" / "cluttered.yaml"
     scene = load_scene(path)
-    first = plan_of(scene)
+    first = plan_of(scene, margin=0)  # in the exact regions, as the controls below
     controls = edge_controls(scene)
     model = CollisionModel(scene, [c.edge for c in controls])
     margin = clearance_margin(scene)

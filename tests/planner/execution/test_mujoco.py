@@ -342,3 +342,39 @@ def test_a_start_error_moves_the_part_moved_first_and_a_bump_the_part_the_pusher
     (run,) = simulate(scene, short, n=1, bumps=[(0.0, 0.0, 0.003, 0.0)]).runs
     assert run.tracks[first][0][1] == pytest.approx(result.starts[first][1] + 0.003, abs=5e-4)
     assert np.abs(run.tracks[then][-1] - result.starts[then]).max() < 1e-4
+
+
+# A scene nobody tuned (drawn at random: a triangle, its CF off the centroid, mu 0.51), where the
+# plan at the exact limit keeps only 6 % of the friction on one push.
+UNTUNED = """\
+name: untuned
+slider:
+  vertices: [[-0.0209, -0.0175], [0.003, 0.0261], [0.0182, 0.0098]]
+  cf: [-0.0016, 0.0075]
+pusher: {width: 0.057, depth: 0.01, mu: 0.51}
+obstacles: [{box: {center: [0.2, -0.25], size: [0.06, 0.25], angle: 0}}]
+workspace: {min: [-0.2, -0.45], max: [0.7, 0.45]}
+start: [0, 0, 0]
+goal: [0.32613, -0.07392, -18.8517]
+"""
+
+
+def test_a_plan_at_the_exact_limit_slips_with_less_friction_and_one_with_the_margin_does_not(tmp_path):
+    """What the margin buys, in MuJoCo: with the pusher friction 10 % below the scene's, the plan
+    made at the exact limit (whose certified friction margin says it keeps less than 10 %) slips
+    on every run, and the plan made with the default margin sticks on every run."""
+    from planner import Planner
+    from planner.actions.margins import smallest, with_margins
+    from planner.execution.mujoco_sim import SLIP, simulate
+    from planner.model.scene_file import parse_scene
+    import yaml
+
+    scene = parse_scene(yaml.safe_load(UNTUNED))
+    low = 0.9 * scene.pusher.mu
+    exact = with_margins(scene, Planner(scene, {"seed": 1, "margin": 0}).plan())
+    kept = with_margins(scene, Planner(scene, {"seed": 1}).plan())
+    assert smallest(exact).mu < 0.1 <= smallest(kept).mu
+    slipped = simulate(scene, exact, n=2, mu=low).runs
+    held = simulate(scene, kept, n=2, mu=low).runs
+    assert all(r.slip > SLIP and not r.passed for r in slipped), [r.slip for r in slipped]
+    assert all(r.passed and r.slip < SLIP for r in held), [r.slip for r in held]
