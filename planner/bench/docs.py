@@ -11,7 +11,7 @@ everything else is prose, kept as written. The blocks:
   its PNG text holds the plan's headline) and its caption, from the seed-1 plan (the tray is
   ``scenes/parts/tray.yaml``, six parts);
 - ``mujoco-table``: every shipped scene's seed-1 plan run in MuJoCo on 8 support distributions
-  (:mod:`planner.bench.simulate`; about two minutes, needs the mujoco extra; ``--no-mujoco`` keeps
+  (:mod:`planner.bench.simulate`; about 30 s here, needs the mujoco extra; ``--no-mujoco`` keeps
   the committed table).
 
 Every block comes from seed-1 plans, which a seed decides, and seeded simulations: regenerating

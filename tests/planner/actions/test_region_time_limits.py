@@ -125,12 +125,13 @@ def test_no_stable_push_anywhere_is_refused_before_any_region(tmp_path):
 
 def test_the_plan_command_honours_its_time_limit_on_a_200_gon(empty_cache, tmp_path):
     """Regions and search share the limit: ``plan --time-limit 5`` ends well within 10 s, with
-    one line saying what was not done in time."""
+    one line saying what was not done in time. At the exact limit: the ellipse's facets are far
+    shorter than the default margin's CF disk, which none of them can hold (the margin is named)."""
     scene = tmp_path / "ellipse.yaml"
     scene.write_text(yaml.safe_dump(many_edged()))
     started = time.perf_counter()
-    run = subprocess.run([str(Path(sys.executable).parent / "plan"), str(scene), "--time-limit", "5", "--out",
-                          str(tmp_path / "out")], capture_output=True, text=True, timeout=60, cwd=tmp_path,
+    run = subprocess.run([str(Path(sys.executable).parent / "plan"), str(scene), "--time-limit", "5", "--margin", "0",
+                          "--out", str(tmp_path / "out")], capture_output=True, text=True, timeout=60, cwd=tmp_path,
                          env={**os.environ, "STABLEPUSH_CACHE": str(empty_cache.folder)})
     assert time.perf_counter() - started < 10.0
     assert run.returncode in (0, 2), run.stderr
