@@ -391,3 +391,18 @@ def guaranteed_stable(vertices, cf, edge: int, mu: float, width, twist) -> bool:
     along = verts @ ref.t
     c_t = np.array([-v[1], v[0]]) / v[2] @ ref.t
     return bool(c_t <= along.min()) if v[2] > 0 else bool(c_t >= along.max())
+
+
+# ----------------------------------------------------------------------------------------------
+# Test parts shared by the mechanics tests: fixtures A, B, D (docs/mechanics.md, "Fixtures"), an
+# L-shaped part and a random convex one.
+
+RECT = [[-1, 0], [1, 0], [1, 1], [-1, 1]]
+D_VERTS = [(-2, 0), (-0.5, 0), (1, 0), (2, 0), (2, 1), (-2, 1)]
+PARTS = {
+    "A": dict(vertices=np.array(RECT, float), cf=np.array([0.0, 0.5]), edge=0, mu=0.5, width=None),
+    "B": dict(vertices=np.array(RECT, float), cf=np.array([0.4, 0.3]), edge=0, mu=0.5, width=None),
+    "D": dict(vertices=np.array(D_VERTS, float), cf=np.array([0.6, 0.5]), edge=1, mu=0.8, width=None),
+    "L": {**random_geometry(np.random.default_rng(11), "L"), "mu": 0.7, "width": None},
+    "convex": {**random_geometry(np.random.default_rng(5), "convex"), "width": None},
+}

@@ -17,16 +17,7 @@ import shapely
 import oracle as O
 from mechanics import Slider, exact_region, procedure_stable, push_margins
 
-RECT = [[-1, 0], [1, 0], [1, 1], [-1, 1]]
-D_VERTS = [(-2, 0), (-0.5, 0), (1, 0), (2, 0), (2, 1), (-2, 1)]
-# Fixtures A, B, D (docs/mechanics.md, "Fixtures"), an L-shaped part and a random convex one.
-PARTS = {
-    "A": dict(vertices=np.array(RECT, float), cf=np.array([0.0, 0.5]), edge=0, mu=0.5, width=None),
-    "B": dict(vertices=np.array(RECT, float), cf=np.array([0.4, 0.3]), edge=0, mu=0.5, width=None),
-    "D": dict(vertices=np.array(D_VERTS, float), cf=np.array([0.6, 0.5]), edge=1, mu=0.8, width=None),
-    "L": {**O.random_geometry(np.random.default_rng(11), "L"), "mu": 0.7, "width": None},
-    "convex": {**O.random_geometry(np.random.default_rng(5), "convex"), "width": None},
-}
+PARTS = O.PARTS  # fixtures A, B, D, an L and a random convex part (tests/oracle.py)
 
 
 def slider(g: dict) -> Slider:
