@@ -33,8 +33,6 @@ Static (no timeline, always visible)
   times, the stability margin the plan was made for and the least its pushes keep
   (:mod:`planner.actions.margins`), and last, for several parts which were delivered, for one
   part the search tree's size.
-* ``/log/pushes`` -- ``TextLog``, a row per push at its first frame on both timelines: its own
-  certified margin (how much lower the friction, and how far the CF, may be before it may slip).
   They are on both timelines at 0, not static: a text log view lists only rows of its timeline.
 
 Animated, one row per frame on the timelines ``time`` (plan time in seconds, pushes, transits and
@@ -45,7 +43,9 @@ travel, at most ``MAX_FRAMES`` in all:
 * ``<part>/slider`` -- the part's outline; it stands still but while it is pushed;
 * ``/world/pusher`` -- the pusher's outline on the table: on the pushed edge during a push, and
   along the path (:func:`planner.actions.transit.transit_poses`) during a transit or transfer; no
-  strip while it is lifted;
+  strip while it is lifted; during a push, labelled with the push's own certified margin
+  (``push 2/5: margin friction -81 %, CF 1.2 mm``: how much lower the friction, and how far the
+  CF, may be before it may slip) where the plan has its margins;
 * ``/world/pusher_lifted`` -- the pusher's outline while it is in the air (the inside of a lift's
   middle piece), thin, faint and labelled ``lifted``; no strip on every other frame;
 * ``<part>/cf_path`` -- the path of the part's centre of friction so far (thinned to about
@@ -240,9 +240,8 @@ def _summary(scene: Scene, plan: Plan) -> list[str]:
             f"{', '.join(times)} (every point of the pusher at most 1 m/s)"]
     if plan.margin is not None or plan.margins:
         least = smallest(plan)
-        rows.append("stability margin: " + ", ".join(
-            ([f"planned for {plan.margin}"] if plan.margin is not None else [])
-            + ([f"the pushes keep at least {least} (each on its own)"] if least is not None else [])))
+        rows.append("; ".join(([f"stability margin {plan.margin}"] if plan.margin is not None else [])
+                              + ([f"least kept: {least}"] if least is not None else [])))
     return [*rows, last]
 
 
@@ -422,29 +421,24 @@ def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan, look: dict[st
             colors=mine.part, radii=_BOLD, labels=None if mine.name is None else [mine.name]), static=True)
         rec.log(f"{root}/cf_path", rr.LineStrips3D.from_fields(colors=mine.path, radii=_LINE), static=True)
     pusher = _z(place(_closed(pusher_frame_body(scene.pusher.width, scene.pusher.depth)), shown.pusher), "part")
-    for entity, where in (("world/pusher", ~shown.lifted), ("world/pusher_lifted", shown.lifted)):
-        send(entity, rr.LineStrips3D.columns(strips=pusher[where]), where.astype(int))
+    send("world/pusher", rr.LineStrips3D.columns(strips=pusher[~shown.lifted],
+                                                 labels=_margin_labels(plan, shown)[~shown.lifted]),
+         (~shown.lifted).astype(int))
+    send("world/pusher_lifted", rr.LineStrips3D.columns(strips=pusher[shown.lifted]), shown.lifted.astype(int))
     send("world/cor", rr.Points3D.columns(positions=_z(np.concatenate(cor), "marker")), [len(c) for c in cor])
     rec.log("world/pusher", rr.LineStrips3D.from_fields(colors=_DARK, radii=_BOLD), static=True)
     rec.log("world/pusher_lifted", rr.LineStrips3D.from_fields(colors=_LIFTED, radii=_THIN, labels=["lifted"]),
             static=True)
     rec.log("world/cor", rr.Points3D.from_fields(colors=_COR, radii=_DOT, labels=["COR"]), static=True)
-    _log_margins(rec, plan, shown)
     return shown
 
 
-def _log_margins(rec: rr.RecordingStream, plan: Plan, shown: Frames) -> None:
-    """``/log/pushes``: a row per push at its first frame, with its own certified margin."""
-    pushes = [(k, name, s) for k, (name, s) in enumerate(plan.steps) if isinstance(s, Push)]
-    if not plan.margins or not pushes:
-        return
-    first = np.array([np.argmax(shown.index == k) for k, _, _ in pushes])
-    several = len(plan.names) > 1
-    lines = [f"push {j}/{len(pushes)} ({f'{name}, ' if several else ''}edge {s.edge}): margin {m}"
-             for j, ((_, name, s), m) in enumerate(zip(pushes, plan.margins), 1)]
-    rec.send_columns("log/pushes", indexes=[rr.TimeColumn("step", sequence=first),
-                                            rr.TimeColumn("time", duration=shown.times[first])],
-                     columns=rr.TextLog.columns(text=lines, level=["INFO"] * len(lines)))
+def _margin_labels(plan: Plan, shown: Frames) -> np.ndarray:
+    """The pusher's label at each frame: during a push, the push and its own certified margin
+    (``push 2/5: margin friction -81 %, CF 1.2 mm``); else none (an empty label)."""
+    pushes = [k for k, (_, s) in enumerate(plan.steps) if isinstance(s, Push)]
+    text = {k: f"push {j}/{len(pushes)}: margin {m}" for j, (k, m) in enumerate(zip(pushes, plan.margins), 1)}
+    return np.array([text.get(int(k), "") for k in shown.index], dtype=object)
 
 
 def _log_reach(rec: rr.RecordingStream, reach: ReachableSet) -> None:

@@ -209,8 +209,7 @@ def test_the_viewer_shows_the_plan_from_above_y_up_beside_a_summary(straight):
     assert summary_rows(path) == ["straight: planner rrt, seed 1: solved with 1 push",
                                   "CF path length 0.1200 m; cost 0.1200 m (length + 0.25 m per switch)",
                                   "push time 0.1200 s (every point of the pusher at most 1 m/s)",
-                                  "stability margin: planned for friction -10 %, CF within 2 % of the part radius "
-                                  "(>= 1 mm)",
+                                  "stability margin friction -10 %, CF within 2 % of the part radius (>= 1 mm)",
                                   f"search tree: {len(plan.tree)} edges"]
     timelines = {}
     for chunk in RrdReader(str(path)).store().stream():
@@ -691,21 +690,19 @@ def test_a_multi_part_summary_counts_moves_transfers_and_their_times(swap):
         "swap: planner rrt, seed 1: solved with 2 parts, 3 moves (1 buffer), 4 pushes and 2 transfers",
         f"CF path length {result.length:.4f} m; cost {result.cost:.4f} m (length + 0.25 m per switch and per transfer)",
         f"push time {pushes:.4f} s, transfer time {transfers:.4f} s (every point of the pusher at most 1 m/s)",
-        "stability margin: planned for friction -10 %, CF within 2 % of the part radius (>= 1 mm), the pushes keep "
-        f"at least {smallest(result)} (each on its own)",
+        f"stability margin friction -10 %, CF within 2 % of the part radius (>= 1 mm); least kept: {smallest(result)}",
         "delivered: 2 of 2 parts"]
 
 
-def test_each_push_s_own_margin_is_logged_when_it_begins(swap):
-    """/log/pushes: a row per push, in plan order, on both timelines at the push's first frame,
-    naming the part, the edge and the push's own certified margin."""
+def test_each_push_s_own_margin_labels_the_pusher_while_it_pushes(swap):
+    """/world/pusher: while a push runs, its label is that push's number and its own certified
+    margin; during a transfer, none."""
     scene, result, path = swap
-    pushes = [(name, s) for name, s in result.steps if isinstance(s, Push)]
-    rows = rrd_rows(path, "/log/pushes", "TextLog:text", "time")
-    assert [text for _, (text,) in rows] == [f"push {k}/{len(pushes)} ({name}, edge {s.edge}): margin {m}"
-                                           for k, ((name, s), m) in enumerate(zip(pushes, result.margins), 1)]
-    times = [t for t, _ in rows]
-    assert times == sorted(times) and times[0] == 0
+    pushes = [k for k, (_, s) in enumerate(result.steps) if isinstance(s, Push)]
+    said = {f"push {j}/{len(pushes)}: margin {m}" for j, m in enumerate(result.margins, 1)}
+    labels = [row[0] if row else None for _, row in rrd_rows(path, "/world/pusher", "LineStrips3D:labels", "time")]
+    shown = {label for label in labels if label}
+    assert shown == said and "" in labels  # every push labelled, transfers not
     assert all(m.mu >= 0.1 - 1e-9 and m.cf >= 0.001 for m in result.margins)
 
 
