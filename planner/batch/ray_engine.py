@@ -133,5 +133,11 @@ class RayExecutor:
                                                  attempts=feed.answered(index))
                 submit()
         finally:
-            for ref in running:
-                ray.cancel(ref, force=True)
+            # Cancelling a task that completes at that moment trips a check inside Ray 2.60
+            # ("Tried to complete task that was not pending") that aborts this process, as a
+            # SIGTERM mid-batch did once in CI. A cluster this executor started is shut down next,
+            # which stops its tasks anyway; on another cluster only the tasks not done are cancelled.
+            if running and not self._started:
+                done, _ = ray.wait(list(running), num_returns=len(running), timeout=0)
+                for ref in set(running) - set(done):
+                    ray.cancel(ref, force=True)
