@@ -124,9 +124,14 @@ class ClosedRun(ByPart):
         kinds = ", ".join(sorted({f.kind for f in self.supports.values()}))
         worst = f" ({_worst(self.goal_errors)})" if several else ""
         return (f"closed loop {k}/{n} ({kinds}, {'+'.join(str(len(f.points)) for f in self.supports.values())} feet): "
-                f"goal error {self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad{worst}; {len(self.replans)} "
-                f"re-plans{latency}; {_carried(self.carried)}"
+                f"goal error {self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad{worst}; "
+                f"{_replans(len(self.replans))}{latency}; {_carried(self.carried)}"
                 f"{self.seconds:.1f} s for {self.simulated:.1f} s: {', '.join(faults) if faults else 'ok'}")
+
+
+def _replans(n: int) -> str:
+    """``'1 re-plan'``, ``'3 re-plans'``."""
+    return f"{n} re-plan{'' if n == 1 else 's'}"
 
 
 def _carried(carried: tuple[tuple[float, str], ...]) -> str:
@@ -158,12 +163,13 @@ class ClosedLoop(Runs):
         latencies = [x for r in self.runs for x in r.latencies]
         timing = (f", re-plan latency median {np.median(latencies) * 1e3:.0f} ms, max {max(latencies) * 1e3:.0f} ms"
                   if latencies else "")
-        placed = "; ".join(f"{'the part' if len(self.starts) == 1 else name} started at ({pose[0]:.17g}, "
-                           f"{pose[1]:.17g}, {math.degrees(pose[2]):.17g} deg)" for name, pose in self.starts.items())
+        # Rounded to what a perturbation is given to (0.1 mm, 0.01 degree): not float noise.
+        placed = "; ".join(f"{'the part' if len(self.starts) == 1 else name} started at ({pose[0]:.4f}, "
+                           f"{pose[1]:.4f}, {math.degrees(pose[2]):.2f} deg)" for name, pose in self.starts.items())
         goal = "in the goal" if len(self.starts) == 1 else "with every part in its goal"
         return (f"closed loop: {'passed' if self.passed else 'FAILED'}: {sum(r.passed for r in self.runs)}/"
                 f"{len(self.runs)} runs {goal} without collision (MuJoCo, pusher mu {self.mu:g}, table mu "
-                f"{TABLE_MU:g}); {sum(len(r.replans) for r in self.runs)} re-plans{timing}; worst goal error "
+                f"{TABLE_MU:g}); {_replans(sum(len(r.replans) for r in self.runs))}{timing}; worst goal error "
                 f"{max(r.goal_error[0] for r in self.runs):.2e} m; {placed}; {sum(r.seconds for r in self.runs):.1f} s")
 
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:
@@ -359,6 +365,8 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
         collisions += bool(now)
         for fault in now:
             faults.setdefault(fault, u)
+        if world.diverged:  # nothing real is left to observe: the run fails, saying why
+            break
         if k % every == 0:
             seen = {n: world.pose(n) + rng.normal(0.0, [noise[0], noise[0], noise[1]]) for n in scene.names}
             if loop.observe(u, seen) or u > limit:
@@ -370,7 +378,7 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
                           part=np.array(moving) if len(scene.parts) > 1 else None)
     tracks = {n: table[:, 10 + 3 * j:13 + 3 * j] for j, n in enumerate(scene.names)}
     ends = {n: world.pose(n) for n in scene.names}
-    reason = loop.reason or ("" if loop.done else f"not done after {limit:.0f} s")
+    reason = world.diverged or loop.reason or ("" if loop.done else f"not done after {limit:.0f} s")
     return ClosedRun(dict(supports), {n: pose_error(end, scene.part(n).goal) for n, end in ends.items()},
                      {n: scene.delivered(n, end) for n, end in ends.items()}, tuple(loop.replans), reason, collisions,
                      time.perf_counter() - clock, float(table[-1, 0]), executed, tracks, tuple(loop.carried),

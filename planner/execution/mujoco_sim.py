@@ -145,6 +145,10 @@ SETTLE = 0.1
 GRID_FEET = 9
 #: Step by which a knocked part is moved off the pusher, m.
 BUMP_STEP = 0.0002
+#: How a run that blew up is reported (World.diverged): its one fault, which fails it.
+DIVERGED = "the simulation diverged"
+#: The texts of the MuJoCo warnings seen since the last divergence was reported (World).
+_WARNINGS: list[str] = []
 
 T = TypeVar("T")
 
@@ -511,7 +515,8 @@ class Run(ByPart):
         missed = ", ".join(name for name, ok in self.delivered.items() if not ok)
         touches = "; ".join(f"{what} at {t:.1f} s" for t, what in self.faults[:3]) + (
             f"; {len(self.faults) - 3} more" if len(self.faults) > 3 else "")
-        faults = ([] if self.in_goal else [f"misses the goal{': ' + missed if several else ''}"]) + (
+        blown = [what for _, what in self.faults if what.startswith(DIVERGED)]
+        faults = blown[:1] or ([] if self.in_goal else [f"misses the goal{': ' + missed if several else ''}"]) + (
             ["SLIPS"] if self.slip > SLIP else []) + (
             [f"collides ({self.collisions} samples{': ' + touches if several else ''})"] if self.collisions else [])
         kinds = ", ".join(sorted({f.kind for f in self.supports.values()}))
@@ -589,12 +594,24 @@ class World:
     """One run's MuJoCo model and data: the parts placed at ``starts`` (by name) on their
     ``supports``, the pusher driven by a function of the run's clock ``u`` (seconds since the
     pusher began to move, after :data:`SETTLE`), and the bumps ``(T, part, dx, dy, dtheta)``
-    applied to that part when ``u`` passes ``T``."""
+    applied to that part when ``u`` passes ``T``.
+
+    A state MuJoCo finds non-finite or huge (it then resets the data and warns) ends the run's
+    physics: :attr:`diverged` says why and when, :meth:`faults` reports it from then on and
+    :meth:`step_to` steps no more, so a run that blows up fails at once instead of passing on the
+    reset state or stepping on for ever."""
 
     def __init__(self, scene: Scene, supports: Mapping[str, Feet], mu: float | None,
                  starts: Mapping[str, ArrayLike], bumps: tuple = ()):
         import mujoco  # only when simulating: a plan run without --simulate never loads it
 
+        # MuJoCo prints its warnings on the terminal, thousands a second from a run that keeps
+        # blowing up; the run reports divergence itself (diverged), so they are kept, not printed.
+        mujoco.set_mju_user_warning(_WARNINGS.append)
+        self.diverged: str | None = None
+        # The warnings of a state MuJoCo had to reset.
+        self.unstable = [int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
+                                          mujoco.mjtWarning.mjWARN_BADQACC)]
         self.mujoco = mujoco
         self.scene = scene
         self.model = mujoco.MjModel.from_xml_string(mjcf(scene, supports, mu, starts))
@@ -623,7 +640,7 @@ class World:
         model")."""
         data = self.data
         ahead = None
-        while data.time < t - TIMESTEP / 2:
+        while data.time < t - TIMESTEP / 2 and self.diverged is None:
             u = data.time - SETTLE
             pose, rate = ahead if ahead is not None else self._drive(pusher, u)
             ahead = self._drive(pusher, u + TIMESTEP)
@@ -639,6 +656,10 @@ class World:
                 data.qpos[self.slots[name]] = self._off_pusher(name, data.qpos[self.slots[name]] + shift, pose)
                 data.qvel[self.speeds[name]] = 0.0
             self.mujoco.mj_step(self.model, data)
+            if any(data.warning[w].number for w in self.unstable) or not np.isfinite(data.qpos).all():
+                said = _WARNINGS[-1].split(". ")[0] if _WARNINGS else "a non-finite state"
+                self.diverged = f"{DIVERGED} at {max(u, 0.0):.2f} s (MuJoCo: {said})"
+                del _WARNINGS[:]
 
     @staticmethod
     def _drive(pusher: Driver, u: float) -> tuple[ArrayLike, np.ndarray]:
@@ -665,7 +686,7 @@ class World:
     def faults(self, allowed: Collection[str]) -> list[str]:
         """The contacts on now that must not happen, in words: a part against another part, a wall
         or an obstacle, or the pusher against a part not named in ``allowed``."""
-        out = []
+        out = [self.diverged] if self.diverged else []
         contacts = self.data.contact
         # The feet always press into the table: only a touching pair with a part's geom is looked at.
         pairs = contacts.geom[contacts.dist < 0]

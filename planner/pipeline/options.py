@@ -22,8 +22,12 @@ from pathlib import Path
 from ..model.extras import have, needs
 from ..model.fields import SceneError, shown
 from ..model.scene import Scene
+from ..model.scene_file import MU_RANGE
 
-__all__ = ["RunOptions"]
+__all__ = ["MAX_NOISE", "RunOptions"]
+
+#: The most observation noise a closed loop takes: standard deviations, m and rad (45 degrees).
+MAX_NOISE = (0.1, math.pi / 4)
 
 #: The options that only apply to a simulation.
 _SIMULATION = ("sim_mu", "sim_cf_offset", "start_error", "bumps", "pose_noise", "closed_loop", "mjcf")
@@ -85,11 +89,23 @@ class RunOptions:
                 raise SceneError("bump", f"must be finite, got {' '.join(map(str, bump))}")
             if bump[0] < 0:
                 raise SceneError("bump", "a bump's time must be >= 0")
+        # Physical ranges: beyond them MuJoCo's state blows up (a friction of 1e300, a knock of
+        # 1e20 radians) or the perturbation means nothing (a knock of many turns is one of less
+        # than half a turn; a pose seen 10 cm off is not a measurement).
+        for name, turn in [("start_error", self.start_error), *(("bump", bump[1:]) for bump in self.bumps)]:
+            if turn is not None and not abs(turn[2]) <= math.pi:
+                raise SceneError(name, f"must turn the part by at most half a turn (180 degrees), got "
+                                       f"{math.degrees(turn[2]):g} degrees")
         noise = self.pose_noise
         if noise is not None and min(noise) < 0:
             raise SceneError("pose_noise", f"standard deviations must be >= 0, got {' '.join(map(str, noise))}")
-        if self.sim_mu is not None and not 0 < self.sim_mu < math.inf:
-            raise SceneError("sim_mu", f"must be a positive friction coefficient, got {self.sim_mu}")
+        if noise is not None and not (abs(noise[0]) <= MAX_NOISE[0] and abs(noise[1]) <= MAX_NOISE[1]):
+            raise SceneError("pose_noise", f"must be at most {MAX_NOISE[0]:g} m and "
+                                           f"{math.degrees(MAX_NOISE[1]):g} degrees, got {noise[0]:g} m and "
+                                           f"{math.degrees(noise[1]):g} degrees")
+        if self.sim_mu is not None and not MU_RANGE[0] <= self.sim_mu <= MU_RANGE[1]:
+            raise SceneError("sim_mu", f"must be a friction coefficient in {MU_RANGE[0]:g}..{MU_RANGE[1]:g} (as "
+                                       f"pusher.mu), got {self.sim_mu:g}")
         if self.reach is not None and self.reach not in (1, 2):
             raise SceneError("reach", f"must be 1 or 2 pushes, got {self.reach}")
         if self.reach is not None and not have("matplotlib"):  # found before the work, not after it

@@ -179,7 +179,13 @@ def test_a_lift_alone_leaves_the_part_where_it_is():
 
 
 @pytest.mark.parametrize("argv, field", [(["--sim-mu", "0.5"], "--sim-mu"), (["--simulate", "0"], "--simulate"),
-                                         (["--simulate", "1", "--sim-cf-offset", "1", "0"], "--sim-cf-offset")])
+                                         (["--simulate", "1", "--sim-cf-offset", "1", "0"], "--sim-cf-offset"),
+                                         # Physical ranges: beyond them the state blows up or means nothing.
+                                         (["--simulate", "1", "--sim-mu", "1e300"], "--sim-mu"),
+                                         (["--simulate", "1", "--sim-bump", "1", "0", "0", "1e20"], "--sim-bump"),
+                                         (["--simulate", "1", "--sim-start-error", "0", "0", "200"], "--sim-start-error"),
+                                         (["--simulate", "1", "--closed-loop", "--sim-pose-noise", "1e6", "0"],
+                                          "--sim-pose-noise")])
 def test_bad_simulation_flags_are_bad_input(tmp_path, capsys, argv, field):
     assert main([BATTERY, "--out", str(tmp_path / "out"), *argv]) == 1
     assert capsys.readouterr().err.startswith(f"plan: error: {field}: ")
@@ -378,3 +384,24 @@ def test_a_plan_at_the_exact_limit_slips_with_less_friction_and_one_with_the_mar
     held = simulate(scene, kept, n=2, mu=low).runs
     assert all(r.slip > SLIP and not r.passed for r in slipped), [r.slip for r in slipped]
     assert all(r.passed and r.slip < SLIP for r in held), [r.slip for r in held]
+
+
+def test_a_run_that_blows_up_fails_at_once_saying_so_and_prints_nothing_of_mujoco(capfd):
+    """A friction of 1e300 (the library takes what the command refuses) makes MuJoCo's state
+    non-finite: each run, open or closed loop, stops there and fails with that reason, instead of
+    stepping on for ever through MuJoCo's resets, and MuJoCo's own warnings are not printed."""
+    from planner.execution.mujoco_sim import DIVERGED, simulate
+
+    scene = load_scene(BATTERY)
+    result = plan(scene, seed=1)
+    runs = simulate(scene, result, n=2, mu=1e300).runs
+    assert all(not r.passed and r.faults[0][1].startswith(DIVERGED) for r in runs)
+    assert all(r.line(1, 1).endswith(r.faults[0][1]) for r in runs)
+    from planner import Planner
+    from planner.execution.closed_loop import closed_loop
+
+    session = Planner(scene)
+    (closed,) = closed_loop(session, session.plan(), 1, 1, 1e300).runs
+    assert not closed.passed and closed.reason.startswith(DIVERGED)
+    out, err = capfd.readouterr()
+    assert "WARNING" not in out + err

@@ -89,4 +89,4 @@ def test_the_command_delivers_a_tray_closed_loop_that_it_misses_open_loop(tmp_pa
     assert main([SWAP, "--simulate", "1", *error, "--closed-loop", "--out", str(tmp_path / "closed")]) == 0
     out = capsys.readouterr().out
     assert "closed loop: passed: 1/1 runs with every part in its goal without collision" in out
-    assert "red started at (-0.13, 0, 8.0" in out
+    assert "red started at (-0.1300, 0.0000, 8.00 deg)" in out
