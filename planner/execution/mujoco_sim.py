@@ -118,7 +118,7 @@ from ..world.validity import CollisionModel
 from .approach import first_edge, lead_in_pose
 from .trajectory import Trajectory, planned_part, trajectory
 
-__all__ = ["MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "ByPart", "Feet", "Perturbed", "Run", "Runs", "Simulation", "World", "feet",
+__all__ = ["DIVERGED", "MAX_RUNS", "MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "ByPart", "Feet", "Perturbed", "Run", "Runs", "Simulation", "World", "feet",
            "foot_sets", "mjcf", "needs_mujoco", "perturbations", "simulate", "support_centre", "write_mjcf"]
 
 #: The one line ``plan --simulate`` prints (after ``plan: error: --simulate: ``) without MuJoCo.
@@ -143,6 +143,8 @@ PUSHER_MASS = 1000.0
 SETTLE = 0.1
 #: Feet of a grid distribution (about).
 GRID_FEET = 9
+#: Most runs of one simulation (each some seconds): a bound on the work a number asks for.
+MAX_RUNS = 1_000
 #: Step by which a knocked part is moved off the pusher, m.
 BUMP_STEP = 0.0002
 #: How a run that blew up is reported (World.diverged): its one fault, which fails it.
@@ -182,8 +184,8 @@ def feet(scene: Scene, n: int, seed: int = 1, offset: ArrayLike = (0.0, 0.0)) ->
     >>> [f.kind for f in feet(load_scene("scenes/battery.yaml"), 4)]
     ['grid', 'extreme', 'random', 'extreme']
     """
-    if n < 1:
-        raise ValueError(f"need at least one distribution, got {n}")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= MAX_RUNS:
+        raise SceneError("simulate", f"must be 1 to {MAX_RUNS} distributions, got {n!r}")
     footprint, centre = scene.slider.polygon, support_centre(scene, offset)
     rng = np.random.default_rng(seed)
     try:

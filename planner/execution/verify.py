@@ -76,11 +76,14 @@ from ..model.scene import Part, Pusher, Scene
 from ..model.segments import Push, Transfer, Transit
 from .sweep import collision_model, is_clear
 
-__all__ = ["TOLERANCE", "MoveCheck", "PushCheck", "Verification", "check_chain", "check_solved", "distributions",
+__all__ = ["MAX_DISTRIBUTIONS", "TOLERANCE", "MoveCheck", "PushCheck", "Verification", "check_chain", "check_solved", "distributions",
            "placed_moves", "verify"]
 
 #: Default relative tolerance: positions in part radii, angles in radians (module docstring).
 TOLERANCE = 1e-6
+#: Most support distributions a verification takes: each re-simulates every push (some ms each),
+#: so the cap bounds the work at minutes, not at what a number typed by mistake asks for.
+MAX_DISTRIBUTIONS = 10_000
 #: Support points of the uniform grid and of each random distribution.
 GRID_POINTS, RANDOM_POINTS = 100, 40
 
@@ -100,8 +103,8 @@ def distributions(scene: Scene, n: int, seed: int = 1) -> tuple[list[SupportDist
     >>> bool(np.allclose([s.centre for s in supports], load_scene("scenes/battery.yaml").slider.cf))
     True
     """
-    if n < 1:
-        raise ValueError(f"need at least one distribution, got {n}")
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= MAX_DISTRIBUTIONS:
+        raise SceneError("verify", f"must be 1 to {MAX_DISTRIBUTIONS} distributions, got {n!r}")
     footprint, cf, rho = scene.slider.polygon, scene.slider.cf, scene.cf_uncertainty
     rng = np.random.default_rng(seed)
     extreme = (n - 1) // 3
@@ -516,8 +519,8 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
         edge the scene does not allow, a contact off its edge, a push of no duration, a lift where
         ``transit`` keeps the pusher on the table) or does not take over where the one before it
         left its part and the pusher (module docstring), naming the plan field.
-    ValueError
-        If ``n < 1``.
+    SceneError
+        If ``n`` is not 1 to :data:`MAX_DISTRIBUTIONS` (naming ``verify``).
 
     Examples
     --------

@@ -71,10 +71,13 @@ class RunOptions:
         SceneError
             Naming the option at fault.
         """
-        for name in ("verify", "simulate"):
+        from ..execution.mujoco_sim import MAX_RUNS  # loads no MuJoCo, only its bounds
+        from ..execution.verify import MAX_DISTRIBUTIONS
+
+        for name, most in (("verify", MAX_DISTRIBUTIONS), ("simulate", MAX_RUNS)):
             if (value := getattr(self, name)) is not None and (isinstance(value, bool) or not isinstance(value, int)
-                                                               or value < 1):
-                raise SceneError(name, f"must be at least 1 distribution, got {shown(value)}")
+                                                               or not 1 <= value <= most):
+                raise SceneError(name, f"must be 1 to {most} distributions, got {shown(value)}")
         if self.plan_file is not None and self.verify is None and self.simulate is None:
             raise SceneError("plan_file", "needs verify or simulate: a plan file is only read to be checked")
         if self.simulate is None:

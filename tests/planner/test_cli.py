@@ -263,6 +263,9 @@ BAD_FLAGS = {
     "--margin beyond the part": (["--margin", "0.1", "1"], "--margin"),
     "--margin three values": (["--margin", "0.1", "0.02", "0.3"], "--margin"),
     "--margin one nonzero value": (["--margin", "0.1"], "--margin"),
+    # The work a number asks for is bounded: no typo runs for days.
+    "--verify 100000": (["--verify", "100000"], "--verify"),
+    "--simulate 5000": (["--simulate", "5000"], "--simulate"),
 }
 
 

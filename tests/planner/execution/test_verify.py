@@ -106,6 +106,9 @@ def test_distributions_mix_kinds_with_centre_at_the_cf_and_depend_on_the_seed_on
     assert not any(np.array_equal(a.points, b.points) for a, b in zip(supports[4:], other[4:]))
     with pytest.raises(ValueError):
         distributions(scene, 0)
+    with pytest.raises(planner.SceneError) as err:  # a bound on the work, named as the flag's field
+        distributions(scene, 10**9)
+    assert err.value.field == "verify"
 
 
 # -- twists across STABLE's boundary ----------------------------------------------------------------
