@@ -47,7 +47,8 @@ exit codes:
   4    an output could not be written: one line "plan: error: cannot write <file>: <OS error>";
        no file is left in its place (a file already there is kept as it was); the output
        folder and --mjcf's are tried before planning
-  130  interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing is written, no process is left
+  130  interrupted (Ctrl-C), 143 terminated (SIGTERM): nothing is written (unless the signal
+       came after the plan file, the last output, was in place), no process is left
 
 Defaults: a scene's planner: mapping (and pusher.transit) sets its own, which these options
 override; without them --planner {DEFAULT_PLANNER}, --time-limit {PlannerOptions.time_limit:g}, \
