@@ -7,6 +7,7 @@ the flag the user typed. Nothing here loads the planner until a parser is made.
 from __future__ import annotations
 
 import argparse
+import re
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -25,6 +26,10 @@ ARGUMENTS = {"seed": "--seed", "cf_offset": "--sim-cf-offset", "sim_cf_offset": 
              **{name: f"--{name.replace('_', '-')}" for name in
                 ("engine", "jobs", "address", "out", "seeds", "resume", "simulate", "verify", "reach", "part",
                  "trajectory", "sim_mu", "mjcf", "closed_loop", "export_scene")}}
+
+
+#: A negative number as float() reads it: -1, -.5, -1e-3, -2.5E+4, -inf, -nan.
+_NEGATIVE = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
 
 
 def parser() -> argparse.ArgumentParser:
@@ -58,6 +63,10 @@ the time limit bounds them and the search together, and they may take half of it
 $STABLEPUSH_CACHE, else $XDG_CACHE_HOME/stablepush or ~/.cache/stablepush (here: {cache_folder()})."""
     p = argparse.ArgumentParser(prog="plan", description="Plan guaranteed-stable pushes for a YAML scene.",
                                 epilog=epilog, formatter_class=argparse.RawDescriptionHelpFormatter)
+    # argparse takes "-1e-3" or "-inf" for an option (it knows negatives only as -1 and -.5), so
+    # "--sim-start-error -1e-3 0 0" was "expected 3 arguments". No flag of ours looks like a number,
+    # so every number in float's notation is a value; the checks then refuse what is not finite.
+    p._negative_number_matcher = _NEGATIVE
     p.add_argument("scene", nargs="+", help="scene file (YAML; its format is in the README); several make a batch")
     p.add_argument("--planner", choices=PLANNERS, help=f"OMPL control planner (default: the scene's, else {DEFAULT_PLANNER})")
     p.add_argument("--time-limit", type=float, metavar="S",

@@ -653,3 +653,21 @@ def test_every_planner_setting_has_its_flag_and_the_flag_sets_it():
         changed = options_of(_parser().parse_args(["s.yaml", flag, *typed.get(field, [str(given[field])])]), base)
         assert getattr(changed, field) == given[field] != getattr(base, field)
         assert {f.name for f in dataclasses.fields(base) if getattr(changed, f.name) != getattr(base, f.name)} == {field}
+
+
+@pytest.mark.parametrize("values, field", [(["-1e-3", "0", "0"], None), (["-1E-3", "-0", "-0.0"], None),
+                                           (["-inf", "0", "0"], "--sim-start-error"),
+                                           (["-nan", "0", "0"], "--sim-start-error")])
+def test_negative_numbers_in_every_notation_are_values(values, field):
+    """argparse knows negatives only as -1 and -.5: "-1e-3" and "-inf" were taken for options
+    ("expected 3 arguments"). They are values, and the checks refuse what is not finite."""
+    from planner.cli import read_inputs
+    from planner.model.fields import SceneError
+
+    argv = [str(SCENES / "battery.yaml"), "--simulate", "1", "--sim-start-error", *values]
+    if field is None:
+        assert read_inputs(argv).options.start_error[0] == float(values[0])
+    else:
+        with pytest.raises(SceneError) as err:
+            read_inputs(argv)
+        assert err.value.field == field

@@ -54,7 +54,10 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     if not isinstance(root, svg.SVG):
         raise SceneError(selection.field, "not a readable SVG file (no svg element)")
     # Back from the screen to the file's user units, then y up (module docstring).
-    to_table = ~svg.Matrix(root.viewbox_transform or "") * svg.Matrix("scale(1, -1)")
+    try:
+        to_table = ~svg.Matrix(root.viewbox_transform or "") * svg.Matrix("scale(1, -1)")
+    except ZeroDivisionError:  # svgelements divides by the viewBox's and the page's sizes
+        raise SceneError(selection.field, "its viewBox, width or height is zero: the drawing has no scale") from None
     skipped: Counter[str] = Counter()
     rings, left_open, points = [], 0, 0
     for element in _chosen(root, selection):
@@ -113,6 +116,8 @@ def _path(segments: list) -> tuple[ezdxf.path.Path | None, bool]:
     import svgelements as svg
 
     start = segments[0].end if isinstance(segments[0], svg.Move) else segments[0].start
+    if start is None:  # a subpath that never says where it is ("Z" alone): nothing drawn
+        return None, False
     path = ezdxf.path.Path((start.x, start.y))
     closed = False
     for segment in segments:

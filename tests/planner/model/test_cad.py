@@ -300,8 +300,19 @@ def part_on_layer(layer: str):
     return lambda folder: dxf_file(folder, lambda msp: rounded_rectangle(msp, layer))
 
 
+def svg_text(text: str):
+    return lambda folder: (folder / "part.svg").write_text(
+        f'<svg xmlns="http://www.w3.org/2000/svg" {text}</svg>')
+
+
 BAD = {
     # (what to write, the slider's file reference, the field named, words of the problem)
+    "an SVG path that is a lone Z": (svg_text('width="100mm" height="100mm" viewBox="0 0 100 100"><path d="Z"/>'),
+                                     {"file": "part.svg", "units": "mm"}, "slider.file", ["holds no closed outline"]),
+    "an SVG viewBox of zero": (svg_text('width="100mm" height="100mm" viewBox="0 0 0 0"><rect width="9" height="9"/>'),
+                               {"file": "part.svg", "units": "mm"}, "slider.file", ["viewBox, width or height is zero"]),
+    "an SVG page of zero size": (svg_text('width="0" height="0" viewBox="0 0 100 100"><rect width="9" height="9"/>'),
+                                 {"file": "part.svg", "units": "mm"}, "slider.file", ["viewBox, width or height is zero"]),
     "missing file": (lambda folder: None, {"file": "none.dxf", "units": "mm"}, "slider.file", ["cannot read"]),
     "unreadable file (a folder)": (lambda folder: (folder / "dir.svg").mkdir(), {"file": "dir.svg", "units": "mm"},
                                    "slider.file", ["not a regular file (a folder)"]),
