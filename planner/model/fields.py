@@ -21,7 +21,7 @@ import numpy as np
 
 from mechanics import wrap_angle
 
-__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "pose_text", "poses", "shown",
+__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "pose", "pose_text", "poses", "shown",
            "vector"]
 
 #: Most characters of a bad value a message quotes: enough to recognise it, never a flood.
@@ -191,6 +191,20 @@ def poses(value: Any, name: str) -> np.ndarray:
         raise SceneError(name, f"must be poses (x, y, theta) of finite numbers, got {shown(value)}")
     rows[:, 2] = wrap_angle(rows[:, 2])
     return rows
+
+
+def pose(value: Any, name: str) -> np.ndarray:
+    """``value`` as one pose ``(x, y, theta)`` (:func:`poses`' checks; radians).
+
+    >>> pose([0, 0, float("nan")], "start")
+    Traceback (most recent call last):
+    ...
+    planner.model.fields.SceneError: start: must be poses (x, y, theta) of finite numbers, got [0, 0, nan]
+    """
+    rows = poses(value, name)
+    if len(rows) != 1:
+        raise SceneError(name, f"must be one pose (x, y, theta), got {len(rows)}")
+    return rows[0]
 
 
 def vector(value: Any, name: str, size: int, limit: Limit | None = None) -> np.ndarray:

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import GOALS, SupportModel, classify_goal, log_pose
 
+from ..model.fields import pose
 from ..model.segments import Push
 from ..actions.controls import clearance_margin, edge_controls
 from ..model.margin import EXACT, Margin
@@ -55,8 +56,8 @@ def one_step(scene: Scene, start: ArrayLike | None = None, goal: ArrayLike | Non
 
     Edges are tried in the order the scene allows them; the first that works is returned.
     """
-    start = scene.start if start is None else np.asarray(start, dtype=float)
-    goal = scene.goal if goal is None else np.asarray(goal, dtype=float)
+    start = scene.start if start is None else pose(start, "start")
+    goal = scene.goal if goal is None else pose(goal, "goal")
     pushes = edge_controls(scene, regions=regions, margin=margin)
     model = CollisionModel(scene, [p.edge for p in pushes])
     verdicts = goal_verdicts(scene, start, goal)

@@ -45,6 +45,7 @@ from mechanics import log_pose, wrap_angle
 
 from ..actions.push import connect
 from ..model.extras import pyplot
+from ..model.fields import SceneError, number
 from ..model.segments import Push
 from ..search.goal_region import GoalRegion
 from ..actions.controls import EdgeControls, clearance_margin, controls_or_reason
@@ -53,12 +54,15 @@ from ..model.options import DEFAULT_REGIONS
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
-__all__ = ["HEADINGS", "ReachableSet", "reachable_set", "reach_points", "write_png"]
+__all__ = ["HEADINGS", "MAX_CELLS", "ReachableSet", "reachable_set", "reach_points", "write_png"]
 
 #: Headings tried (evenly spaced from 0) when the map is for any final heading.
 HEADINGS = 24
 #: Default cells along the workspace diagonal.
 CELLS_PER_DIAGONAL = 60
+#: Most cells of a map (1000 x 1000): each is collision-checked per heading, so the work and the
+#: memory of a map grow with them; the default grid has some 1,800.
+MAX_CELLS = 1_000_000
 #: Colours of cells reached in 1 and 2 pushes (PNG and rerun alike).
 COLOURS = {1: "#2e9e5b", 2: "#f0b429"}
 #: Colour of cells where the part at the goal collides.
@@ -137,13 +141,16 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
 
     clock = time.perf_counter()
     if pushes not in (1, 2):
-        raise ValueError(f"pushes must be 1 or 2, got {pushes!r}")
+        raise SceneError("pushes", f"must be 1 or 2, got {pushes!r}")
+    if heading is not None:
+        heading = number(heading, "heading")
     xmin, ymin, xmax, ymax = scene.workspace
     w, h = xmax - xmin, ymax - ymin
-    res = math.hypot(w, h) / CELLS_PER_DIAGONAL if resolution is None else float(resolution)
-    if not res > 0:
-        raise ValueError(f"resolution must be positive, got {resolution!r}")
+    res = math.hypot(w, h) / CELLS_PER_DIAGONAL if resolution is None else number(resolution, "resolution", positive=True)
     nx, ny = max(1, round(w / res)), max(1, round(h / res))
+    if nx * ny > MAX_CELLS:  # each cell is collision-checked per heading: the work and memory grow with them
+        raise SceneError("resolution", f"{res:g} m makes {nx * ny} cells of the workspace, more than {MAX_CELLS}: "
+                                       f"at least {math.sqrt(w * h / MAX_CELLS):.3g} m")
     dx, dy = w / nx, h / ny
     x, y = np.meshgrid(xmin + (np.arange(nx) + 0.5) * dx, ymin + (np.arange(ny) + 0.5) * dy)
     xy = np.stack([x.ravel(), y.ravel()], axis=-1)

@@ -38,7 +38,7 @@ from numpy.typing import ArrayLike
 from ..actions.controls import NoStablePush, RegionTimeout, clearance_margin
 from ..actions.region_cache import RegionCache
 from ..actions.transit import TransitPlanner
-from ..model.fields import SceneError, integer, poses
+from ..model.fields import SceneError, integer, pose, poses
 from ..model.options import PlannerOptions, check_planner
 from ..model.scene import Scene
 from ..model.plan import Plan
@@ -171,12 +171,7 @@ class Planner:
         return PlanRequest.of(self.options, seed=seed, time_limit=time_limit, optimize=optimize, planner=planner)
 
     def _pose(self, value: ArrayLike | None, name: str, default: np.ndarray) -> np.ndarray:
-        if value is None:
-            return default.copy()
-        rows = poses(value, name)
-        if len(rows) != 1:
-            raise SceneError(name, f"must be one pose (x, y, theta), got {len(rows)}")
-        return rows[0]
+        return default.copy() if value is None else pose(value, name)
 
     def plan(self, start: ArrayLike | None = None, goal: ArrayLike | None = None, *, seed: int | None = None,
              time_limit: float | None = None, optimize: int | None = None, planner: str | None = None,
@@ -212,7 +207,8 @@ class Planner:
         else:
             start = self._pose(start, "start", self.scene.start)
             goal = self._pose(goal, "goal", self.scene.goal)
-            if edges is not None and not all(isinstance(e, int) and e in self.scene.edges for e in edges):
+            if edges is not None and (not isinstance(edges, Sequence)
+                                      or not all(isinstance(e, int) and e in self.scene.edges for e in edges)):
                 raise SceneError("edges", f"must be allowed edges of the pusher {list(self.scene.edges)}, got {edges}")
             found = self._plan(start, goal, request, time.perf_counter() if since is None else since, reuse, edges,
                                observed)

@@ -267,3 +267,24 @@ def test_a_query_serves_the_next(parking):
     spec = yaml.safe_load(PARKING.read_text())
     for answer in sorted(new, key=lambda a: a.plan.length)[:1]:
         replay_plan(spec, answer.plan.to_dict(), answer.goal)
+
+
+def test_bad_query_arguments_are_scene_errors_naming_them():
+    """What the API is given is checked as the command's flags are: a non-finite start or heading,
+    a grid a million times finer than the default, edges that are not a list; each a SceneError
+    naming the argument (they were GEOS errors, a TypeError, and a map that ran out of memory)."""
+    from planner import SceneError, load_scene, one_step
+    from planner.queries.reachable_set import MAX_CELLS
+
+    scene = load_scene(Path(__file__).resolve().parents[3] / "scenes" / "battery.yaml")
+    session = Planner(scene)
+    calls = {"start": lambda: one_step(scene, start=[math.nan, 0, 0]),
+             "heading": lambda: session.reachable_set(1, heading=math.nan),
+             "resolution": lambda: session.reachable_set(1, resolution=1e-5),
+             "edges": lambda: session.plan(edges=5),
+             "pushes": lambda: session.reachable_set(3)}
+    for field, call in calls.items():
+        with pytest.raises(SceneError) as err:
+            call()
+        assert err.value.field == field, err.value
+    assert str(MAX_CELLS) in str(pytest.raises(SceneError, calls["resolution"]).value)
