@@ -49,7 +49,7 @@ from numpy.typing import ArrayLike
 from mechanics import pose_error, wrap_angle
 
 from ..actions.transit import edge_contact_pose
-from ..model.fields import SceneError
+from ..model.fields import SceneError, counted
 from ..model.plan import Plan
 from ..model.scene import Scene
 from ..model.segments import Transit
@@ -125,13 +125,8 @@ class ClosedRun(ByPart):
         worst = f" ({_worst(self.goal_errors)})" if several else ""
         return (f"closed loop {k}/{n} ({kinds}, {'+'.join(str(len(f.points)) for f in self.supports.values())} feet): "
                 f"goal error {self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad{worst}; "
-                f"{_replans(len(self.replans))}{latency}; {_carried(self.carried)}"
+                f"{counted(len(self.replans), 're-plan')}{latency}; {_carried(self.carried)}"
                 f"{self.seconds:.1f} s for {self.simulated:.1f} s: {', '.join(faults) if faults else 'ok'}")
-
-
-def _replans(n: int) -> str:
-    """``'1 re-plan'``, ``'3 re-plans'``."""
-    return f"{n} re-plan{'' if n == 1 else 's'}"
 
 
 def _carried(carried: tuple[tuple[float, str], ...]) -> str:
@@ -169,7 +164,7 @@ class ClosedLoop(Runs):
         goal = "in the goal" if len(self.starts) == 1 else "with every part in its goal"
         return (f"closed loop: {'passed' if self.passed else 'FAILED'}: {sum(r.passed for r in self.runs)}/"
                 f"{len(self.runs)} runs {goal} without collision (MuJoCo, pusher mu {self.mu:g}, table mu "
-                f"{TABLE_MU:g}); {_replans(sum(len(r.replans) for r in self.runs))}{timing}; worst goal error "
+                f"{TABLE_MU:g}); {counted(sum(len(r.replans) for r in self.runs), 're-plan')}{timing}; worst goal error "
                 f"{max(r.goal_error[0] for r in self.runs):.2e} m; {placed}; {sum(r.seconds for r in self.runs):.1f} s")
 
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:

@@ -67,7 +67,7 @@ from mechanics.quasistatic import (DEFAULT_STEPS, Contact, ContactMode, PushResu
 
 from ..actions.margins import keeps, with_margins
 from ..actions.transit import edge_contact_pose
-from ..model.fields import SceneError, pose_text
+from ..model.fields import SceneError, counted, pose_text
 from ..model.margin import Margin, PushMargin
 from ..model.options import DEFAULT_REGIONS, DEFAULT_TRANSIT
 from ..model.plan import Move, Plan
@@ -331,7 +331,7 @@ class Verification:
         least = "" if not margins else (f"; smallest margin friction -{min(m.mu for m in margins) * 100:.0f} %, "
                                         f"CF {min(m.cf for m in margins) * 1e3:.2g} mm")
         if (below := sum(p.keeps is False for p in self.pushes)):
-            least += f" ({below} push{'' if below == 1 else 'es'} below the plan's margin, {self.margin})"
+            least += f" ({counted(below, 'push')} below the plan's margin, {self.margin})"
         elif self.margin is not None:
             least += f" (planned: {self.margin})"
         return (f"verify: {'passed' if self.passed else 'FAILED'}: {pushes} x "

@@ -21,7 +21,7 @@ import numpy as np
 
 from mechanics import wrap_angle
 
-__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "integer", "keys", "member", "number", "pose", "pose_text", "poses", "shown",
+__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "counted", "integer", "keys", "member", "number", "pose", "pose_text", "poses", "shown",
            "vector"]
 
 #: Most characters of a bad value a message quotes: enough to recognise it, never a flood.
@@ -77,6 +77,15 @@ def shown(value: Any) -> str:
 
 #: A key that names itself plainly in a dotted field name; any other is quoted (:func:`shown`).
 _PLAIN_KEY = re.compile(r"[A-Za-z0-9_-]{1,40}")
+
+
+def counted(n: int, word: str) -> str:
+    """``n`` and ``word``, plural unless ``n`` is 1.
+
+    >>> counted(1, "push"), counted(3, "push"), counted(2, "switch"), counted(0, "re-plan")
+    ('1 push', '3 pushes', '2 switches', '0 re-plans')
+    """
+    return f"{n} {word if n == 1 else word + ('es' if word.endswith(('sh', 'ch')) else 's')}"
 
 
 def pose_text(pose: Any) -> str:

@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .fields import SceneError
+from .fields import SceneError, counted
 from .margin import Margin, PushMargin
 from .scene import ONE_PART
 from .segments import Push, Transfer, Transit, floats, path_length
@@ -68,11 +68,6 @@ class Move:
     @property
     def end(self) -> np.ndarray:
         return self.segments[-1].end
-
-
-def _count(n: int, word: str) -> str:
-    """``'1 push'``, ``'3 pushes'``, ``'2 switches'``, ``'1 move'``."""
-    return f"{n} {word if n == 1 else word + ('es' if word.endswith(('sh', 'ch')) else 's')}"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -211,10 +206,10 @@ class Plan:
         words = []
         if len(self.starts) > 1:
             buffers = f" ({self.buffer_moves} buffer)" if self.buffer_moves else ""
-            words += [_count(len(self.starts), "part"), _count(len(self.moves), "move") + buffers]
-        words.append(_count(self.pushes, "push"))
-        words += [_count(self.switches, "switch")] if self.switches else []
-        words += [_count(self.transfers, "transfer")] if self.transfers else []
+            words += [counted(len(self.starts), "part"), counted(len(self.moves), "move") + buffers]
+        words.append(counted(self.pushes, "push"))
+        words += [counted(self.switches, "switch")] if self.switches else []
+        words += [counted(self.transfers, "transfer")] if self.transfers else []
         return joiner.join(words)
 
     def headline(self) -> str:
