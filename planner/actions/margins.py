@@ -18,7 +18,7 @@ import numpy as np
 
 from mechanics import push_margins
 
-from ..model.margin import EXACT, Margin, PushMargin
+from ..model.margin import EXACT, Margin, PushMargin, nominal_friction
 from ..model.plan import Plan
 from ..model.scene import Scene
 from ..model.segments import Push
@@ -28,10 +28,14 @@ from .region_cache import edge_region
 __all__ = ["keeps", "smallest", "with_margins"]
 
 
-def _pushes(plan: Plan) -> list[tuple[int, str, Push]]:
-    """``(index among the plan's pushes, part, push)`` in step order."""
-    pushes = [(part, s) for part, s in plan.steps if isinstance(s, Push)]
-    return [(k, part, s) for k, (part, s) in enumerate(pushes)]
+def _pushes(plan: Plan) -> list[tuple[str, Push]]:
+    """``(part, push)`` for each push of the plan, in step order."""
+    return [(part, s) for part, s in plan.steps if isinstance(s, Push)]
+
+
+def _alone(scene: Scene, plan: Plan) -> dict[str, Scene]:
+    """Each part's scene of its own (the stable regions are a part's, whatever stands about it)."""
+    return {name: scene.move_scene(name, plan.starts, others=False) for name in plan.names}
 
 
 def with_margins(scene: Scene, plan: Plan) -> Plan:
@@ -49,14 +53,15 @@ def with_margins(scene: Scene, plan: Plan) -> Plan:
     """
     if not plan.solved:
         return plan
-    p = scene.pusher
-    nominal = p.mu if p.mu_high is None else (p.mu + p.mu_high) / 2
-    found: dict[int, PushMargin] = {}
+    p, alone = scene.pusher, _alone(scene, plan)
+    nominal = nominal_friction(p.mu, p.mu_high)
+    pushes = _pushes(plan)
+    found: list[PushMargin | None] = [None] * len(pushes)
     groups: dict[tuple[str, int], list[tuple[int, Push]]] = {}
-    for k, part, s in _pushes(plan):
+    for k, (part, s) in enumerate(pushes):
         groups.setdefault((part, s.edge), []).append((k, s))
     for (name, edge), items in groups.items():
-        one = scene.move_scene(name, plan.starts)
+        one = alone[name]
         # The friction margin is found with the CF disk the plan was made for; that disk and that
         # friction are rungs of the searches, so a push certified for them says so exactly, not to
         # the ladders' step below.
@@ -67,7 +72,7 @@ def with_margins(scene: Scene, plan: Plan) -> Plan:
             # Rounded: a friction certified at exactly 90 % of the scene's is a 10 % margin, not 9.99...
             found[k] = PushMargin(max(0.0, round(1.0 - float(low) / nominal, 12)) if np.isfinite(low) else 0.0,
                                   float(radius) if np.isfinite(radius) else 0.0)
-    return replace(plan, margins=tuple(found[k] for k in sorted(found)))
+    return replace(plan, margins=tuple(found))
 
 
 def smallest(plan: Plan) -> PushMargin | None:
@@ -81,9 +86,9 @@ def smallest(plan: Plan) -> PushMargin | None:
 def keeps(scene: Scene, plan: Plan, margin: Margin, regions: str = "exact") -> list[bool]:
     """For each push of ``plan`` in step order, whether it lies in its edge's stable region of
     ``margin`` (the regions a plan with that margin is planned in; computed, or read from the cache)."""
-    out = []
-    for _, name, s in _pushes(plan):
-        one = scene.move_scene(name, plan.starts)
+    out, alone = [], _alone(scene, plan)
+    for name, s in _pushes(plan):
+        one = alone[name]
         mu, rho = certified_for(one, margin, regions)
         region = edge_region(one.slider, s.edge, mu, scene.pusher.width, regions, rho)
         out.append(bool(region.contains(s.twist)))

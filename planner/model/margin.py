@@ -34,7 +34,7 @@ from typing import Any
 
 from .fields import SceneError, number, shown
 
-__all__ = ["CF_FLOOR", "DEFAULT_MARGIN", "EXACT", "Margin", "PushMargin", "check_margin"]
+__all__ = ["CF_FLOOR", "DEFAULT_MARGIN", "EXACT", "Margin", "PushMargin", "check_margin", "nominal_friction"]
 
 #: The smallest CF disk of a non-zero margin, m: a CF drawn or measured is rarely better than this.
 CF_FLOOR = 0.001
@@ -57,8 +57,7 @@ class Margin:
     def friction(self, mu: float, mu_high: float | None = None) -> float:
         """The friction the pushes are certified for, of a pusher of friction ``mu`` (or the
         interval ``[mu, mu_high]``)."""
-        nominal = mu if mu_high is None else (mu + mu_high) / 2
-        return min(mu, nominal * (1 - self.mu))
+        return min(mu, nominal_friction(mu, mu_high) * (1 - self.mu))
 
     def cf_radius(self, radius: float, cf_uncertainty: float = 0.0) -> float:
         """The radius of the CF disk the pushes are certified for, of a part of ``radius`` whose
@@ -98,6 +97,16 @@ class PushMargin:
         'friction -23 %, CF 3.1 mm'
         """
         return f"friction -{self.mu * 100:.0f} %, CF {self.cf * 1e3:.2g} mm"
+
+
+def nominal_friction(mu: float, mu_high: float | None = None) -> float:
+    """The friction a scene states, which a margin is a fraction of: ``mu``, or the middle of the
+    interval ``[mu, mu_high]``.
+
+    >>> nominal_friction(0.5), nominal_friction(0.4, 0.6)
+    (0.5, 0.5)
+    """
+    return mu if mu_high is None else (mu + mu_high) / 2
 
 
 #: The margin every plan keeps unless told otherwise.
