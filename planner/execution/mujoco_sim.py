@@ -149,8 +149,12 @@ MAX_RUNS = 1_000
 BUMP_STEP = 0.0002
 #: How a run that blew up is reported (World.diverged): its one fault, which fails it.
 DIVERGED = "the simulation diverged"
-#: The texts of the MuJoCo warnings seen since the last divergence was reported (World).
-_WARNINGS: list[str] = []
+#: The text of the last MuJoCo warning (World): one, however many a long run raises.
+_LAST_WARNING: list[str] = []
+
+
+def _keep_warning(text: str) -> None:
+    _LAST_WARNING[:] = [text]
 
 T = TypeVar("T")
 
@@ -609,7 +613,7 @@ class World:
 
         # MuJoCo prints its warnings on the terminal, thousands a second from a run that keeps
         # blowing up; the run reports divergence itself (diverged), so they are kept, not printed.
-        mujoco.set_mju_user_warning(_WARNINGS.append)
+        mujoco.set_mju_user_warning(_keep_warning)
         self.diverged: str | None = None
         # The warnings of a state MuJoCo had to reset.
         self.unstable = [int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
@@ -659,9 +663,8 @@ class World:
                 data.qvel[self.speeds[name]] = 0.0
             self.mujoco.mj_step(self.model, data)
             if any(data.warning[w].number for w in self.unstable) or not np.isfinite(data.qpos).all():
-                said = _WARNINGS[-1].split(". ")[0] if _WARNINGS else "a non-finite state"
+                said = _LAST_WARNING.pop().split(". ")[0] if _LAST_WARNING else "a non-finite state"
                 self.diverged = f"{DIVERGED} at {max(u, 0.0):.2f} s (MuJoCo: {said})"
-                del _WARNINGS[:]
 
     @staticmethod
     def _drive(pusher: Driver, u: float) -> tuple[ArrayLike, np.ndarray]:
