@@ -80,7 +80,7 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     SystemExit
         On argparse's usage errors (code 2) and ``--help`` (code 0).
     """
-    from .model.fields import SceneError
+    from .model.fields import FileFieldError, SceneError
     from .model.scene_file import load_scene
     from .pipeline import RunOptions
 
@@ -91,7 +91,10 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
     if _is_batch(args) or args.resume:
         raise SceneError("--resume" if args.resume else "scene", "several scenes, --seeds or --resume make a batch, "
                                                                "which the plan command runs itself (planner.batch)")
-    scene = load_scene(args.scene[0])
+    try:
+        scene = load_scene(args.scene[0])
+    except SceneError as err:
+        raise FileFieldError(err.field, err.problem) from None
     planner_options = options_of(args, scene.options)
     out = Path(args.out) if args.out else _fresh_folder(Path("logs") / f"{scene.name}-{time.strftime('%Y%m%d-%H%M%S')}")
     options = RunOptions(
@@ -126,7 +129,7 @@ def main(argv: list[str] | None = None) -> int:
     loading = ({s: signal.signal(s, _stop_while_loading) for s in (signal.SIGINT, signal.SIGTERM)
                 if signal.getsignal(s) in (signal.default_int_handler, signal.SIG_DFL)}
                if threading.current_thread() is threading.main_thread() else {})
-    from .model.fields import SceneError
+    from .model.fields import FileFieldError, SceneError
     from .model.stop import Terminated, raise_on_sigterm
     from .pipeline import OutputError
 
@@ -143,7 +146,8 @@ def main(argv: list[str] | None = None) -> int:
                 return run_command(args)
             return _run(args, read_inputs(argv))
     except SceneError as err:
-        print(f"plan: error: {SceneError(flag_of(err.field), err.problem)}", file=sys.stderr)
+        print(f"plan: error: {err if isinstance(err, FileFieldError) else SceneError(flag_of(err.field), err.problem)}",
+              file=sys.stderr)
         return 1
     except OutputError as err:
         print(f"plan: error: {err}", file=sys.stderr)

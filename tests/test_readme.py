@@ -29,6 +29,19 @@ def test_readme_opens_with_install_and_plan_then_tests():
     assert tests == "pip install -e '.[test]' && python -m pytest -q"
 
 
+def test_the_opening_says_the_python_version_the_venv_and_where_regions_are_cached(monkeypatch):
+    """Issue 41: a newcomer was told none of them. The version is the package's own, the folder
+    the cache's default."""
+    from planner.actions.region_cache import cache_folder
+
+    opening = README[:README.index("## Quick start")]
+    version = re.search(r'requires-python = ">=(\d+\.\d+)"', (ROOT / "pyproject.toml").read_text()).group(1)
+    assert f"Python {version}+" in opening and "python3 -m venv .venv" in opening
+    monkeypatch.delenv("STABLEPUSH_CACHE", raising=False)
+    monkeypatch.delenv("XDG_CACHE_HOME", raising=False)
+    assert f"`{str(cache_folder()).replace(str(Path.home()), '~')}`" in opening
+
+
 def quick_start() -> str:
     start = README.index("## Quick start")
     return README[start:README.index("\n## ", start + 1) + 1]

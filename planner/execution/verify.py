@@ -42,6 +42,15 @@ planner's rule (:mod:`planner.actions.transit`), not checked here; a plan read f
 checked against its scene, obstacles included, before it is verified (:mod:`planner.execution.fit`,
 which uses :func:`check_chain`).
 
+The pusher's own way between contacts is checked as written, not as the planner would have made
+it: a transit or a transfer touches a part only at its ends (flush on an edge), so each of its
+moves on the table (:func:`~planner.actions.transit.in_plane_moves`, by the segment's own
+``mode``) is swept, by the planner's conservative advancement, against every part where it stands,
+each shrunk by :data:`REACH_IN` of its radius; a segment whose pusher reaches deeper goes *through*
+the part, and its move fails naming it. So a transit cut to its two contact poses, a lift
+relabelled ``plane`` (its flight then on the table) or a transfer straight across the parts fails,
+however well its pushes stick.
+
 Several parts. A plan is a sequence of moves, each of one part with the others standing still, so
 each move's pushes are verified as above under the distributions of that move's part. What the
 simulation of one part cannot see is another part in the way: every push and every transit of a
@@ -66,7 +75,7 @@ from mechanics.quasistatic import (DEFAULT_STEPS, Contact, ContactMode, PushResu
                                    tripod_supports)
 
 from ..actions.margins import keeps, with_margins
-from ..actions.transit import edge_contact_pose
+from ..actions.transit import edge_contact_pose, in_plane_moves
 from ..model.fields import SceneError, counted, pose_text
 from ..model.margin import Margin, PushMargin
 from ..model.options import DEFAULT_REGIONS, DEFAULT_TRANSIT
@@ -74,9 +83,10 @@ from ..model.plan import Move, Plan
 from ..model.plan_file import part_field
 from ..model.scene import Part, Pusher, Scene
 from ..model.segments import Push, Transfer, Transit
+from ..world.validity import CollisionModel
 from .sweep import collision_model, is_clear
 
-__all__ = ["MAX_DISTRIBUTIONS", "TOLERANCE", "MoveCheck", "PushCheck", "Verification", "check_chain", "check_solved", "distributions",
+__all__ = ["MAX_DISTRIBUTIONS", "REACH_IN", "TOLERANCE", "MoveCheck", "PushCheck", "Verification", "check_chain", "check_solved", "distributions",
            "placed_moves", "verify"]
 
 #: Default relative tolerance: positions in part radii, angles in radians (module docstring).
@@ -86,6 +96,10 @@ TOLERANCE = 1e-6
 MAX_DISTRIBUTIONS = 10_000
 #: Support points of the uniform grid and of each random distribution.
 GRID_POINTS, RANDOM_POINTS = 100, 40
+#: How deep (in part radii) the pusher may reach into a part on a transit or a transfer: it touches
+#: a part only at the segment's ends, flush, so this is room for rounding at the contacts, a
+#: thousand times less than any path through the part (module docstring).
+REACH_IN = 1e-3
 
 
 def distributions(scene: Scene, n: int, seed: int = 1) -> tuple[list[SupportDistribution], list[str]]:
@@ -183,12 +197,15 @@ class PushCheck:
 @dataclass(frozen=True, eq=False)
 class MoveCheck:
     """One move of a plan verified: a check per push, in order, the worst CF distance (m) and
-    angle (rad) of its chained end from the move's, and the other parts it meets (none: clear)."""
+    angle (rad) of its chained end from the move's, the other parts it meets (none: clear), and per
+    segment (as :attr:`segments` numbers them) the parts its pusher goes through on the way between
+    contacts (none for a push; module docstring)."""
 
     move: Move
     pushes: tuple[PushCheck, ...]
     drift: tuple[float, float]
     met: tuple[str, ...]
+    crossed: tuple[tuple[str, ...], ...]
 
     @property
     def segments(self) -> list[Push | Transit | Transfer]:
@@ -197,7 +214,7 @@ class MoveCheck:
 
     @property
     def passed(self) -> bool:
-        return all(p.passed for p in self.pushes) and not self.met
+        return all(p.passed for p in self.pushes) and not self.met and not any(self.crossed)
 
 
 @dataclass(frozen=True, eq=False)
@@ -242,7 +259,7 @@ class Verification:
 
     @property
     def passed(self) -> bool:
-        """No run of any push slipped, and no move meets another part."""
+        """No run of any push slipped, no move meets another part, and no pusher goes through a part."""
         return all(m.passed for m in self.moves)
 
     @property
@@ -272,8 +289,8 @@ class Verification:
         :meth:`summary`); with several parts, each move's segments after a line on the move.
 
         A transit or a transfer has nothing to simulate and :func:`verify` refuses a plan whose
-        transits and transfers do not join up, so every one it reports on is ``ok``; its line shows
-        where the pusher goes.
+        transits and transfers do not join up; its line shows where the pusher goes, and whether it
+        goes through a part on the way.
         """
         segments, pushes = self.segments, iter(self.pushes)
         totals, seen = Counter(map(type, segments)), Counter()
@@ -282,20 +299,25 @@ class Verification:
             if len(self.scene.parts) > 1:  # a part alone has no other part to meet
                 clear = f"meets {', '.join(move.met)}: FAILED" if move.met else "clear of the other parts"
                 out.append(f"move {k}/{len(self.moves)} ({move.move.part}): {clear}")
-            for s in move.segments:
+            for s, crossed in zip(move.segments, move.crossed):
                 seen[type(s)] += 1
                 count = f"{seen[type(s)]}/{totals[type(s)]}"
+                way = f"the pusher goes through {self._parts(crossed)}: FAILED" if crossed else "ok"
                 if isinstance(s, Push):
                     text = self._push_line(count, next(pushes))
                 elif isinstance(s, Transit):
                     text = (f"transit {count} (edge {s.from_edge} -> {s.to_edge}, {s.mode}, {s.duration:.3f} s): "
-                            "part still, flush on both edges: ok")
+                            f"part still, flush on both edges: {way}")
                 else:
                     text = (f"transfer {count} ({s.from_part} -> {s.to_part} edge {s.to_edge}, {s.mode}, "
-                            f"{s.duration:.3f} s): parts still, flush on both: ok")
+                            f"{s.duration:.3f} s): parts still, flush on both: {way}")
                 # The plan's own numbering, as --simulate and the CSV use.
                 out.append(f"segment {sum(seen.values())}/{len(segments)}: {text}")
         return out
+
+    def _parts(self, names: tuple[str, ...]) -> str:
+        """How a line names parts: "the part" when the scene has one."""
+        return "the part" if len(self.scene.parts) == 1 else ", ".join(names)
 
     def _push_line(self, count: str, p: PushCheck) -> str:
         """The verdict on push ``count`` (``k/n``) and what its runs did."""
@@ -334,6 +356,8 @@ class Verification:
             least += f" ({counted(below, 'push')} below the plan's margin, {self.margin})"
         elif self.margin is not None:
             least += f" (planned: {self.margin})"
+        if (through := sum(map(bool, (c for m in self.moves for c in m.crossed)))):
+            least += f"; the pusher goes through {self._parts(('a part',))} on {counted(through, 'segment')}"
         return (f"verify: {'passed' if self.passed else 'FAILED'}: {pushes} x "
                 f"{len(self.kinds)} distributions ({mix}); worst deviation {position:.2e} m, {angle:.2e} rad; "
                 f"chained drift {self.drift[0]:.2e} m, {self.drift[1]:.2e} rad "
@@ -484,6 +508,38 @@ def _meets(scene: Scene, move: Move, poses: dict[str, np.ndarray], other: str) -
     return not all(is_clear(only, model, s) for s in move.segments)
 
 
+def _goes_through(scene: Scene, segment: Transit | Transfer, name: str, pose: np.ndarray) -> bool:
+    """Whether ``segment``'s pusher, on the table, reaches deeper than :data:`REACH_IN` of its
+    radius into part ``name`` standing at ``pose`` (module docstring)."""
+    part = scene.part(name)
+    depth = REACH_IN * part.slider.radius
+    inner = scene.body(name, pose).buffer(-depth)
+    if inner.is_empty:  # a part thinner than the room left for rounding: nothing to go through
+        return False
+    # Walls are the file check's business (planner.execution.fit): kept far off, they cannot be
+    # mistaken for the part.
+    path = np.asarray(segment.pusher_path, dtype=float)[:, :2]
+    low, high = np.minimum(path.min(axis=0), inner.bounds[:2]), np.maximum(path.max(axis=0), inner.bounds[2:])
+    room = 1.0 + scene.pusher.width + scene.pusher.depth
+    alone = replace(scene.move_scene(name, {**scene.starts, name: pose}, others=False),
+                    obstacles=tuple(getattr(inner, "geoms", (inner,))),
+                    workspace=tuple(float(v) for v in (*(low - room), *(high + room))))
+    model = CollisionModel(alone, [])
+    return not all(model.pusher_move_is_free(a, b, depth / 2) for a, b in in_plane_moves(segment))
+
+
+def _crossings(scene: Scene, move: Move, poses: dict[str, np.ndarray]) -> tuple[tuple[str, ...], ...]:
+    """Per segment of ``move`` (its transfer first), the parts its pusher goes through, every part
+    where it stands then: ``poses`` as the move begins, its own part where each transit has it."""
+    out, standing = [], dict(poses)
+    for segment in [move.transfer] * (move.transfer is not None) + list(move.segments):
+        if isinstance(segment, Transit):
+            standing[move.part] = segment.pose
+        out.append(() if isinstance(segment, Push) else
+                   tuple(n for n in scene.names if _goes_through(scene, segment, n, standing[n])))
+    return tuple(out)
+
+
 def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: float = TOLERANCE, *,
            transit: str = DEFAULT_TRANSIT, regions: str = DEFAULT_REGIONS) -> Verification:
     """Re-simulate every push of ``plan`` under ``n`` support distributions of its part, and sweep
@@ -556,6 +612,7 @@ def verify(scene: Scene, plan: Plan, n: int = 200, seed: int = 1, tolerance: flo
             chained = exp_twist(chained, log_pose(segment.start, ends))
         drift = _deviation(part.slider, chained, move.end)
         met = tuple(other for other in scene.names if other != move.part and _meets(scene, move, poses, other))
-        moves.append(MoveCheck(move, tuple(checks), (float(drift[0].max()), float(drift[1].max())), met))
+        moves.append(MoveCheck(move, tuple(checks), (float(drift[0].max()), float(drift[1].max())), met,
+                               _crossings(scene, move, poses)))
     return Verification(scene, tuple(moves), supports_of, tuple(kinds), tolerance, time.perf_counter() - clock,
                         plan.margin)

@@ -21,7 +21,7 @@ import numpy as np
 
 from mechanics import wrap_angle
 
-__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "Limit", "SceneError", "counted", "integer", "keys", "member", "number", "pose", "pose_text", "poses", "shown",
+__all__ = ["ANGLE", "LENGTH", "MAX_SHOWN", "FileFieldError", "Limit", "SceneError", "counted", "integer", "keys", "member", "number", "pose", "pose_text", "poses", "shown",
            "vector"]
 
 #: Most characters of a bad value a message quotes: enough to recognise it, never a flood.
@@ -54,6 +54,11 @@ class SceneError(ValueError):
         self.field = _clipped(_printable(field), _MAX_FIELD)
         self.problem = _clipped(_printable(problem), _MAX_PROBLEM)
         super().__init__(f"{self.field}: {self.problem}")
+
+
+class FileFieldError(SceneError):
+    """A :class:`SceneError` naming a field of a file the command read (a scene's ``part:``), which
+    the command prints as it is, never as its flag of the same name (``--part``)."""
 
 
 _REPR = reprlib.Repr()
@@ -109,9 +114,11 @@ def member(name: str, key: Any) -> str:
     return text if name == "scene" else f"{name}.{text}"
 
 
-def keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str, ...] = ()) -> dict:
+def keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str, ...] = (),
+         suggest: tuple[str, ...] = ()) -> dict:
     """``value`` as a mapping with all of ``required`` and nothing but those and ``optional``; an
-    unknown key's error names the known key it most resembles, if one is close.
+    unknown key's error names the known key it most resembles, if one is close, or one of
+    ``suggest`` (keys of another form of the same thing, as a tray's ``parts``).
 
     >>> keys({"worksapce": 1}, "scene", ("workspace", "start"))
     Traceback (most recent call last):
@@ -126,7 +133,7 @@ def keys(value: Any, name: str, required: tuple[str, ...], optional: tuple[str, 
         raise SceneError(name, f"must be a mapping with keys {', '.join(required + optional)}")
     for key in value:
         if key not in required + optional:
-            close = difflib.get_close_matches(str(key), required + optional, n=1)
+            close = difflib.get_close_matches(str(key), required + optional + suggest, n=1)
             hint = f"; did you mean {close[0]}?" if close else f" (known: {', '.join(required + optional)})"
             raise SceneError(member(name, key), f"unknown key{hint}")
     for key in required:

@@ -55,6 +55,8 @@ MIN_TOLERANCE = 1e-9
 
 #: The keys of one part of ``parts:``: those of ``slider`` (or a CAD file's) and these.
 _PART_KEYS = ("name", "start", "goal", "edges")
+#: The keys of a scene of one part that a tray, with its ``parts:``, does not have.
+ONE_PART_KEYS = ("slider", "start", "goal")
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -330,8 +332,12 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     """
     if isinstance(data, dict) and "parts" in data:
         return _parse_parts(data, default_name, path)
-    spec = keys(data, "scene", ("slider", "pusher", "workspace", "start", "goal"),
-                ("name", "obstacles", "tolerance", "planner"))
+    required, optional = ("slider", "pusher", "workspace", "start", "goal"), ("name", "obstacles", "tolerance", "planner")
+    keys(data, "scene", (), required + optional, suggest=("parts",))  # a tray's "part:" is a typo of parts:
+    if not any(key in data for key in ONE_PART_KEYS):  # neither form: say both, not what one part misses
+        raise SceneError("parts", "missing: a scene has parts: (each with its own start and goal) or slider, start "
+                                  "and goal (one part)")
+    spec = keys(data, "scene", required, optional)
     name = read_name(spec.get("name", default_name))
     folder, notes = Path(path).parent if path else Path(), []
     slider = read_slider(spec["slider"], folder, notes)
@@ -410,7 +416,7 @@ def read_name(value: Any) -> str:
 
 def _parse_parts(data: dict, default_name: str, path: str | None) -> Scene:
     """:func:`parse_scene` of a mapping with ``parts:``."""
-    for key in ("slider", "start", "goal"):
+    for key in ONE_PART_KEYS:
         if key in data:
             raise SceneError(key, "a scene has parts: (each with its own start and goal) or slider, start and goal, "
                                   "not both")

@@ -197,12 +197,15 @@ def _closed(points: ArrayLike) -> np.ndarray:
 
 def _root(look: Look) -> str:
     """Where a part's entities lie (module docstring): ``world`` for the one part of a
-    ``slider:`` scene, ``world/parts/<name>`` for a named part.
+    ``slider:`` scene, ``world/parts/<name>`` for a named part, the name escaped as one part of
+    the path (a name may hold spaces or slashes, which rerun would otherwise warn of, or split on).
 
     >>> _root(Look((0, 0, 0), (0, 0, 0), (0, 0, 0), None)), _root(Look((0, 0, 0), (0, 0, 0), (0, 0, 0), "red"))
     ('world', 'world/parts/red')
+    >>> print(_root(Look((0, 0, 0), (0, 0, 0), (0, 0, 0), "red part/2")))
+    world/parts/red\\ part\\/2
     """
-    return "world" if look.name is None else f"world/parts/{look.name}"
+    return "world" if look.name is None else f"world/parts/{rr.escape_entity_path_part(look.name)}"
 
 
 def _analysed(scene: Scene, plan: Plan) -> tuple[str, int | None]:

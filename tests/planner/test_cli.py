@@ -27,6 +27,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+from ctrl_c import sigint_default
 from planner.model import files
 from planner.cli import main
 from planner.model.files import write_atomic
@@ -563,7 +564,7 @@ def test_ctrl_c_during_the_search_ends_as_interrupted(tmp_path):
     exit 130 and its one line, writing nothing, instead of ending as if out of time."""
     run = subprocess.Popen([sys.executable, "-m", "planner.cli", str(SCENES / "junction.yaml"), "--transit", "none",
                             "--time-limit", "60", "--out", str(tmp_path / "out")],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, preexec_fn=sigint_default)
     time.sleep(3.0)  # imports and regions (about a second, cold) are done: it is searching
     run.send_signal(signal.SIGINT)
     out, err = run.communicate(timeout=30)  # well before the time limit
@@ -576,6 +577,27 @@ def test_a_mistyped_key_gets_a_did_you_mean(tmp_path, capsys):
     (tmp_path / "typo.yaml").write_text(text)
     assert main([str(tmp_path / "typo.yaml"), "--out", str(tmp_path / "out")]) == 1
     assert capsys.readouterr().err == "plan: error: worksapce: unknown key; did you mean workspace?\n"
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("change, line", [
+    # A tray's parts: mistyped in a scene of one part's keys: the tray's key is suggested, not start.
+    (lambda text: yaml.safe_dump({"part": yaml.safe_load(text)["parts"][0], **{k: v for k, v in yaml.safe_load(text).items()
+                                                                                 if k != "parts"}}),
+     "plan: error: part: unknown key; did you mean parts?"),
+    # Neither form: say both, not what a scene of one part misses.
+    (lambda text: yaml.safe_dump({k: v for k, v in yaml.safe_load(text).items() if k != "parts"}),
+     "plan: error: parts: missing: a scene has parts: (each with its own start and goal) or slider, start and goal "
+     "(one part)"),
+    # A scene's field named as a flag is (--seed) is the file's, not the flag's.
+    (lambda text: text + "\nseed: 3\n", "plan: error: seed: unknown key (known: parts, pusher, workspace, name, "
+                                         "obstacles, tolerance, planner)")])
+def test_a_tray_file_with_a_wrong_key_is_told_about_the_tray_form(change, line, tmp_path, capsys):
+    """Issue 41: "part:" for "parts:" suggested "start", and a scene field named like a flag was
+    printed as the flag (--part)."""
+    (tmp_path / "tray.yaml").write_text(change((SCENES / "parts" / "swap.yaml").read_text()))
+    assert main([str(tmp_path / "tray.yaml"), "--out", str(tmp_path / "out")]) == 1
+    assert capsys.readouterr().err == line + "\n"
     assert not (tmp_path / "out").exists()
 
 

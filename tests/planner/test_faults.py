@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 import yaml
 
+from ctrl_c import sigint_default
 from planner.model.files import remove_orphans
 
 PLAN = Path(sys.executable).with_name("plan")
@@ -59,7 +60,8 @@ def start(tmp_path: Path, *args: str, cache: Path, **kwargs) -> subprocess.Popen
     """A `plan` run in its own session, so that all it starts shares its process group."""
     env = {**os.environ, "STABLEPUSH_CACHE": str(cache)}
     return subprocess.Popen([str(PLAN), *args], cwd=tmp_path, env=env, start_new_session=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kwargs)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=sigint_default,
+                            **kwargs)
 
 
 @pytest.fixture

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ctrl_c import sigint_default
 from planner import load_scene
 from planner.batch import BatchFailed, LocalExecutor, Outcome, make_tasks, run_batch
 from planner.batch.reach import reachable_set_on
@@ -310,6 +311,7 @@ def test_ctrl_c_while_the_workers_start_is_one_line(tmp_path):
     planner for a second or so: they start with it ignored, so only the command speaks."""
     runs = [subprocess.Popen([str(PLAN), *SCENES, "--seeds", "1:20", "--jobs", "2", "--out", str(tmp_path / f"o{k}")],
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                             preexec_fn=sigint_default,
                              env={**os.environ, "STABLEPUSH_CACHE": str(tmp_path / f"cache{k}")}) for k in range(2)]
     began = time.monotonic()
     for after, run in zip((0.8, 1.4), runs):

@@ -267,6 +267,58 @@ def test_a_transit_the_options_do_not_allow_names_its_mode(allowed, name):
     assert verify(scene, plan, n=2, transit=scene.options.transit).passed  # the scene's file allows it
 
 
+
+def _straight(t):
+    """The transit cut to its two contact poses: straight from one edge to the other."""
+    return dataclasses.replace(t, pusher_path=t.pusher_path[[0, -1]])
+
+
+def _flight_on_the_table(t):
+    """A lift's four poses (backed off each edge by its standoff) relabelled 'plane'."""
+    heading = t.pusher_path[[0, -1], 2]
+    back = 0.03 * np.c_[np.cos(heading), np.sin(heading), np.zeros(2)]
+    return dataclasses.replace(t, mode="plane", pusher_path=np.array(
+        [t.pusher_path[0], t.pusher_path[0] - back[0], t.pusher_path[-1] - back[1], t.pusher_path[-1]]))
+
+
+def _body_overlap(scene, transit) -> float:
+    """Independently of verify: the largest area the pusher's rectangle shares with the part at 21
+    poses along each straight piece of ``transit``'s path (shapely, no sweeping)."""
+    part = scene.body(scene.part().name, transit.pose)
+    w, d = scene.pusher.width / 2, scene.pusher.depth
+    worst = 0.0
+    for a, b in zip(transit.pusher_path, transit.pusher_path[1:]):
+        turn = (b[2] - a[2] + np.pi) % (2 * np.pi) - np.pi
+        for t in np.linspace(0, 1, 21):
+            x, y, th = a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * turn
+            c, s_ = np.cos(th), np.sin(th)
+            box = shapely.Polygon([(x + c * px - s_ * py, y + s_ * px + c * py) for px, py in
+                                   [(-d, -w), (0, -w), (0, w), (-d, w)]])
+            worst = max(worst, box.intersection(part).area)
+    return worst
+
+
+@pytest.mark.parametrize("doctor", [_straight, _flight_on_the_table], ids=["cut to its ends", "lift as plane"])
+def test_a_transit_whose_pusher_goes_through_the_part_fails(doctor):
+    """Issue 41: a transit that joins up (flush at both ends) but whose pusher crosses the part on
+    the way used to pass, its pushes being fine."""
+    scene, plan, k = switching("junction")
+    segments = list(plan.segments)
+    segments[k] = doctor(segments[k])
+    assert _body_overlap(scene, segments[k]) > 0.1 * scene.pusher.width * scene.pusher.depth
+    check = verify(scene, plan.with_segments(segments), n=2)
+    assert not check.passed and all(p.passed for p in check.pushes)
+    assert check.lines()[k].endswith("the pusher goes through the part: FAILED")
+    assert "the pusher goes through the part on 1 segment" in check.summary()
+
+
+def test_the_pusher_touching_the_part_only_at_its_contacts_is_not_going_through():
+    """The planner's own transits walk round the part, touching it only flush at their two ends."""
+    for name in ("junction", "narrow_junction"):
+        scene, plan, k = switching(name)
+        assert not any(verify(scene, plan, n=1, transit=scene.options.transit).moves[0].crossed)
+
+
 # -- recording ---------------------------------------------------------------------------------------
 
 def test_the_recording_shows_the_worst_run_as_a_ghost(tmp_path):
@@ -436,6 +488,25 @@ def test_a_transfer_that_does_not_reach_its_part_names_the_field():
     with pytest.raises(planner.SceneError) as err:
         verify(scene, dataclasses.replace(plan, moves=moves), n=2)
     assert err.value.field == f"plan.segments[{k}].pusher_path" and "starts at" in err.value.problem
+
+
+def test_a_transfer_straight_through_the_parts_fails_through_the_command(tmp_path):
+    """Issue 41: a plan/2 transfer cut to its ends (so straight across both parts) used to pass
+    ``--verify`` (exit 0); now the transfer's line names the parts it goes through, exit 3."""
+    scene, plan = release("swap")
+    data = json.loads(plan.to_json())
+    cut = [k for k, s in enumerate(data["segments"]) if s["kind"] == "transfer"]
+    for k in cut:
+        data["segments"][k]["pusher_path"] = data["segments"][k]["pusher_path"][:: len(data["segments"][k]["pusher_path"]) - 1]
+        data["segments"][k]["mode"] = "plane"
+    doctored = tmp_path / "doctored.json"
+    doctored.write_text(json.dumps(data))
+    run = subprocess.run([str(PLAN), str(ROOT / "scenes" / "parts" / "swap.yaml"), "--plan", str(doctored), "--verify", "2",
+                          "--out", "out"], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert run.returncode == 3, run.stdout + run.stderr
+    lines = [line for line in run.stdout.splitlines() if line.startswith("segment ")]
+    assert all("the pusher goes through" in lines[k] and lines[k].endswith(": FAILED") for k in cut)
+    assert "verify: FAILED" in run.stdout
 
 
 def test_a_plan_not_solved_is_refused():

@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import json
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +57,21 @@ def test_bad_fields_are_named(written, tmp_path, edit, field):
     with pytest.raises(SceneError) as err:
         load_plan(path)
     assert err.value.field == field
+
+
+@pytest.mark.parametrize("twist", [[1e300, 0.0, 0.0], [1e300, 1e300, 1e300]])
+def test_a_huge_twist_is_one_error_without_a_warning_first(written, tmp_path, twist):
+    """Issue 41: a twist of 1e300 overflowed in the length made from it, and numpy's RuntimeWarning
+    came out before the one error line."""
+    _, data = written
+    bad = copy.deepcopy(data)
+    bad["segments"][0]["twist"] = twist
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(SceneError) as err:
+            load_plan(tmp_path / "bad.json")
+    assert err.value.field == "plan.length" and err.value.problem.endswith("but the segments make inf")
 
 
 def test_cost_and_length_side_by_side(written):

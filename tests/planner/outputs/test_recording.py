@@ -621,6 +621,18 @@ def swap(tmp_path_factory):
     return scene, result, path
 
 
+def test_a_part_name_with_a_space_is_one_entity_without_a_warning(tmp_path):
+    """Issue 41: a part named "red part" made rerun print WARN lines (unescaped whitespace) for each
+    of its entities; the name is now escaped as one part of the entity path."""
+    text = (SCENES / "parts" / "swap.yaml").read_text().replace("name: red,", 'name: "red part",')
+    (tmp_path / "named.yaml").write_text(text)
+    run = subprocess.run([sys.executable, "-m", "planner.cli", str(tmp_path / "named.yaml"), "--out", "out"],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=120,
+                         env={**os.environ, "PYTHONPATH": str(SCENES.parent)})
+    assert run.returncode == 0 and run.stderr == "", run.stderr
+    assert {"/world/parts/red\\ part/slider", "/world/parts/blue/slider"} <= entities(tmp_path / "out" / "swap.rrd")
+
+
 def test_a_multi_part_recording_moves_every_part_on_one_timeline(swap):
     """Every part is its own labelled entity; at the last frame each outline is where the plan
     leaves the part (placed here from the scene's vertices), at the first where it starts; the
