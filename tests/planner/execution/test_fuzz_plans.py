@@ -20,7 +20,9 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import pytest
+import shapely
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
@@ -29,12 +31,16 @@ from planner.batch.results import COLUMNS, ResultsFile, is_record, summary
 from planner.batch.run import batch_records, reusable
 from planner.cli import read_inputs
 from planner.execution.fit import fit_plan
-from planner.model.plan_file import load_plan
+from planner.execution.verify import REACH_IN, verify
+from planner.model.plan_file import load_plan, read_plan
+from planner.model.scene_file import load_scene
 from planner.model.fields import SceneError
 from test_fuzz_scenes import assert_one_line_naming_a_field, inside, long_texts, mutate
 
 ROOT = Path(__file__).resolve().parents[3]
 PLANS = {name: json.loads((ROOT / "scenes" / "best" / f"{name}.json").read_text()) for name in ("battery", "junction")}
+# A plan/2 file of a tray (its previous release's plan of swap): moves, transfers, parts.
+PLANS["parts/swap"] = json.loads((ROOT / "tests" / "data" / "release_plans" / "swap.json").read_text())
 #: A tenth of the profile's examples: each example reads a scene and builds a collision model.
 FEW = settings(max_examples=max(10, settings().max_examples // 10))
 #: Seconds an example may take: the checks of a plan are bounded (planner.execution.fit.MAX_CHECKS).
@@ -82,7 +88,7 @@ def check_plan(folder: Path, name: str, content: bytes) -> None:
             scene, options, planner_options = read_inputs([str(ROOT / "scenes" / f"{name}.yaml"), "--verify=2",
                                                            "--plan=plan.json"])
             given = fit_plan(scene, load_plan(options.plan_file), transit=planner_options.transit)  # the run's first step
-            assert given.solved and (given.start == scene.start).all()
+            assert given.solved and all((given.starts[n] == scene.starts[n]).all() for n in scene.names)
         except SceneError as err:
             assert_one_line_naming_a_field(err)
             assert err.field.split(".")[0].split("[")[0] == "plan", str(err)
@@ -102,6 +108,96 @@ def test_mutated_plan_files(folder, case):
 def test_hostile_plan_text(folder, case):
     name, text = case
     check_plan(folder, name, text.encode("utf-8", "surrogatepass"))
+
+
+# --- pusher paths doctored: no wrong pass ------------------------------------------------------------------
+
+#: Plans whose pusher travels between contacts: junction's transit walks round its part, swap's two
+#: transfers go from one part to the other.
+TRAVELS = {"junction": "transit", "parts/swap": "transfer"}
+
+
+@st.composite
+def doctored_paths(draw: Callable) -> tuple[str, dict]:
+    """A plan whose transits or transfers have their pusher paths doctored: inner poses dropped or
+    moved (up to a part's size), or the mode relabelled (a lift's four poses, its flight then on the table)."""
+    name = draw(st.sampled_from(sorted(TRAVELS)))
+    doc = json.loads(json.dumps(PLANS[name]))
+    travels = [s for s in doc["segments"] if s["kind"] == TRAVELS[name]]
+    for segment in draw(st.lists(st.sampled_from(travels), min_size=1, max_size=len(travels))):
+        path = segment["pusher_path"]
+        how = draw(st.sampled_from(["drop", "move", "relabel"]))
+        if how == "drop" and len(path) > 2:
+            keep = sorted(draw(st.sets(st.integers(1, len(path) - 2), max_size=len(path) - 3)))
+            segment["pusher_path"] = [path[0], *(path[k] for k in keep), path[-1]]
+        elif how == "move" and len(path) > 2:
+            k = draw(st.integers(1, len(path) - 2))
+            offset = draw(st.tuples(*[st.floats(-0.06, 0.06)] * 2, st.floats(-1.0, 1.0)))
+            path[k] = [v + d for v, d in zip(path[k], offset)]
+        elif how == "relabel":
+            segment["mode"] = "lift" if segment["mode"] == "plane" and len(path) == 4 else "plane"
+    return name, doc
+
+
+def overlap(scene, plan) -> float:
+    """Independently of the planner: the largest area (m^2) the pusher's rectangle shares with a
+    part, over 41 poses of each of its moves on the table between contacts (a lift's flight, the
+    middle of its four poses, excepted), every part where it stands then (shapely only)."""
+    w, d = scene.pusher.width / 2, scene.pusher.depth
+    poses, worst = dict(plan.starts), 0.0
+    for move in plan.moves:
+        for segment in [move.transfer] * (move.transfer is not None) + list(move.segments):
+            if segment.kind == "push":
+                continue
+            if segment.kind == "transit":
+                poses[move.part] = segment.pose
+            parts = [scene.body(n, poses[n]) for n in scene.names]
+            path = np.asarray(segment.pusher_path, dtype=float)
+            pieces = [(0, 1), (2, 3)] if segment.mode == "lift" else list(zip(range(len(path) - 1), range(1, len(path))))
+            for a, b in ((path[i], path[j]) for i, j in pieces):
+                turn = (b[2] - a[2] + np.pi) % (2 * np.pi) - np.pi
+                for t in np.linspace(0.0, 1.0, 41):
+                    x, y, th = a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * turn
+                    c, s_ = np.cos(th), np.sin(th)
+                    box = shapely.Polygon([(x + c * px - s_ * py, y + s_ * px + c * py)
+                                           for px, py in [(-d, -w), (0, -w), (0, w), (-d, w)]])
+                    worst = max(worst, max(box.intersection(part).area for part in parts))
+        poses[move.part] = move.end
+    return worst
+
+
+@FEW
+@given(case=doctored_paths())
+def test_a_doctored_pusher_path_never_passes_verify_through_a_part(folder, case):
+    """Issue 41: whatever is done to the pusher's paths between contacts, ``--verify`` either
+    refuses the plan (one line), fails it, or passes it only if the pusher, sampled independently,
+    never reaches into a part (beyond twice the rounding room verify allows)."""
+    name, doc = case
+    (folder / "plan.json").write_text(json.dumps(doc))
+    with inside(folder):
+        try:
+            scene, options, planner_options = read_inputs([str(ROOT / "scenes" / f"{name}.yaml"), "--verify=1",
+                                                           "--plan=plan.json"])
+            given = fit_plan(scene, load_plan(options.plan_file), transit=planner_options.transit)
+            check = verify(scene, given, n=1, transit=planner_options.transit)
+        except SceneError as err:
+            assert_one_line_naming_a_field(err)
+            return
+    if check.passed:
+        allowed = 2 * REACH_IN * max(p.slider.radius for p in scene.parts) * scene.pusher.width
+        assert overlap(scene, given) <= allowed, "\n".join(check.lines())
+
+
+def test_the_doctored_paths_oracle_sees_a_path_through_the_part():
+    """The oracle above is not blind: the plans as shipped keep out, a transit cut to its ends does not."""
+    scene = load_scene(ROOT / "scenes" / "junction.yaml")
+    good = fit_plan(scene, read_plan(PLANS["junction"]))
+    assert overlap(scene, good) < 1e-9
+    doc = json.loads(json.dumps(PLANS["junction"]))
+    for segment in doc["segments"]:
+        if segment["kind"] == "transit":
+            segment["pusher_path"] = segment["pusher_path"][:: len(segment["pusher_path"]) - 1]
+    assert overlap(scene, fit_plan(scene, read_plan(doc))) > 1e-4
 
 
 # --- results files -----------------------------------------------------------------------------------
