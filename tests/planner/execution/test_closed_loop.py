@@ -43,6 +43,14 @@ def test_bad_perturbations_are_one_line_of_bad_input(tmp_path, capsys, argv, fla
     assert not (tmp_path / "out").exists()
 
 
+def test_a_pose_noise_of_minus_zero_is_no_noise():
+    """Issue 41: -0 passed the ">= 0" check and then failed in numpy ("scale < 0"), a traceback."""
+    from planner.cli import read_inputs
+
+    noise = read_inputs([BATTERY, "--simulate", "1", "--closed-loop", "--sim-pose-noise", "-0", "-0"]).options.pose_noise
+    assert noise == (0.0, 0.0) and all(math.copysign(1.0, v) == 1.0 for v in noise)
+
+
 def test_a_bump_after_the_run_is_bad_input_once_the_plan_says_how_long_it_is(tmp_path, capsys):
     assert main([BATTERY, "--simulate", "1", "--sim-bump", "1000", "0.01", "0", "0", "--out", str(tmp_path / "out")]) == 1
     err = capsys.readouterr().err

@@ -509,6 +509,21 @@ def test_a_transfer_straight_through_the_parts_fails_through_the_command(tmp_pat
     assert "verify: FAILED" in run.stdout
 
 
+@pytest.mark.parametrize("edge", [99, -1])
+def test_a_transfer_to_an_edge_the_part_has_not_is_one_line(edge, tmp_path, capsys):
+    """Issue 41: a plan/2 transfer with to_edge 99 or -1 was a ValueError traceback (the transfer
+    was checked before the move's edges)."""
+    scene, plan = release("swap")
+    data = json.loads(plan.to_json())
+    k = next(k for k, s in enumerate(data["segments"]) if s["kind"] == "transfer")
+    data["segments"][k]["to_edge"] = edge
+    (tmp_path / "bad.json").write_text(json.dumps(data))
+    assert main([str(ROOT / "scenes" / "parts" / "swap.yaml"), "--plan", str(tmp_path / "bad.json"), "--verify", "2",
+                 "--out", str(tmp_path / "out")]) == 1
+    assert error_field(capsys.readouterr().err) == f"plan.segments[{k}]"
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_plan_not_solved_is_refused():
     scene, plan = planned("battery")
     with pytest.raises(planner.SceneError) as err:
