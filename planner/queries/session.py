@@ -329,7 +329,9 @@ class Planner:
 
     def certify_unreachable(self, goal: ArrayLike | None = None, *, start: ArrayLike | None = None) -> str | None:
         """Why ``goal`` (default: the scene's) is certainly unreachable from ``start`` (default:
-        the scene's), or None if no certificate shows it (:mod:`planner.queries.reachability`)."""
+        the scene's), or None if no certificate shows it (:mod:`planner.queries.reachability`);
+        for a scene of one part."""
+        self.scene.one_part("certify_unreachable")
         return self._reason(self._pose(goal, "goal", self.scene.goal), self._pose(start, "start", self.scene.start))
 
     def _reason(self, goal: np.ndarray, start: np.ndarray) -> str | None:
@@ -344,6 +346,7 @@ class Planner:
         """The map of goal positions reachable from the scene's start in at most ``pushes`` (1 or
         2) stable pushes (:func:`planner.queries.reachable_set.reachable_set`), on this session's
         regions and collision model."""
+        self.scene.one_part("reachable_set")
         return reachable_set(self.scene, pushes, heading, resolution,
                              controls=None if self.world is None else self.world.controls, regions=self.options.regions,
                              margin=self.options.margin,

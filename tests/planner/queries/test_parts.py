@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 import yaml
 
+import planner
 from planner import Planner, load_scene, parse_scene
 from planner.model.fields import SceneError
 from planner.model.plan import Plan
@@ -291,3 +292,24 @@ def test_a_tray_with_a_part_of_two_microns_plans_within_a_memory_cap(tmp_path):
              if s["kind"] != "transfer" and (k == 0 or data["segments"][k - 1]["kind"] == "transfer")]
     assert len(moves) >= 3 and moves.count(moves[0]) == 2  # one of them left at a buffer pose, then fetched
     replay_parts_plan(spec, data)
+
+
+@pytest.mark.parametrize("query, ask", [
+    ("one_step", lambda scene, session: planner.one_step(scene, [0.0, 0.0, 0.0], [0.1, 0.0, 0.0])),
+    ("reachable_set", lambda scene, session: planner.reachable_set(scene)),
+    ("reachable_set", lambda scene, session: session.reachable_set()),
+    ("controllability", lambda scene, session: planner.controllability(scene)),
+    ("certify_unreachable", lambda scene, session: planner.certify_unreachable(scene, [0.0, 0.0, 0.0])),
+    ("certify_unreachable", lambda scene, session: session.certify_unreachable([0.0, 0.0, 0.0], start=[-0.1, 0.0, 0.0])),
+])
+def test_queries_of_one_part_refuse_a_tray_naming_the_scene(query, ask):
+    """The queries that answer for one part, asked of swap's two, say so in one line naming the
+    scene and the query and how to pick a part; the move scene of one part is then answered."""
+    scene = load_scene("scenes/parts/swap.yaml")
+    session = Planner(scene)
+    with pytest.raises(SceneError) as refused:
+        ask(scene, session)
+    assert refused.value.field == "scene" and query in refused.value.problem and "move_scene" in refused.value.problem
+    assert len(str(refused.value).splitlines()) == 1
+    one = scene.move_scene("red", scene.starts)
+    ask(one, Planner(one))
