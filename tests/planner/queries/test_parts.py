@@ -295,6 +295,8 @@ def test_a_tray_with_a_part_of_two_microns_plans_within_a_memory_cap(tmp_path):
 
 
 @pytest.mark.parametrize("query, ask", [
+    ("reachability", lambda scene, session: planner.reachability(scene, [[0.0, 0.0, 0.0]])),
+    ("reachability", lambda scene, session: session.reachability([[0.0, 0.0, 0.0]], start=[-0.1, 0.0, 0.0])),
     ("one_step", lambda scene, session: planner.one_step(scene, [0.0, 0.0, 0.0], [0.1, 0.0, 0.0])),
     ("reachable_set", lambda scene, session: planner.reachable_set(scene)),
     ("reachable_set", lambda scene, session: session.reachable_set()),
