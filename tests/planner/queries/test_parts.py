@@ -294,16 +294,22 @@ def test_a_tray_with_a_part_of_two_microns_plans_within_a_memory_cap(tmp_path):
     replay_parts_plan(spec, data)
 
 
-@pytest.mark.parametrize("query, ask", [
-    ("reachability", lambda scene, session: planner.reachability(scene, [[0.0, 0.0, 0.0]])),
-    ("reachability", lambda scene, session: session.reachability([[0.0, 0.0, 0.0]], start=[-0.1, 0.0, 0.0])),
-    ("one_step", lambda scene, session: planner.one_step(scene, [0.0, 0.0, 0.0], [0.1, 0.0, 0.0])),
-    ("reachable_set", lambda scene, session: planner.reachable_set(scene)),
-    ("reachable_set", lambda scene, session: session.reachable_set()),
-    ("controllability", lambda scene, session: planner.controllability(scene)),
-    ("certify_unreachable", lambda scene, session: planner.certify_unreachable(scene, [0.0, 0.0, 0.0])),
-    ("certify_unreachable", lambda scene, session: session.certify_unreachable([0.0, 0.0, 0.0], start=[-0.1, 0.0, 0.0])),
-])
+ASKED = {  # each query of one part, and what it is asked of a scene (or of a session of it)
+    "reachability": ("reachability", lambda scene, session: planner.reachability(scene, [[0.0, 0.0, 0.0]])),
+    "session.reachability": ("reachability", lambda scene, session: session.reachability([[0.0, 0.0, 0.0]],
+                                                                                          start=[-0.1, 0.0, 0.0])),
+    "one_step": ("one_step", lambda scene, session: planner.one_step(scene, [0.0, 0.0, 0.0], [0.1, 0.0, 0.0])),
+    "reachable_set": ("reachable_set", lambda scene, session: planner.reachable_set(scene)),
+    "session.reachable_set": ("reachable_set", lambda scene, session: session.reachable_set()),
+    "controllability": ("controllability", lambda scene, session: planner.controllability(scene)),
+    "certify_unreachable": ("certify_unreachable",
+                            lambda scene, session: planner.certify_unreachable(scene, [0.0, 0.0, 0.0])),
+    "session.certify_unreachable": ("certify_unreachable", lambda scene, session: session.certify_unreachable(
+        [0.0, 0.0, 0.0], start=[-0.1, 0.0, 0.0])),
+}
+
+
+@pytest.mark.parametrize("query, ask", ASKED.values(), ids=ASKED.keys())
 def test_queries_of_one_part_refuse_a_tray_naming_the_scene(query, ask):
     """The queries that answer for one part, asked of swap's two, say so in one line naming the
     scene and the query and how to pick a part; the move scene of one part is then answered."""
