@@ -108,5 +108,5 @@ def top_speed(outline: Sequence[np.ndarray], twist: ArrayLike) -> np.ndarray:
     >>> top_speed(body_outline(block, 0, 0.5, 0.1), [[0.0, 0.0, 1.0], [0.0, 2.0, 0.0]]).round(6).tolist()
     [1.414214, 2.0]
     """
-    v = np.asarray(twist, dtype=float)[..., None, :]
-    return np.max([np.linalg.norm(point_velocity(v, points), axis=-1).max(axis=-1) for points in outline], axis=0)
+    points = np.concatenate(outline)  # for each call: holding it for every edge is what the pair saves
+    return np.linalg.norm(point_velocity(np.asarray(twist, dtype=float)[..., None, :], points), axis=-1).max(axis=-1)

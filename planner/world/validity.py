@@ -195,22 +195,25 @@ class CollisionModel:
         """The clearance of the pusher alone (``key`` :data:`_PUSHER`) or of the part with the pusher
         on edge ``key`` where it is below ``enough``; where it is not, possibly only a lower bound
         that is itself at least ``enough``."""
-        at = tuple(float(v) for v in pose)
+        x, y, theta = pose
+        at = (float(x), float(y), float(theta))
+        placed: list = []  # the pose's fcl transform and obstacles nearest first, made once if asked for
         if key == _PUSHER:
-            return self._body_clearance(at, _PUSHER, enough)
+            return self._body_clearance(at, _PUSHER, enough, placed)
         if key not in self._bodies:
             self.body_pieces(key)
         if self._part_at is not None and self._part_at[0] == at and (self._part_at[1] < self._part_at[2]
                                                                      or self._part_at[2] >= enough):
             part = self._part_at[1]  # exact, or a lower bound at least as high as asked
         else:
-            part = self._body_clearance(at, _PART, enough)
+            part = self._body_clearance(at, _PART, enough, placed)
             self._part_at = (at, part, enough)
         # Below enough the least is exact; else each is a lower bound at least min(part, enough).
-        return part if part <= 0 else min(part, self._body_clearance(at, key, min(part, enough)))
+        return part if part <= 0 else min(part, self._body_clearance(at, key, min(part, enough), placed))
 
-    def _body_clearance(self, pose: tuple[float, float, float], key: int | str, enough: float) -> float:
-        """:meth:`_clearance` of body ``key`` alone."""
+    def _body_clearance(self, pose: tuple[float, float, float], key: int | str, enough: float, placed: list) -> float:
+        """:meth:`_clearance` of body ``key`` alone; ``placed`` holds what the bodies at ``pose``
+        share (filled by the first that needs it)."""
         pieces, hull, reach = self._bodies[key]
         x, y, theta = pose
         xmin, ymin, xmax, ymax = self.workspace
@@ -224,15 +227,16 @@ class CollisionModel:
             best = min(min(wx) - xmin, xmax - max(wx), min(wy) - ymin, ymax - max(wy))
         if best <= 0 or not self._obstacles:
             return best
-        bounds = sorted(
-            (math.hypot(max(bx0 - x, 0.0, x - bx1), max(by0 - y, 0.0, y - by1)) - reach, k)
-            for k, (bx0, by0, bx1, by1) in enumerate(self._boxes)
-        )
-        tf = fcl.Transform(np.array([math.cos(theta / 2), 0.0, 0.0, math.sin(theta / 2)]), np.array([x, y, 0.0]))
+        if not placed:
+            placed += [fcl.Transform(np.array([math.cos(theta / 2), 0.0, 0.0, math.sin(theta / 2)]),
+                                     np.array([x, y, 0.0])),
+                       sorted((math.hypot(max(bx0 - x, 0.0, x - bx1), max(by0 - y, 0.0, y - by1)), k)
+                              for k, (bx0, by0, bx1, by1) in enumerate(self._boxes))]
+        tf, nearest = placed
         for piece in pieces:
             piece.setTransform(tf)
-        for bound, k in bounds:
-            if bound >= min(best, enough):  # no obstacle left can be nearer, or matter
+        for distance, k in nearest:
+            if distance - reach >= min(best, enough):  # no obstacle left can be nearer, or matter
                 break
             for piece in pieces:
                 best = min(best, fcl.distance(piece, self._obstacles[k], self._request, fcl.DistanceResult()))
