@@ -107,20 +107,102 @@ class Slider:
 
     def inward_normal(self, i: int) -> np.ndarray:
         """Unit normal of edge ``i`` pointing into the part: the direction a pusher pushes it."""
-        a, b = self.edge(i)
-        d = (b - a) / np.linalg.norm(b - a)
-        return self.winding * np.array([-d[1], d[0]])
+        return self._inward_normals[self._check_edge(i)].copy()
+
+    @cached_property
+    def _inward_normals(self) -> np.ndarray:
+        # Every edge's at once: a part of a hundred thousand edges (a circle from CAD) asks for all.
+        d = np.roll(self.vertices, -1, axis=0) - self.vertices
+        d /= np.sqrt(d[:, None, :] @ d[:, :, None])[:, 0]  # each row's dot, as norm() of one edge rounds it
+        return self.winding * np.column_stack([-d[:, 1], d[:, 0]])
 
     def is_pushable(self, i: int) -> bool:
         """True if edge ``i`` lies on the convex hull, so a flat face can touch all of it."""
-        a, _ = self.edge(i)
-        depth = (self.vertices - a) @ self.inward_normal(i)
-        return bool(np.all(depth >= -1e-9 * self.radius))
+        return bool(self._on_hull[self._check_edge(i)])
 
     @cached_property
     def pushable_edges(self) -> tuple[int, ...]:
         """Indices of the edges on the convex hull."""
-        return tuple(i for i in range(self.n) if self.is_pushable(i))
+        return tuple(np.flatnonzero(self._on_hull).tolist())
+
+    @cached_property
+    def _on_hull(self) -> np.ndarray:
+        # Edge i is on the hull when no vertex lies beyond its line (depth below -1e-9 of the radius);
+        # the deepest vertex is the hull's farthest along the outward normal, found in O(log n).
+        return -self.extent(-self._inward_normals, self.vertices) >= -1e-9 * self.radius
+
+    @property
+    def hull(self) -> np.ndarray:
+        """The vertices of the part's convex hull (some of the part's, exactly), counter-clockwise,
+        those exactly on a line through their neighbours left out: where any convex function of
+        position (a point's speed, its distance to a wall) peaks over the part. Side ``j`` joins
+        vertex ``j`` to vertex ``j + 1``; the sides' directions ascend from the first, the one
+        nearest the x axis's (angle 0) counter-clockwise.
+
+        >>> Slider([[0, 2], [0, 1], [0, 0], [2, 0], [1, 1], [2, 2]]).hull.tolist()  # a notch on the right
+        [[0.0, 0.0], [2.0, 0.0], [2.0, 2.0], [0.0, 2.0]]
+        """
+        return self._hull_sides[0]
+
+    @cached_property
+    def _hull_sides(self) -> tuple[np.ndarray, np.ndarray]:
+        """:attr:`hull`, and the angles of its sides' directions in ``[0, 2 pi)``, ascending."""
+        ring = shapely.orient_polygons(shapely.convex_hull(shapely.multipoints(self.vertices))).exterior
+        hull = np.asarray(ring.coords)[:-1]
+        side = np.roll(hull, -1, axis=0) - hull
+        angles = np.arctan2(side[:, 1], side[:, 0]) % (2 * np.pi)
+        first = int(np.argmin(angles))
+        return np.roll(hull, -first, axis=0), np.roll(angles, -first)
+
+    def _sides_near(self, directions: np.ndarray) -> np.ndarray:
+        """For each of ``directions`` (shape ``(..., 2)``), three consecutive hull indices: the first
+        side that points at least a quarter turn left of it, whose first vertex reaches farthest
+        along it, and the two around it (against rounding of the angles). O(log n) a direction."""
+        angles = self._hull_sides[1]
+        quarter_left = (np.arctan2(directions[..., 1], directions[..., 0]) + np.pi / 2) % (2 * np.pi)
+        return (np.searchsorted(angles, quarter_left)[..., None] + np.arange(-1, 2)) % len(angles)
+
+    def extent(self, directions: ArrayLike, origin: ArrayLike = (0.0, 0.0)) -> np.ndarray:
+        """How far the part reaches along each of ``directions`` (shape ``(..., 2)``) from
+        ``origin`` (broadcast with them): the largest ``(v - origin) . d`` over its vertices
+        ``v``, found on the hull in O(log n) per direction instead of over all n vertices.
+
+        >>> s = Slider([[0, 0], [2, 0], [1, 1], [2, 2], [0, 2], [0, 1]])
+        >>> s.extent([[1, 0], [-1, 0], [1, 1], [0, -1]]).tolist()
+        [2.0, 0.0, 4.0, 0.0]
+        >>> s.extent([1, 0], origin=[2, 5]).tolist()
+        0.0
+        """
+        d = np.asarray(directions, dtype=float)
+        candidates = self.hull[self._sides_near(d)] - np.asarray(origin, dtype=float)[..., None, :]
+        return (candidates @ d[..., :, None])[..., 0].max(axis=-1)
+
+    def hull_side(self, edge: int) -> int:
+        """The side of :attr:`hull` (side ``j`` joins vertices ``j`` and ``j + 1``) that pushable
+        edge ``edge`` lies on.
+
+        >>> s = Slider([[0, 2], [0, 1], [0, 0], [2, 0], [1, 1], [2, 2]])
+        >>> s.pushable_edges, [s.hull_side(e) for e in s.pushable_edges]
+        ((0, 1, 2, 5), [3, 3, 0, 2])
+        """
+        e = self._check_edge(edge)
+        # Counter-clockwise, the edge begins at its first vertex; clockwise, at its second.
+        return int(self._hull_sides_of_vertices[e if self.winding > 0 else (e + 1) % self.n])
+
+    @cached_property
+    def _hull_sides_of_vertices(self) -> np.ndarray:
+        """Per vertex, the hull side it begins, or lies on, counter-clockwise: the boundary visits
+        the hull's vertices in the hull's order, so a vertex's side is that of the last hull
+        vertex at or before it. (The hull's vertices are some of the part's, exactly.)"""
+        index = {tuple(p): j for j, p in enumerate(self.hull.tolist())}
+        ccw = np.arange(self.n) if self.winding > 0 else np.arange(self.n)[::-1]
+        side = np.array([index.get(tuple(p), -1) for p in self.vertices[ccw].tolist()])
+        last = np.maximum.accumulate(np.where(side >= 0, np.arange(self.n), -1))
+        # Before the first hull vertex, the boundary is still on the side of the last one.
+        last[last < 0] = np.flatnonzero(side >= 0)[-1]
+        out = np.empty(self.n, dtype=int)
+        out[ccw] = side[last]
+        return out
 
     @cached_property
     def cf_depth(self) -> float:
@@ -134,11 +216,12 @@ class Slider:
 
     @cached_property
     def turns(self) -> tuple[int, ...]:
-        """The part's rotational symmetries about its CF, as vertex shifts: each ``r`` in
-        ``1..n-1`` such that a rotation about the CF carries every vertex ``k`` onto vertex
-        ``k + r`` (mod ``n``), within ``1e-10`` of the radius. It carries edge ``k`` onto edge
-        ``k + r`` with everything that acts on it (part, CF, a pusher centred on the edge), so
-        the two edges' pushes are the same in each edge's own frame.
+        """The part's rotational symmetries about its CF, as vertex shifts: the multiples ``r``
+        in ``1..n-1`` of the least shift ``d`` such that a rotation about the CF carries every
+        vertex ``k`` onto vertex ``k + d`` (mod ``n``), within ``1e-10`` of the radius (the turn
+        ``r`` is that rotation taken ``r / d`` times). It carries edge ``k`` onto edge ``k + r``
+        with everything that acts on it (part, CF, a pusher centred on the edge), so the two
+        edges' pushes are the same in each edge's own frame.
 
         >>> Slider([[-2, -1], [2, -1], [2, 1], [-2, 1]]).turns   # a rectangle: the half turn
         (2,)
@@ -147,14 +230,15 @@ class Slider:
         >>> Slider([[-2, -1], [2, -1], [2, 1], [-2, 1]], cf=[0.5, 0]).turns  # the CF off the centre
         ()
         """
+        # The turns are a group (two make a third), the multiples of the least, which divides n:
+        # trying n's divisors costs n times their count, not n^2 (a circle from CAD has every turn).
         rel = self.vertices - self.cf
-        found = []
-        for r in range(1, self.n):
+        for r in (r for r in range(1, self.n // 2 + 1) if self.n % r == 0):
             c, s = np.cos(self.turn_angle(r)), np.sin(self.turn_angle(r))
             turned = rel @ np.array([[c, s], [-s, c]])  # each row rotated
             if np.all(np.linalg.norm(turned - np.roll(rel, -r, axis=0), axis=1) <= 1e-10 * self.radius):
-                found.append(r)
-        return tuple(found)
+                return tuple(range(r, self.n, r))
+        return ()
 
     def turn_angle(self, r: int) -> float:
         """The angle (radians, in ``[-pi, pi)``) of the rotation about the CF that carries vertex

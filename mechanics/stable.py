@@ -211,7 +211,7 @@ def procedure_stable(
     n = slider.inward_normal(edge)
     t = np.array([n[1], -n[0]])
     e_l, e_r = sorted(slider.contact(edge, width), key=lambda e: float(e @ t))
-    c0, verts = slider.cf, slider.vertices
+    c0 = slider.cf
     alpha = np.arctan(mu)
     d_l = np.cos(alpha) * n - np.sin(alpha) * t
     d_r = np.cos(alpha) * n + np.sin(alpha) * t
@@ -219,16 +219,19 @@ def procedure_stable(
     p_l, p_r = np.linalg.norm(e_l - c0), np.linalg.norm(e_r - c0)
     u_l, u_r = (e_l - c0) / p_l, (e_r - c0) / p_r
 
-    def sense_rows(sense: int, d_near, d_far, u_near, p_near, u_far, p_far) -> np.ndarray:
+    reach_l, reach_r, back_l, back_r = slider.extent([d_l, d_r, -d_l, -d_r])  # how far the part reaches along each
+
+    def sense_rows(sense: int, d_near, reach_near, d_far, back_far, u_near, p_near, u_far, p_far) -> np.ndarray:
         # Steps 1 and 2 of STABLE, as read in docs/mechanics.md, "Procedure STABLE" (S1-S4; S1'-S4' mirrored).
         return np.array([
-            _halfplane_row(d_near, (verts @ d_near).max(), sense),
-            _halfplane_row(-d_far, -(verts @ d_far).min(), sense),
+            _halfplane_row(d_near, reach_near, sense),
+            _halfplane_row(-d_far, back_far, sense),
             _halfplane_row(u_near, c0 @ u_near + p_near / 2, sense),
             _halfplane_row(-u_far, -(c0 @ u_far) + k / p_far, sense),
         ])
 
-    rows = {1: sense_rows(1, d_l, d_r, u_l, p_l, u_r, p_r), -1: sense_rows(-1, d_r, d_l, u_r, p_r, u_l, p_l)}
+    rows = {1: sense_rows(1, d_l, reach_l, d_r, back_r, u_l, p_l, u_r, p_r),
+            -1: sense_rows(-1, d_r, reach_r, d_l, back_l, u_r, p_r, u_l, p_l)}
     # Translations: the line through the CF along the push meets the contact, within the cone.
     h = float(n @ (c0 - e_l))
     lo = max(-mu, float(t @ (e_l - c0)) / h)

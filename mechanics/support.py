@@ -52,7 +52,6 @@ import copy
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 import shapely
@@ -181,21 +180,25 @@ def _centre_directions() -> np.ndarray:
 
 def _triangle_around(x: np.ndarray, target: np.ndarray) -> np.ndarray:
     """Indices of three of the points ``x`` whose triangle holds ``target`` (a feasible simplex
-    basis): among corners of their hull (at most 16 evenly spread, else all), the one whose
-    smallest barycentric weight of ``target`` is largest.
+    basis): among at most 16 corners of their hull, evenly spread, the one whose smallest
+    barycentric weight of ``target`` is largest; failing that (``target`` near a side of the hull
+    they cut off), the same among the triangles fanned out from the first corner, which cover the
+    hull. Time and memory grow with the points, not their square (a part drawn as a circle of a
+    hundred thousand vertices has as many corners).
 
     >>> sorted(_triangle_around(np.array([[0.0, 0], [2, 0], [0, 2], [0.5, 0.5]]), np.array([0.5, 0.5])).tolist())
     [0, 1, 2]
     """
-    corners = np.asarray(shapely.MultiPoint(x).convex_hull.exterior.coords)[:-1]
-    index = np.argmin(np.linalg.norm(x[None] - corners[:, None], axis=2), axis=1)
-    for pick in (index[np.linspace(0, len(index), min(16, len(index)), endpoint=False).astype(int)], index):
-        triples = np.array(list(itertools.combinations(pick, 3)))
+    corners = shapely.points(np.asarray(shapely.MultiPoint(x).convex_hull.exterior.coords)[:-1])
+    index = shapely.STRtree(shapely.points(x)).query_nearest(corners, all_matches=False)[1]  # each corner is a point
+    spread = index[np.linspace(0, len(index), min(16, len(index)), endpoint=False).astype(int)]
+    fan = np.column_stack([np.full(len(index) - 2, index[0]), index[1:-1], index[2:]])
+    for triples in (np.array(list(itertools.combinations(spread, 3))), fan):
         m = np.stack([np.ones(triples.shape), x[triples, 0], x[triples, 1]], axis=1)  # columns: the corners
         ok = np.abs(np.linalg.det(m)) > 1e-12
         weights = np.linalg.solve(m[ok], np.broadcast_to(np.r_[1.0, target], (int(ok.sum()), 3))[..., None])[..., 0]
-        best = int(np.argmax(weights.min(axis=1)))
-        if weights[best].min() >= -1e-12:
+        best = int(np.argmax(weights.min(axis=1))) if len(weights) else 0
+        if len(weights) and weights[best].min() >= -1e-12:
             return triples[ok][best]
     raise ValueError("the target lies outside the samples' hull")
 

@@ -116,7 +116,7 @@ class EdgeCar:
     def reach(self) -> float:
         """Farthest point of the pushed body (part and pusher) from the CF: a body point moves at
         most ``1 + reach / radius`` times the CF's speed."""
-        return float(np.linalg.norm(self.push.outline - self.cf, axis=1).max())
+        return float(max(np.linalg.norm(points - self.cf, axis=1).max() for points in self.push.outline))
 
 
 def edge_car(push: EdgeControls, cf: ArrayLike) -> EdgeCar | None:

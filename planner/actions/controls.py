@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import DeadlineExceeded, PushRegion, StableSteering, point_velocity, stable_region
+from mechanics import DeadlineExceeded, PushRegion, StableSteering, stable_region
 
-from ..model.bodies import body_outline
+from ..model.bodies import body_outline, top_speed
 from ..model.segments import Push
 from .region_cache import RegionCache, compute_regions, edge_region, is_cached
 from ..model.fields import SceneError
@@ -51,12 +51,11 @@ class EdgeControls:
     edge: int
     region: PushRegion
     steering: StableSteering
-    outline: np.ndarray  # slider + pusher vertices, slider frame
+    outline: tuple[np.ndarray, np.ndarray]  # the body's outline, slider frame (planner.model.bodies.body_outline)
 
     def speed(self, twist: ArrayLike) -> np.ndarray:
         """Largest point speed of the body under ``twist`` (attained at an outline vertex)."""
-        v = np.asarray(twist, dtype=float)
-        return np.linalg.norm(point_velocity(v[..., None, :], self.outline), axis=-1).max(axis=-1)
+        return top_speed(self.outline, twist)
 
     def control_twist(self, u: ArrayLike) -> np.ndarray:
         """The unit-speed stable twist for control ``u`` in ``[0, 1]^2``."""
@@ -122,9 +121,9 @@ def edge_controls(scene: Scene, deadline: float | None = None, progress: Callabl
     method, (mu, rho) = regions, certified_for(scene, margin, regions)
     todo = [e for e in scene.edges if not is_cached(slider, e, mu, p.width, method, rho, cache)]
     computed = compute_regions(slider, todo, mu, p.width, rho, deadline, progress, cache=cache)
-    out, pending = [], []
+    out, pending, uncomputed = [], [], set(todo) - set(computed)
     for e in scene.edges:
-        if e in todo and e not in computed:
+        if e in uncomputed:
             pending.append(e)
             continue
         try:  # read from the cache, or computed again if its file turned out unreadable

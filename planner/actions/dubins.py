@@ -33,8 +33,9 @@ from .shortcut import farthest_first
 __all__ = ["WHOLE_PLAN_CARS", "DubinsCurves", "DubinsShortcut", "pieces"]
 
 #: Starting intervals per turning radius of curve length when cutting a curve into pieces (the
-#: halving finds every joint; this only bounds its depth).
-_SAMPLES_PER_RADIUS = 4
+#: halving finds every joint; this only bounds its depth), and the most of them: a curve of a metre
+#: turning at a micron (a part of microns) would otherwise be sampled millions of times.
+_SAMPLES_PER_RADIUS, _MOST_SAMPLES = 4, 4096
 #: Least relative gain for which a shortcut replaces a stretch of plan: its pieces are pushes
 #: too, and a push is not worth adding for less.
 _GAIN = 0.01
@@ -86,7 +87,7 @@ def pieces(curve, length: float, radius: float, tol: float = 1e-12) -> list[tupl
 
     if length <= 0:
         return []
-    n = max(2, math.ceil(_SAMPLES_PER_RADIUS * length / radius))
+    n = min(_MOST_SAMPLES, max(2, math.ceil(_SAMPLES_PER_RADIUS * length / radius)))
     grid = np.linspace(0.0, 1.0, n + 1)
     states = [np.asarray(curve(t), dtype=float) for t in grid]
     for k in range(n):

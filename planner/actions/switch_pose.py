@@ -42,6 +42,7 @@ import shapely
 from ..model.bodies import cf_poses, place
 from ..model.segments import Push, Transit, rechain
 from ..model.scene import Scene
+from ..world.grid import grid_spacing
 from ..world.validity import CollisionModel
 from .dubins import DubinsCurves
 from .transit import TransitPlanner
@@ -64,6 +65,9 @@ _ALONG = (0.25, 0.5, 0.75, 1.0)
 _CHUNK = 4096
 #: Fewest headings of the stage-1 grid (every 15 degrees).
 _LEAST_TURNS = 24
+#: Most CF positions of the stage-1 grid over the table, before the ellipse keeps a few (a part of
+#: microns would otherwise lay 10^11 at its spacing of half a radius).
+_MOST_CELLS = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -351,11 +355,12 @@ class SwitchShortcut:
     def _grid(self, begin: np.ndarray, end: np.ndarray, below: float, near: np.ndarray) -> np.ndarray:
         """Switch poses on the stage-1 grid through ``near`` whose CF is in the ellipse and
         where its disk fits: headings every :attr:`Grid.heading` degrees, or coarser (down to
-        every 15 degrees, then with the CF spacing doubled) to keep to :attr:`Grid.candidates`."""
+        every 15 degrees, then with the CF spacing doubled) to keep to :attr:`Grid.candidates`;
+        the CF spacing is never so fine that the table holds more than :data:`_MOST_CELLS`."""
         g = self.grid
         fa, fb, fn = place(self.cf[None], np.array([begin, end, near]))[:, 0]
         xmin, ymin, xmax, ymax = self._workspace
-        h = g.spacing * self.radius
+        h = grid_spacing(xmax - xmin, ymax - ymin, g.spacing * self.radius, _MOST_CELLS)
         while True:
             xs = fn[0] + h * np.arange(math.ceil((xmin - fn[0]) / h), math.floor((xmax - fn[0]) / h) + 1)
             ys = fn[1] + h * np.arange(math.ceil((ymin - fn[1]) / h), math.floor((ymax - fn[1]) / h) + 1)

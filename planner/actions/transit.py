@@ -29,7 +29,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import shapely
 from numpy.typing import ArrayLike
 
 from mechanics import Slider, transform_points, wrap_angle
@@ -201,22 +200,17 @@ class TransitPlanner:
         self.model, self.margin = model, margin
         self.standoff = standoff(scene)
         self.reach = float(np.linalg.norm(pusher_frame_body(scene.pusher.width, scene.pusher.depth), axis=1).max())
-        hull = shapely.orient_polygons(scene.slider.polygon.convex_hull)
-        self._hull = np.asarray(hull.exterior.coords)[:-1]  # counter-clockwise
+        slider = scene.slider
+        self._hull = slider.hull  # counter-clockwise
         along = np.roll(self._hull, -1, axis=0) - self._hull
         along /= np.linalg.norm(along, axis=1)[:, None]
         self._normal = np.c_[along[:, 1], -along[:, 0]]  # outward
         self._sides = {}  # edge -> (hull side, midpoint, outward normal)
         for e in edges:
-            a, b = scene.slider.edge(e)
-            mid, out = (a + b) / 2, -scene.slider.inward_normal(e)
-            self._sides[e] = (self._side_of(mid, out), mid, out)
+            a, b = slider.edge(e)
+            mid, out = (a + b) / 2, -slider.inward_normal(e)
+            self._sides[e] = (slider.hull_side(e), mid, out)
         self._cache: dict[tuple, Transit | None] = {}
-
-    def _side_of(self, mid: np.ndarray, out: np.ndarray) -> int:
-        """The hull side that holds a pushable edge: the same outward normal, through its midpoint."""
-        offset = np.abs(np.einsum("ij,ij->i", mid - self._hull, self._normal))
-        return int(np.argmin(offset + (1.0 - self._normal @ out)))
 
     def find(self, part_pose: ArrayLike, a: int, b: int) -> Transit | None:
         """The quickest free transit from edge ``a`` to edge ``b`` with the part at ``part_pose``, or None."""

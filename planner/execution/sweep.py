@@ -13,12 +13,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-import numpy as np
-
-from mechanics import point_velocity
-
 from ..actions.transit import in_plane_moves
-from ..model.bodies import body_outline
+from ..model.bodies import body_outline, top_speed
 from ..model.scene import Scene
 from ..model.segments import Push, Transfer, Transit
 from ..world.validity import CollisionModel, advances, pose_along
@@ -33,8 +29,7 @@ CLEARANCE = 1e-6
 
 def body_speed(scene: Scene, push: Push) -> float:
     """The largest speed of any point of the body (``scene``'s one part and the pusher) under ``push``'s twist."""
-    outline = body_outline(scene.slider, push.edge, scene.pusher.width, scene.pusher.depth)
-    return float(np.linalg.norm(point_velocity(push.twist, outline), axis=1).max())
+    return float(top_speed(body_outline(scene.slider, push.edge, scene.pusher.width, scene.pusher.depth), push.twist))
 
 
 def collision_model(scene: Scene, segments: Sequence[Push | Transit]) -> CollisionModel:

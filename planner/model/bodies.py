@@ -7,13 +7,16 @@ overlap the part).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike
 
-from mechanics import Slider, transform_points
+from mechanics import Slider, point_velocity, transform_points
 
-__all__ = ["body_outline", "cf_poses", "place", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at"]
+__all__ = ["body_outline", "cf_poses", "place", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at",
+           "top_speed"]
 
 
 def place(points: np.ndarray, poses: np.ndarray) -> np.ndarray:
@@ -83,8 +86,27 @@ def convex_pieces(polygon: shapely.Polygon) -> list[np.ndarray]:
     return [np.asarray(shapely.orient_polygons(p).exterior.coords)[:-1] for p in pieces]
 
 
-def body_outline(slider: Slider, edge: int, width: float, depth: float) -> np.ndarray:
-    """Vertices of the slider and of the pusher on ``edge`` (slider frame): the points where any
-    convex function of position, such as a point's speed or its distance to a wall, peaks."""
-    pusher = np.asarray(pusher_polygon(slider, edge, width, depth).exterior.coords)[:-1]
-    return np.vstack([slider.vertices, pusher])
+def body_outline(slider: Slider, edge: int, width: float, depth: float) -> tuple[np.ndarray, np.ndarray]:
+    """The points of the slider and of the pusher on ``edge`` (slider frame) where any convex
+    function of position, such as a point's speed or its distance to a wall, peaks: the part's
+    hull vertices (one array, :attr:`mechanics.Slider.hull`, shared by every edge: a part of a
+    hundred thousand edges would otherwise hold as many copies) and the pusher's four corners.
+
+    >>> block = Slider([[-1, 0], [1, 0], [0.5, 0.5], [1, 1], [-1, 1]])
+    >>> part, pusher = body_outline(block, 0, 0.5, 0.1)
+    >>> len(part), part is body_outline(block, 4, 0.5, 0.1)[0], len(pusher)
+    (4, True, 4)
+    """
+    return slider.hull, np.asarray(pusher_polygon(slider, edge, width, depth).exterior.coords)[:-1]
+
+
+def top_speed(outline: Sequence[np.ndarray], twist: ArrayLike) -> np.ndarray:
+    """The largest speed of any point of a body under each of ``twist`` (shape ``(..., 3)``),
+    ``outline`` being its :func:`body_outline`.
+
+    >>> block = Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]])
+    >>> top_speed(body_outline(block, 0, 0.5, 0.1), [[0.0, 0.0, 1.0], [0.0, 2.0, 0.0]]).round(6).tolist()
+    [1.414214, 2.0]
+    """
+    points = np.concatenate(outline)  # for each call: holding it for every edge is what the pair saves
+    return np.linalg.norm(point_velocity(np.asarray(twist, dtype=float)[..., None, :], points), axis=-1).max(axis=-1)

@@ -117,6 +117,20 @@ class Scene:
                 return p
         raise SceneError("part", f"no part is named {shown(name)} (the parts: {', '.join(self.names)})")
 
+    def one_part(self, query: str) -> None:
+        """Refuse this scene for ``query`` if it has several parts: ``query`` answers for one, and
+        the message says how to ask for one.
+
+        >>> from planner.model.scene_file import load_scene
+        >>> load_scene("scenes/parts/swap.yaml").one_part("one_step")
+        Traceback (most recent call last):
+        ...
+        planner.model.fields.SceneError: scene: has 2 parts; one_step answers for one part: pick one with scene.move_scene(name, scene.starts)
+        """
+        if len(self.parts) > 1:
+            raise SceneError("scene", f"has {len(self.parts)} parts; {query} answers for one part: pick one with "
+                                      "scene.move_scene(name, scene.starts)")
+
     @property
     def slider(self) -> Slider:
         """The one part's outline and CF."""

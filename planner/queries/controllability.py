@@ -136,6 +136,7 @@ def controllability(scene: Scene, *, regions: str = DEFAULT_REGIONS,
     >>> print(c.summary())
     controllable (edges 0, 1, 2, 3); small-time locally controllable with edges 0 and 2 (opposite faces)
     """
+    scene.one_part("controllability")
     try:
         pushes = edge_controls(scene, regions=regions, margin=margin)
     except SceneError as err:

@@ -34,16 +34,21 @@ import shapely
 
 from ..actions.controls import NoStablePush
 from ..actions.transit import edge_contact_pose
-from ..model.bodies import slider_at
+from ..model.bodies import place
 from ..model.options import PlannerOptions
 from ..model.scene import Scene
 from ..model.plan import Move, Plan
 from ..search.transfer import TransferPaths
+from ..world.grid import grid_spacing
 
-__all__ = ["BUFFER_TRIES", "MOVE_SHARE", "PartSession", "plan_parts"]
+__all__ = ["BUFFER_CELLS", "BUFFER_TRIES", "BUFFER_VERTICES", "MOVE_SHARE", "PartSession", "buffer_cells", "plan_parts"]
 
 #: Buffer poses tried for one part in one state, nearest its way first.
 BUFFER_TRIES = 4
+#: The buffer grid's most cells, and the most vertices of the part placed at them all
+#: (:func:`buffer_cells`): a part a radius apart on a metre's table makes hundreds of cells, a part
+#: of microns would make 10^11.
+BUFFER_CELLS, BUFFER_VERTICES = 4096, 1_000_000
 #: Share of the time limit one move's search may take (at least a second, or what is left).
 MOVE_SHARE = 0.1
 #: Rounding of poses (metres, radians) by which a state counts as seen.
@@ -56,6 +61,17 @@ class PartSession(Protocol):
     def certify_unreachable(self, goal: np.ndarray) -> str | None: ...
 
     def plan(self, *, goal: np.ndarray, seed: int, time_limit: float) -> Plan: ...
+
+
+def buffer_cells(vertices: int) -> int:
+    """The most cells of the buffer grid of a part of ``vertices`` vertices: :data:`BUFFER_CELLS`,
+    fewer for a part so detailed that placing it at them all would place more than
+    :data:`BUFFER_VERTICES` vertices, but never fewer than 64 (a grid of 8 x 8 at least).
+
+    >>> buffer_cells(4), buffer_cells(1000), buffer_cells(131072)
+    (4096, 1000, 64)
+    """
+    return min(BUFFER_CELLS, max(64, BUFFER_VERTICES // vertices))
 
 
 @dataclass
@@ -201,15 +217,16 @@ class _Search:
         return on_goal + [n for n in pending if n not in on_goal]
 
     def _buffers(self, name: str, poses: Mapping[str, np.ndarray], bodies: dict, pending: list[str]) -> list[np.ndarray]:
-        """Up to :data:`BUFFER_TRIES` poses to leave ``name`` at: on a grid of the workspace, at its
-        present heading, clear of obstacles, of the other parts and of every pending goal by the
-        pusher's depth and a part radius, nearest the way from where it is to its goal first."""
+        """Up to :data:`BUFFER_TRIES` poses to leave ``name`` at: on a grid of the workspace a part
+        radius apart (or coarser: :func:`buffer_cells`), at its present heading, clear of
+        obstacles, of the other parts and of every pending goal by the pusher's depth and a part
+        radius, nearest the way from where it is to its goal first."""
         scene = self.scene
         part = scene.part(name)
         radius = part.slider.radius
         room = scene.pusher.depth + radius
         xmin, ymin, xmax, ymax = scene.workspace
-        step = radius
+        step = grid_spacing(xmax - xmin - 2 * radius, ymax - ymin - 2 * radius, radius, buffer_cells(part.slider.n))
         xs, ys = np.meshgrid(np.arange(xmin + radius, xmax - radius + 1e-12, step),
                              np.arange(ymin + radius, ymax - radius + 1e-12, step))
         spots = np.column_stack([xs.ravel(), ys.ravel(), np.full(xs.size, poses[name][2])])
@@ -217,7 +234,7 @@ class _Search:
                  *(self.goals[n] for n in pending)]
         keep = shapely.union_all(taken).buffer(room) if taken else shapely.Polygon()
         inside = shapely.box(xmin, ymin, xmax, ymax)
-        outlines = [slider_at(part.slider.polygon, s) for s in spots]
+        outlines = shapely.polygons(place(part.slider.vertices, spots))
         ok = shapely.contains(inside, outlines) & ~shapely.intersects(keep, outlines)
         spots = spots[ok]
         if not len(spots):

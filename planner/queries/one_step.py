@@ -56,6 +56,7 @@ def one_step(scene: Scene, start: ArrayLike | None = None, goal: ArrayLike | Non
 
     Edges are tried in the order the scene allows them; the first that works is returned.
     """
+    scene.one_part("one_step")
     start = scene.start if start is None else pose(start, "start")
     goal = scene.goal if goal is None else pose(goal, "goal")
     pushes = edge_controls(scene, regions=regions, margin=margin)

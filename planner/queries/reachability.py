@@ -159,6 +159,7 @@ def certify_unreachable(scene: Scene, goal: ArrayLike | None = None, *, regions:
     >>> certify_unreachable(scene, [0.30, -0.15, 0.0]).split(" (")[0]  # inside the box in the way
     'collision: the part at the goal overlaps an obstacle or leaves the workspace'
     """
+    scene.one_part("certify_unreachable")
     goal = scene.goal if goal is None else poses(goal, "goal")[0]
     reason = Certificates(scene)(goal)
     if reason is None and regions and not scene.within_tolerance(scene.start, goal):

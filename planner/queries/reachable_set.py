@@ -140,6 +140,7 @@ def reachable_set(scene: Scene, pushes: int = 1, heading: float | None = None, r
     import time
 
     clock = time.perf_counter()
+    scene.one_part("reachable_set")
     if pushes not in (1, 2):
         raise SceneError("pushes", f"must be 1 or 2, got {pushes!r}")
     if heading is not None:

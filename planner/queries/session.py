@@ -52,7 +52,7 @@ from .multi_part import plan_parts
 from .reachability import Certificates, Reach, answers
 from .reachable_set import ReachableSet, reachable_set
 
-__all__ = ["Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
+__all__ = ["MAX_GOALS", "Planner", "REACH_BASE_S", "REACH_PER_GOAL_S", "REMEMBERED_GOALS", "REMEMBERED_PLANS", "plan",
            "reachability", "session_options"]
 
 #: Without a time limit, :meth:`Planner.reachability` grows its search for this long plus this
@@ -65,6 +65,9 @@ REMEMBERED_PLANS = 16
 #: Goals reached by reachability queries whose plans a session keeps (the most recent), for the
 #: queries after them.
 REMEMBERED_GOALS = 20_000
+#: Most goals one reachability query takes: every goal holds its answer (a plan, for one reached)
+#: until the query returns, so a larger batch is refused, not run out of memory: ask in batches.
+MAX_GOALS = 100_000
 
 
 class Planner:
@@ -242,51 +245,76 @@ class Planner:
                      pushes: int | None = None, time_limit: float | None = None,
                      seed: int | None = None, reuse: bool = True) -> list[Reach]:
         """One :class:`~planner.queries.reachability.Reach` per goal (rows ``(x, y, theta)``,
-        radians; default: the scene's goal) from ``start`` (default: the scene's).
+        radians; default: the scene's goal) from ``start`` (default: the scene's), for a scene of
+        one part; at most :data:`MAX_GOALS` goals a query.
 
         Each goal gets the certificates of unreachability
         (:mod:`planner.queries.reachability`); the goals left share one search tree grown towards
-        all of them for ``time_limit`` seconds (default: :data:`REACH_BASE_S` plus
-        :data:`REACH_PER_GOAL_S` per open goal, at most the options' time limit), seeded by
-        ``seed``. Every ``'reachable'`` answer carries a plan (as found, not shortened), every
-        ``'unreachable'`` a certificate; ``pushes`` is a budget of pushes beyond which a plan is
-        answered ``'unknown'``. With ``reuse``, what earlier queries from the same start reached
-        serves this one: a goal reached before is answered by its plan, and goals are also reached
-        from where plans to goals near them end (the session keeps :data:`REMEMBERED_GOALS` of
-        them); the answers then depend on the queries before, as a map drawn goal by goal grows.
+        all of them, seeded by ``seed``. ``time_limit`` bounds the whole query, the certificates
+        taking at most half of it (default: the certificates' time plus :data:`REACH_BASE_S` plus
+        :data:`REACH_PER_GOAL_S` per open goal, at most the options' time limit): a goal not
+        certified, nor reached, within it is answered ``'unknown'``, saying so. Every
+        ``'reachable'`` answer carries a plan (as found, not shortened), every ``'unreachable'`` a
+        certificate; ``pushes`` is a budget of pushes beyond which a plan is answered
+        ``'unknown'``. A pose asked several times is answered once: the copies share its answer.
+        With ``reuse``, what earlier queries from the same start reached serves this one: a goal
+        reached before is answered by its plan, and goals are also reached from where plans to
+        goals near them end (the session keeps :data:`REMEMBERED_GOALS` of them); the answers then
+        depend on the queries before, as a map drawn goal by goal grows.
 
         Raises
         ------
         SceneError
-            Naming the argument at fault.
+            Naming the argument at fault (``goals`` beyond :data:`MAX_GOALS`), or ``scene`` for a
+            scene of several parts.
         """
+        clock = time.perf_counter()
+        self.scene.one_part("reachability")
         start = self._pose(start, "start", self.scene.start)
         rows = self.scene.goal[None] if goals is None else poses(goals, "goals")
+        if len(rows) > MAX_GOALS:
+            raise SceneError("goals", f"{len(rows)} goals, more than {MAX_GOALS} a query: ask in batches")
         if pushes is not None and integer(pushes, "pushes") < 0:
             raise SceneError("pushes", f"must be >= 0, got {pushes}")
-        if time_limit is not None:
-            self._request(seed, time_limit)  # checked before any work
-        clock = time.perf_counter()
-        reasons = [self._reason(g, start) for g in rows]
-        self.timings = {"certificates": time.perf_counter() - clock, "connections": 0.0, "growth": 0.0}
+        limit = self._request(seed, time_limit).time_limit  # checked before any work; None: the options'
+        # Each pose once: the search tests a new state against the goals nearest it, so copies of a
+        # pose would crowd each other out there, and the same pose get different answers.
+        _, first, copies = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+        order = np.argsort(first, kind="stable")  # the poses in the order they were first asked
+        rank = np.empty_like(order)
+        rank[order] = np.arange(len(order))
+        unique = rows[first[order]]
+        reasons: list[str | None] = []
+        for goal in unique:
+            if time.perf_counter() >= clock + limit / 2:  # the rest of the time is the search's
+                break
+            reasons.append(self._reason(goal, start))
+        certified = time.perf_counter()
+        self.timings = {"certificates": certified - clock, "connections": 0.0, "growth": 0.0}
         if time_limit is None:
-            time_limit = min(self.options.time_limit, REACH_BASE_S + REACH_PER_GOAL_S * reasons.count(None))
-        request = self._request(seed, time_limit)
-        clock = time.perf_counter()
+            limit = min(limit, certified - clock + REACH_BASE_S + REACH_PER_GOAL_S * reasons.count(None))
         scene = self.scene if np.array_equal(start, self.scene.start) else self.scene.with_part(start=start)
-        if self.world is None and self._no_push is None:  # no region in time: nothing certain but the geometry
-            return [Reach("unreachable", None, r, None, scene, g, self.options) if r
-                    else Reach("unknown", None, self._timeout, None, scene, g, self.options)
-                    for g, r in zip(rows, reasons)]
-        context = None if self.world is None else PlanningContext(self.world, request, start, clock)
-        key = tuple(start.tolist())
-        found = answers(scene, self.options, context, reasons, rows, pushes, self.timings,
-                        self._reached.filed(key) if reuse else None)
-        if reuse:
-            for answer in found:
-                if answer.plan is not None and answer.plan.solved and answer.plan.segments:
-                    self._reached.file(key, tuple(answer.goal.tolist()), answer.plan.segments)
-        return found
+        if certified >= clock + limit:  # no time left to search: the goals open are not looked for
+            late = f"the time limit of {limit:g} s ran out before the search"
+            found = [Reach("unreachable", None, r, None, scene, g, self.options) if r
+                     else Reach("unknown", None, late, None, scene, g, self.options) for g, r in zip(unique, reasons)]
+        elif self.world is None and self._no_push is None:  # no region in time: nothing certain but the geometry
+            found = [Reach("unreachable", None, r, None, scene, g, self.options) if r
+                     else Reach("unknown", None, self._timeout, None, scene, g, self.options)
+                     for g, r in zip(unique, reasons)]
+        else:
+            context = (None if self.world is None
+                       else PlanningContext(self.world, self._request(seed, limit), start, clock))
+            key = tuple(start.tolist())
+            found = answers(scene, self.options, context, reasons, unique[:len(reasons)], pushes, self.timings,
+                            self._reached.filed(key) if reuse else None)
+            if reuse:
+                for answer in found:
+                    if answer.plan is not None and answer.plan.solved and answer.plan.segments:
+                        self._reached.file(key, tuple(answer.goal.tolist()), answer.plan.segments)
+        unchecked = f"not looked at: the certificates of the goals before it took their half of the time limit of {limit:g} s"
+        found += [Reach("unknown", None, unchecked, None, scene, g, self.options) for g in unique[len(reasons):]]
+        return [found[k] for k in rank[copies.ravel()].tolist()]
 
     def _plan_parts(self, start: object, goal: object, request: PlanRequest, edges: object) -> Plan:
         """:meth:`plan` of a scene of several parts: every part from its start to its goal, or as
@@ -329,7 +357,9 @@ class Planner:
 
     def certify_unreachable(self, goal: ArrayLike | None = None, *, start: ArrayLike | None = None) -> str | None:
         """Why ``goal`` (default: the scene's) is certainly unreachable from ``start`` (default:
-        the scene's), or None if no certificate shows it (:mod:`planner.queries.reachability`)."""
+        the scene's), or None if no certificate shows it (:mod:`planner.queries.reachability`);
+        for a scene of one part."""
+        self.scene.one_part("certify_unreachable")
         return self._reason(self._pose(goal, "goal", self.scene.goal), self._pose(start, "start", self.scene.start))
 
     def _reason(self, goal: np.ndarray, start: np.ndarray) -> str | None:
@@ -344,6 +374,7 @@ class Planner:
         """The map of goal positions reachable from the scene's start in at most ``pushes`` (1 or
         2) stable pushes (:func:`planner.queries.reachable_set.reachable_set`), on this session's
         regions and collision model."""
+        self.scene.one_part("reachable_set")
         return reachable_set(self.scene, pushes, heading, resolution,
                              controls=None if self.world is None else self.world.controls, regions=self.options.regions,
                              margin=self.options.margin,

@@ -6,6 +6,7 @@ shortcuts, built once for a scene and the session's options) and what one run ad
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -27,7 +28,12 @@ from ..model.scene import Scene
 from ..world.validity import CollisionModel
 from .goal_region import GoalRegion
 
-__all__ = ["PlanRequest", "PlanningContext", "SearchWorld", "cost", "length"]
+__all__ = ["DIRECT_CHUNK", "PlanRequest", "PlanningContext", "SearchWorld", "cost", "length"]
+
+#: Goals whose direct connections are looked for between two looks at the deadline: a goal costs
+#: up to a few milliseconds (its collision checks), so a batch of thousands stops within a fraction
+#: of a second of its time limit.
+DIRECT_CHUNK = 64
 
 
 @dataclass(frozen=True)
@@ -155,10 +161,10 @@ class SearchWorld:
             raise SceneError("start", "the pusher has room only on edges with no stable push")
         return starts
 
-    def goal_region(self, goals: ArrayLike, aim: bool = True) -> GoalRegion:
-        """The goal region of ``goals``, with switches where transits are allowed (``aim``: as
-        :class:`~planner.search.goal_region.GoalRegion`'s)."""
-        return GoalRegion(self.scene, goals, self.controls, self.model, self.margin, self.transits, aim)
+    def goal_region(self, goals: ArrayLike, aim: bool = True, deadline: float = math.inf) -> GoalRegion:
+        """The goal region of ``goals``, with switches where transits are allowed (``aim`` and
+        ``deadline``: as :class:`~planner.search.goal_region.GoalRegion`'s)."""
+        return GoalRegion(self.scene, goals, self.controls, self.model, self.margin, self.transits, aim, deadline)
 
     def shortcut_cheaply(self, segments: list[Push | Transit]) -> list[Push | Transit]:
         """:meth:`shortcut` but for the switch poses, which stay where they are."""
@@ -224,7 +230,7 @@ class PlanningContext:
                            segments, reason, self.world.note, tree, improvements)
 
     def goal_region(self, goals: ArrayLike) -> GoalRegion:
-        return self.world.goal_region(goals)
+        return self.world.goal_region(goals, deadline=self.deadline)
 
     def shortcut(self, segments: list[Push | Transit]) -> list[Push | Transit]:
         return self.world.shortcut(segments)
@@ -238,10 +244,16 @@ class PlanningContext:
         return self.direct_many(region, [goal], shorten).get(goal)
 
     def direct_many(self, region: GoalRegion, goals: list[int], shorten: bool = True) -> dict[int, list[Push | Transit]]:
-        """:meth:`direct` for each of ``goals`` (indices) that has one, screened for all at once."""
+        """:meth:`direct` for each of ``goals`` (indices) that has one, screened
+        :data:`DIRECT_CHUNK` at once on each start edge in turn; after the first chunk on the first
+        edge, only until the deadline (what is left is the caller's to answer: many goals, or a
+        part of many edges)."""
         found: dict[int, list[list[Push | Transit]]] = {}
-        for k in self.starts:
-            for g, pushes in region.pushes_to(self.start, k, goals).items():
+        chunks = [goals[first:first + DIRECT_CHUNK] for first in range(0, len(goals), DIRECT_CHUNK)]
+        for n, (chunk, k) in enumerate((chunk, k) for chunk in chunks for k in self.starts):
+            if n and time.perf_counter() >= self.deadline:
+                break
+            for g, pushes in region.pushes_to(self.start, k, chunk).items():
                 found.setdefault(g, []).append(self.world.shortcut(pushes) if shorten else pushes)
         switch_cost = self.world.options.switch_cost
         return {g: min(options, key=lambda d: cost(self.scene, d, switch_cost)) for g, options in found.items()}

@@ -42,6 +42,8 @@ Cheap screens come before the expensive ones, and none changes an answer:
 from __future__ import annotations
 
 import copy
+import math
+import time
 from collections import OrderedDict
 from collections.abc import Sequence
 
@@ -72,6 +74,9 @@ AIMS = ((2.0, 0.9), (1.1, 0.99))
 TRIES = 4
 #: Poses whose answers :meth:`GoalRegion.pushes_to` keeps (per edge and set of goals).
 REMEMBERED = 512
+#: Goals screened at once: the screen holds a pose per goal and waypoint (a hundred a goal), so a
+#: batch of a million goals (a map's cells, a reachability query) is screened a chunk at a time.
+CHUNK = 1024
 _SAMPLES = np.linspace(0.0, 1.0, 9)[1:-1]  # where along a push the part's CF is screened
 
 
@@ -79,9 +84,11 @@ class GoalRegion:
     """Where one or many goals are reached from: within tolerance, by one or two pushes on an
     edge, or (with ``transits``) by a switch to another edge and one or two pushes on it.
 
-    Many goals share the work: their waypoints are screened in one vectorised pass, so a search
-    tree grown towards a batch of goals (:func:`planner.reachability`) tests each new state
-    against all of them at about the cost of one.
+    Many goals share the work: their waypoints are screened in one vectorised pass (:data:`CHUNK`
+    goals at a time), so a search tree grown towards a batch of goals
+    (:func:`planner.reachability`) tests each new state against all of them at about the cost of
+    one. What a goal needs (its aims, the free-space pieces they lie in) is worked out when the
+    goal is first asked about, so setting up a region of many goals costs nothing per goal.
 
     Parameters
     ----------
@@ -94,45 +101,49 @@ class GoalRegion:
     transits : the pusher's transits between those edges, or None where it may not switch
     aim : bool
         Whether pushes may end anywhere within tolerance of a goal where the goal itself has too
-        little room (:meth:`_aims_of`); else they end exactly at it, or not at all.
+        little room (:meth:`_aims_at`); else they end exactly at it, or not at all.
+    deadline : float
+        A ``time.perf_counter()`` time after which :meth:`connections` tries no further edge to
+        switch to (a part of thousands of edges has as many to try from every state).
     """
 
     def __init__(self, scene: Scene, goals: ArrayLike, controls: list[EdgeControls], model: CollisionModel,
-                 margin: float, transits: TransitPlanner | None = None, aim: bool = True):
+                 margin: float, transits: TransitPlanner | None = None, aim: bool = True, deadline: float = math.inf):
         self.scene, self.controls, self.model, self.margin, self.transits = scene, controls, model, margin, transits
+        self.deadline = deadline
         self.goals = np.array(goals, dtype=float).reshape(-1, 3)
         self.goals[:, 2] = wrap_angle(self.goals[:, 2])
-        grid = np.array([(0.5, 0.0)] + [(a, b) for a in _U1 for b in _U2])
-        legs = np.array(_LEGS) * scene.slider.radius
-        self._aims = [self._aims_of(c.edge) if aim else self.goals for c in controls]
-        # Per edge: the waypoint pushes (unit speed: duration = distance) and, per goal, the
-        # waypoints themselves, back along each push from the goal's aim, shape (m, n, 3).
-        self._waypoints = []
-        for c, aims in zip(controls, self._aims):
-            w = np.repeat(c.control_twist(grid), len(legs), axis=0)
-            tau = np.tile(legs, len(grid))
-            self._waypoints.append((exp_twist(aims[:, None, :], -w, tau), w, tau))
+        # Per edge: each goal's aim (NaN: none; aim=False: the goal) and whether it is worked out yet.
+        self._aims = [np.full_like(self.goals, np.nan) if aim else self.goals for _ in controls]
+        self._aimed = [np.full(len(self.goals), not aim) for _ in controls]
+        # Per edge asked about, the waypoint pushes (unit speed: duration = distance); a goal's
+        # waypoints lie back along each from its aim.
+        self._legs: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         self._last_leg: dict[tuple[int, int, int], Push | None] = {}
         self._asked: OrderedDict[tuple, dict[int, list[Push]]] = OrderedDict()
         self._cf = scene.slider.cf
         self._pieces = Components(model.cf_room)
         # The pieces a goal's aims lie in (None: any, where one is on no piece): others are out of reach.
-        self._goal_pieces: list[set[int] | None] = [set() for _ in self.goals]
-        for aims in self._aims:
-            aimed = np.flatnonzero(~np.isnan(aims[:, 0]))
-            for g, label in zip(aimed.tolist(), self._pieces.label(self._cf_at(aims[aimed])).tolist()):
-                pieces = self._goal_pieces[g]
-                if pieces is not None:
-                    self._goal_pieces[g] = None if label < 0 else pieces | {int(label)}
+        self._goal_pieces: dict[int, set[int] | None] = {}
 
-    def _aims_of(self, edge: int) -> np.ndarray:
-        """Per goal, where pushes on ``edge`` aim: the goal itself where the part with the pusher
-        there has room (the first of :data:`AIMS`' clearances), else the nearest pose at its
-        heading that has, within that share of the position tolerance (a goal drawn against a
-        wall, say), trying each of :data:`AIMS` in turn; NaN where none has, so that no push on
-        that edge aims at it."""
-        aims = np.full_like(self.goals, np.nan)
-        for g, goal in enumerate(self.goals):
+    def _legs_of(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """The waypoint pushes of ``controls[k]`` (twists, durations), made when first asked for: a
+        part of many edges may use few of them, and each costs a look at every hull vertex."""
+        if k not in self._legs:
+            grid = np.array([(0.5, 0.0)] + [(a, b) for a in _U1 for b in _U2])
+            legs = np.array(_LEGS) * self.scene.slider.radius
+            self._legs[k] = (np.repeat(self.controls[k].control_twist(grid), len(legs), axis=0), np.tile(legs, len(grid)))
+        return self._legs[k]
+
+    def _aims_at(self, k: int, goals: np.ndarray) -> np.ndarray:
+        """Where pushes on ``controls[k]`` aim, for each of ``goals`` (indices): the goal itself
+        where the part with the pusher there has room (the first of :data:`AIMS`' clearances),
+        else the nearest pose at its heading that has, within that share of the position tolerance
+        (a goal drawn against a wall, say), trying each of :data:`AIMS` in turn; NaN where none
+        has, so that no push on that edge aims at it. Each is worked out once, when first asked."""
+        aims, edge = self._aims[k], self.controls[k].edge
+        for g in goals[~self._aimed[k][goals]].tolist():
+            goal = self.goals[g]
             if self.model.is_clear(goal, edge, AIMS[0][0] * self.margin):
                 aims[g] = goal
                 continue
@@ -142,7 +153,22 @@ class GoalRegion:
                 if aim is not None and self.model.is_clear(aim, edge, self.margin):
                     aims[g] = aim
                     break
-        return aims
+        self._aimed[k][goals] = True
+        return aims[goals]
+
+    def _pieces_of(self, goals: list[int]) -> list[set[int] | None]:
+        """The free-space pieces each of ``goals``' aims lie in (None: any), worked out once."""
+        new = np.array([g for g in dict.fromkeys(goals) if g not in self._goal_pieces], dtype=int)
+        if new.size:
+            found: dict[int, set[int] | None] = {g: set() for g in new.tolist()}
+            for k in range(len(self.controls)):
+                aims = self._aims_at(k, new)
+                aimed = ~np.isnan(aims[:, 0])
+                for g, label in zip(new[aimed].tolist(), self._pieces.label(self._cf_at(aims[aimed])).tolist()):
+                    if found[g] is not None:
+                        found[g] = None if label < 0 else found[g] | {int(label)}
+            self._goal_pieces.update(found)
+        return [self._goal_pieces[g] for g in goals]
 
     @property
     def goal(self) -> np.ndarray:
@@ -165,7 +191,7 @@ class GoalRegion:
         here = int(self._pieces.label(self._cf_at(np.asarray(pose, dtype=float)[None]))[0])
         if here < 0:
             return list(goals)
-        return [g for g in goals if self._goal_pieces[g] is None or here in self._goal_pieces[g]]
+        return [g for g, pieces in zip(goals, self._pieces_of(list(goals))) if pieces is None or here in pieces]
 
     def connections(self, pose: ArrayLike, k: int, goals: Sequence[int]) -> dict[int, list[Push | Transit]]:
         """Per goal index of ``goals`` reached from ``pose`` with the pusher on ``controls[k]``,
@@ -181,7 +207,7 @@ class GoalRegion:
             return found
         for other, c in enumerate(self.controls):
             rest = [g for g in rest if g not in found]
-            if not rest:
+            if not rest or time.perf_counter() >= self.deadline:
                 break
             if other == k or not (lasts := self.pushes_to(pose, other, rest)):
                 continue
@@ -204,15 +230,24 @@ class GoalRegion:
         return self._asked[key]
 
     def _pushes_to(self, pose: np.ndarray, k: int, goals: Sequence[int]) -> dict[int, list[Push]]:
-        controls, aims = self.controls[k], self._aims[k]
+        found: dict[int, list[Push]] = {}
         goals = np.asarray(goals, dtype=int)
-        goals = goals[~np.isnan(aims[goals, 0])]
+        for first in range(0, len(goals), CHUNK):
+            found.update(self._chunk_pushes_to(pose, k, goals[first:first + CHUNK]))
+        return found
+
+    def _chunk_pushes_to(self, pose: np.ndarray, k: int, goals: np.ndarray) -> dict[int, list[Push]]:
+        """:meth:`_pushes_to` of at most :data:`CHUNK` goals."""
+        controls = self.controls[k]
+        aims = self._aims_at(k, goals)
+        goals, aims = goals[~np.isnan(aims[:, 0])], aims[~np.isnan(aims[:, 0])]
         found: dict[int, list[Push]] = {}
         if goals.size == 0:
             return found
-        poses, w, tau = self._waypoints[k]
+        w, tau = self._legs_of(k)
+        poses = exp_twist(aims[:, None, :], -w, tau)  # each goal's waypoints, shape (goals, waypoints, 3)
         # One screen for all: COR_total to each goal's aim (column 0) and to each of its waypoints.
-        total = log_pose(pose, np.concatenate([aims[goals, None], poses[goals]], axis=1))
+        total = log_pose(pose, np.concatenate([aims[:, None], poses], axis=1))
         ok = controls.region.contains(total.reshape(-1, 3)).reshape(total.shape[:2])
         for row, g in enumerate(goals.tolist()):
             # The goal itself first, then the waypoints, shortest two pushes first.
@@ -225,28 +260,29 @@ class GoalRegion:
             along = exp_twist(pose, (total[row, columns] / speed[:, None])[:, None], speed[:, None] * _SAMPLES)
             columns = columns[~self.model.surely_blocked(along).any(axis=1)]
             if columns.size and columns[0] == 0:
-                one = connect(pose, aims[g], controls, self.model, self.margin, total=total[row, 0])
+                one = connect(pose, aims[row], controls, self.model, self.margin, total=total[row, 0])
                 if isinstance(one, Push):
                     found[g] = [one]
                     continue
                 columns = columns[1:]
             for i in columns[:TRIES] - 1:
-                last = self._final_push(k, g, int(i))
+                last = self._final_push(k, g, int(i), poses[row, i])
                 if last is None:
                     continue
-                lead = connect(pose, poses[g, i], controls, self.model, self.margin, total=total[row, 1 + i])
+                lead = connect(pose, poses[row, i], controls, self.model, self.margin, total=total[row, 1 + i])
                 if isinstance(lead, Push):
                     found[g] = [lead, Push(last.edge, last.contact, last.twist, last.duration, lead.end, last.end)]
                     break
         return found
 
-    def _final_push(self, k: int, g: int, i: int) -> Push | None:
-        """The push from waypoint ``i`` of edge ``k`` to goal ``g``, if collision-free (cached)."""
+    def _final_push(self, k: int, g: int, i: int, waypoint: np.ndarray) -> Push | None:
+        """The push from ``waypoint``, waypoint ``i`` of edge ``k`` for goal ``g``, to the goal's
+        aim, if collision-free (cached)."""
         if (k, g, i) not in self._last_leg:
-            poses, w, tau = self._waypoints[k]
+            w, tau = self._legs_of(k)
             c = self.controls[k]
-            free = self.model.push_is_free(poses[g, i], w[i], tau[i], c.edge, self.margin)
-            start = poses[g, i].copy()
+            free = self.model.push_is_free(waypoint, w[i], tau[i], c.edge, self.margin)
+            start = waypoint.copy()
             start[2] = wrap_angle(start[2])
             self._last_leg[(k, g, i)] = (
                 Push(c.edge, c.region.contact, w[i], float(tau[i]), start, self._aims[k][g].copy()) if free else None)

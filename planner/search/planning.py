@@ -23,6 +23,7 @@ from collections import deque
 from collections.abc import Callable, Container, Iterable, Iterator, Mapping, Sequence
 
 import numpy as np
+import shapely
 from ompl import base as ob
 from ompl import control as oc
 from ompl import util as ou
@@ -206,8 +207,10 @@ class _Hops:
         rest = [g for g in range(len(self.region.goals)) if g not in self.found]
         if not plans or not rest:
             return []
-        ends = np.array([p[-1].end[:2] for p in plans])
-        nearest = np.linalg.norm(ends[:, None, :] - self.region.goals[rest][None, :, :2], axis=-1).min(axis=1)
+        ends = shapely.points(np.array([p[-1].end[:2] for p in plans]))
+        # A tree of the goals, not every end against every goal: both may number a hundred thousand.
+        _, nearest = shapely.STRtree(shapely.points(self.region.goals[rest][:, :2])).query_nearest(
+            ends, all_matches=False, return_distance=True)
         order = [i for i in np.argsort(nearest, kind="stable")[:HOP_SOURCES] if nearest[i] <= self._reach]
         return [plans[i] for i in order]
 

@@ -38,7 +38,8 @@ from ..model.scene import Scene
 __all__ = ["CollisionModel", "advances", "pose_along"]
 
 _HEIGHT = 1.0  # every 2-D shape is a prism over the same z-range
-_PUSHER = "pusher"  # the key of the pusher's own body, beside the per-edge bodies
+_PUSHER = "pusher"  # the key of the pusher's own body (its frame), beside the per-edge pushers' (the part's)
+_PART = "part"  # the key of the part's body
 #: Below this turning rate (rad/s, for unit-speed twists) a push is taken as a translation, off by
 #: at most 1e-8 t^2 m; above it the centre of rotation is near enough (|v| / omega <= 5e7 m) that
 #: rounding its position costs about as little.
@@ -121,15 +122,18 @@ class CollisionModel:
         pieces = [p for o in scene.obstacles for p in convex_pieces(o)]
         self._obstacles = [fcl.CollisionObject(_prism(p)) for p in pieces]
         self._boxes = [(*p.min(axis=0).tolist(), *p.max(axis=0).tolist()) for p in pieces]
-        # Per body: its convex pieces, outline vertices (as floats) and farthest point from its origin.
-        # An edge's body is made when first asked for: a part of many edges may use few of them.
-        self._bodies: dict[int | str, tuple[list[fcl.CollisionObject], list, float]] = {}
+        # Per body: its convex pieces, outline vertices (as floats: body_outline) and farthest point
+        # from its origin. The body of a push is the part's and the pusher's on the edge, each
+        # checked on its own (a union's clearance is the least of its members'): the part's is made
+        # once and its clearance at a pose reused for every edge (a part of many edges would
+        # otherwise cost as many copies, and a pose checked on each edge as many checks of the part).
+        # A pusher's body is made when first asked for: a part of many edges may use few of them.
+        self._bodies: dict[int | str, tuple[list[fcl.CollisionObject], list[list], float]] = {}
         p = scene.pusher
         self._slider, self._width, self._depth, self.edges = scene.slider, p.width, p.depth, tuple(edges)
-        # The part's pieces are made once and shared by every edge's body (each check places the
-        # pieces it uses first): a part of many edges would otherwise cost as many copies.
         self.part_pieces = convex_pieces(scene.slider.polygon)
-        self._part = [fcl.CollisionObject(_prism(s)) for s in self.part_pieces]
+        self._add(_PART, [fcl.CollisionObject(_prism(s)) for s in self.part_pieces], scene.slider.hull)
+        self._part_at: tuple[tuple[float, float, float], float, float] | None = None  # pose, clearance, enough
         self._pieces: dict[int, list[np.ndarray]] = {}
         alone = pusher_frame_body(p.width, p.depth)
         self._add(_PUSHER, [fcl.CollisionObject(_prism(alone))], alone)
@@ -151,8 +155,8 @@ class CollisionModel:
                 raise KeyError(edge)
             pusher = convex_pieces(pusher_polygon(self._slider, edge, self._width, self._depth))
             self._pieces[edge] = self.part_pieces + pusher
-            self._add(edge, self._part + [fcl.CollisionObject(_prism(s)) for s in pusher],
-                      body_outline(self._slider, edge, self._width, self._depth))
+            self._add(edge, [fcl.CollisionObject(_prism(s)) for s in pusher],
+                      body_outline(self._slider, edge, self._width, self._depth)[1])
         return self._pieces[edge]
 
     def clearance(self, pose: ArrayLike, edge: int) -> float:
@@ -188,12 +192,30 @@ class CollisionModel:
         return self._clearance(pose, edge, distance) > distance
 
     def _clearance(self, pose: ArrayLike, key: int | str, enough: float = math.inf) -> float:
-        """The clearance where it is below ``enough``; where it is not, possibly only a lower bound
+        """The clearance of the pusher alone (``key`` :data:`_PUSHER`) or of the part with the pusher
+        on edge ``key`` where it is below ``enough``; where it is not, possibly only a lower bound
         that is itself at least ``enough``."""
+        x, y, theta = pose
+        at = (float(x), float(y), float(theta))
+        placed: list = []  # the pose's fcl transform and obstacles nearest first, made once if asked for
+        if key == _PUSHER:
+            return self._body_clearance(at, _PUSHER, enough, placed)
         if key not in self._bodies:
             self.body_pieces(key)
+        if self._part_at is not None and self._part_at[0] == at and (self._part_at[1] < self._part_at[2]
+                                                                     or self._part_at[2] >= enough):
+            part = self._part_at[1]  # exact, or a lower bound at least as high as asked
+        else:
+            part = self._body_clearance(at, _PART, enough, placed)
+            self._part_at = (at, part, enough)
+        # Below enough the least is exact; else each is a lower bound at least min(part, enough).
+        return part if part <= 0 else min(part, self._body_clearance(at, key, min(part, enough), placed))
+
+    def _body_clearance(self, pose: tuple[float, float, float], key: int | str, enough: float, placed: list) -> float:
+        """:meth:`_clearance` of body ``key`` alone; ``placed`` holds what the bodies at ``pose``
+        share (filled by the first that needs it)."""
         pieces, hull, reach = self._bodies[key]
-        x, y, theta = (float(v) for v in pose)
+        x, y, theta = pose
         xmin, ymin, xmax, ymax = self.workspace
         # The body lies in the disc of radius reach about (x, y): lower bounds, walls and obstacles.
         best = min(x - xmin, xmax - x, y - ymin, ymax - y) - reach
@@ -205,15 +227,16 @@ class CollisionModel:
             best = min(min(wx) - xmin, xmax - max(wx), min(wy) - ymin, ymax - max(wy))
         if best <= 0 or not self._obstacles:
             return best
-        bounds = sorted(
-            (math.hypot(max(bx0 - x, 0.0, x - bx1), max(by0 - y, 0.0, y - by1)) - reach, k)
-            for k, (bx0, by0, bx1, by1) in enumerate(self._boxes)
-        )
-        tf = fcl.Transform(np.array([math.cos(theta / 2), 0.0, 0.0, math.sin(theta / 2)]), np.array([x, y, 0.0]))
+        if not placed:
+            placed += [fcl.Transform(np.array([math.cos(theta / 2), 0.0, 0.0, math.sin(theta / 2)]),
+                                     np.array([x, y, 0.0])),
+                       sorted((math.hypot(max(bx0 - x, 0.0, x - bx1), max(by0 - y, 0.0, y - by1)), k)
+                              for k, (bx0, by0, bx1, by1) in enumerate(self._boxes))]
+        tf, nearest = placed
         for piece in pieces:
             piece.setTransform(tf)
-        for bound, k in bounds:
-            if bound >= min(best, enough):  # no obstacle left can be nearer, or matter
+        for distance, k in nearest:
+            if distance - reach >= min(best, enough):  # no obstacle left can be nearer, or matter
                 break
             for piece in pieces:
                 best = min(best, fcl.distance(piece, self._obstacles[k], self._request, fcl.DistanceResult()))

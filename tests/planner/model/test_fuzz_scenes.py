@@ -251,14 +251,14 @@ def root(err: SceneError) -> str:
     return ROOT_END.split(err.field, maxsplit=1)[0]
 
 
-def assert_one_line_naming_a_field(err: SceneError) -> None:
+def assert_one_line_naming_a_field(err: SceneError, roots: set[str] = ROOTS) -> None:
     """The message is ``field: problem``, one printable line of at most 300 characters, and names a
-    field: one under a known root, or a key unknown or given twice, named as itself."""
+    field: one under a known root (of ``roots``), or a key unknown or given twice, named as itself."""
     message = str(err)
     assert err.field and err.problem and message == f"{err.field}: {err.problem}"
     assert message.isprintable() and len(message.splitlines()) == 1, message
     assert len(message) <= 300, message
-    assert root(err) in ROOTS or err.problem.startswith("unknown key") or err.problem.startswith("duplicate key"), message
+    assert root(err) in roots or err.problem.startswith("unknown key") or err.problem.startswith("duplicate key"), message
 
 
 def assert_sane(scene: Scene) -> None:

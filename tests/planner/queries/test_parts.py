@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import copy
 import json
+import subprocess
+import sys
+import time
 from pathlib import Path
 
-import numpy as np
 import pytest
 import yaml
 
+import planner
 from planner import Planner, load_scene, parse_scene
 from planner.model.fields import SceneError
 from planner.model.plan import Plan
@@ -265,3 +268,56 @@ def test_a_picture_of_a_multi_part_plan_holds_its_headline(plans, tmp_path):
 
     draw_plan(load_scene("scenes/parts/swap.yaml"), plans["swap"], str(tmp_path / "swap.png"))
     assert Image.open(tmp_path / "swap.png").text["Description"] == f"swap: {plans['swap'].headline()}"
+
+
+def test_a_tray_with_a_part_of_two_microns_plans_within_a_memory_cap(tmp_path):
+    """Swap with its red block shrunk to a square of 2 um: the buffer grid was spaced a part radius
+    apart (2.55 TiB asked for, a MemoryError); now each grid is held to a number of cells the
+    table sets (planner.world.grid), so under a 4 GB address space the plan comes in seconds, the
+    tiny part pushed aside and fetched, and replays."""
+    spec = spec_of("swap")
+    spec["parts"][0]["vertices"] = [[-1e-6, -1e-6], [1e-6, -1e-6], [1e-6, 1e-6], [-1e-6, 1e-6]]
+    path = tmp_path / "tiny.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    script = (f"import resource\nresource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))\n"
+              f"from planner import Planner, load_scene\n"
+              f"print(Planner(load_scene({str(path)!r}), {{'seed': 1, 'time_limit': 30, 'margin': 0}}).plan().to_json())\n")
+    began = time.perf_counter()
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert time.perf_counter() - began < 120.0
+    data = json.loads(run.stdout)
+    assert data["solved"], data["reason"]
+    moves = [s["part"] for k, s in enumerate(data["segments"])
+             if s["kind"] != "transfer" and (k == 0 or data["segments"][k - 1]["kind"] == "transfer")]
+    assert len(moves) >= 3 and moves.count(moves[0]) == 2  # one of them left at a buffer pose, then fetched
+    replay_parts_plan(spec, data)
+
+
+ASKED = {  # each query of one part, and what it is asked of a scene (or of a session of it)
+    "reachability": ("reachability", lambda scene, session: planner.reachability(scene, [[0.0, 0.0, 0.0]])),
+    "session.reachability": ("reachability", lambda scene, session: session.reachability([[0.0, 0.0, 0.0]],
+                                                                                          start=[-0.1, 0.0, 0.0])),
+    "one_step": ("one_step", lambda scene, session: planner.one_step(scene, [0.0, 0.0, 0.0], [0.1, 0.0, 0.0])),
+    "reachable_set": ("reachable_set", lambda scene, session: planner.reachable_set(scene)),
+    "session.reachable_set": ("reachable_set", lambda scene, session: session.reachable_set()),
+    "controllability": ("controllability", lambda scene, session: planner.controllability(scene)),
+    "certify_unreachable": ("certify_unreachable",
+                            lambda scene, session: planner.certify_unreachable(scene, [0.0, 0.0, 0.0])),
+    "session.certify_unreachable": ("certify_unreachable", lambda scene, session: session.certify_unreachable(
+        [0.0, 0.0, 0.0], start=[-0.1, 0.0, 0.0])),
+}
+
+
+@pytest.mark.parametrize("query, ask", ASKED.values(), ids=ASKED.keys())
+def test_queries_of_one_part_refuse_a_tray_naming_the_scene(query, ask):
+    """The queries that answer for one part, asked of swap's two, say so in one line naming the
+    scene and the query and how to pick a part; the move scene of one part is then answered."""
+    scene = load_scene("scenes/parts/swap.yaml")
+    session = Planner(scene)
+    with pytest.raises(SceneError) as refused:
+        ask(scene, session)
+    assert refused.value.field == "scene" and query in refused.value.problem and "move_scene" in refused.value.problem
+    assert len(str(refused.value).splitlines()) == 1
+    one = scene.move_scene("red", scene.starts)
+    ask(one, Planner(one))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 import shapely
@@ -111,3 +112,50 @@ def test_pose_along_follows_the_matrix_exponential():
             got, want = at(t), advance(pose, twist, t)
             np.testing.assert_allclose(got[:2], want[:2], rtol=0, atol=1e-8 * (1 + t * t))
             assert angle_diff(got[2], want[2]) < 1e-9
+
+
+def test_clear_tests_at_one_pose_agree_whatever_their_thresholds_and_order():
+    """The part's clearance at a pose is found once and read by every edge's test there (the body
+    is the part and the pusher: its clearance the least of theirs); a test that asked for less
+    (a lower bound above its threshold) is not taken for an exact value by a later one."""
+    s = parse_scene({"slider": {"vertices": BLOCK}, "pusher": {"width": 0.05, "depth": 0.015, "mu": 0.5},
+                     "obstacles": [{"box": {"center": [0.0, 0.0], "size": [0.02, 0.3]}}],
+                     "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]},
+                     "start": [-0.2, 0.0, 0.0], "goal": [0.2, 0.0, 0.0]})
+    rng = np.random.default_rng(3)
+    shared = CollisionModel(s, s.edges)
+    for _ in range(200):
+        q = (*rng.uniform(-0.4, 0.4, 2), rng.uniform(-math.pi, math.pi))
+        for e in rng.permutation(s.edges).tolist():
+            distance = float(rng.choice([0.0, 0.001, 0.05, 0.3, math.inf]))
+            exact = CollisionModel(s, s.edges).clearance(q, e)  # a fresh model: nothing remembered
+            assert shared.is_clear(q, e, distance) == (exact > distance)
+            if rng.random() < 0.3:
+                assert shared.clearance(q, e) == exact
+
+
+def test_every_edge_of_a_part_of_five_thousand_edges_is_checked_at_a_pose_in_seconds():
+    """A circle of 5,000 edges: its outline is shared by the edges' bodies (each held all of it
+    before, 5,000 copies of 5,000 points) and its clearance found once for all at a pose, so the
+    start's test on every edge takes seconds. Independently, by shapely: the clearance of the part
+    with the pusher on a sample of edges."""
+    n = 5_000
+    t = 2 * np.pi * np.arange(n) / n
+    circle = (np.c_[np.cos(t), np.sin(t)] * 0.05).tolist()
+    s = parse_scene({"slider": {"vertices": circle}, "pusher": {"width": 0.03, "depth": 0.01, "mu": 0.5},
+                     "obstacles": [{"box": {"center": [0.0, 0.0], "size": [0.02, 0.3]}}],
+                     "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]},
+                     "start": [-0.2, 0.0, 0.0], "goal": [0.2, 0.0, 0.0]})
+    q = (-0.065, 0.02, 0.3)  # 5 mm from the wall: the pushers facing it hit it
+    began = time.perf_counter()
+    model = CollisionModel(s, s.edges)
+    clear = [model.is_clear(q, e, 0.002) for e in s.edges]
+    assert time.perf_counter() - began < 60.0
+    walls = shapely.box(-1, -1, 1, 1).difference(shapely.box(-0.5, -0.5, 0.5, 0.5))
+    blocked = shapely.union_all([*s.obstacles, walls])
+    for e in range(0, n, 97):
+        body = shapely.union_all([place(circle, q), place(pusher_body(circle, e, 0.03, 0.01), q)])
+        expected, got = body.distance(blocked), model.clearance(q, e)
+        assert math.isclose(got, expected, rel_tol=1e-7, abs_tol=1e-9) if expected > 0 else got <= 1e-12, e
+        assert clear[e] == (expected > 0.002)
+    assert 0 < sum(clear) < n  # the pushers facing the wall are too near it, the others not
