@@ -117,6 +117,8 @@ class RunOptions:
             from ..execution.mujoco_sim import needs_mujoco  # MuJoCo is only looked for here
 
             needs_mujoco()
+        if self.trajectory and scene is not None and scene.robot is not None and not have("mink"):
+            raise SceneError("trajectory", f"the arm's joints {needs('mink')}")  # found before the work
         if scene is not None:
             self._fit(scene)
         return replace(self, pose_noise=None if noise is None else tuple(abs(v) for v in noise))
