@@ -174,6 +174,18 @@ def test_a_free_pusher_plan_that_winds_the_wrist_past_its_stop_cannot_be_followe
     assert f"(segment {transit}): " in run.stdout  # missed first where the pusher walks round
 
 
+def test_the_robot_block_is_written_back_as_read(tmp_path):
+    """--export-scene (plain_scene) writes the block so that reading it gives the same robot."""
+    from planner.model.scene_file import load_scene, parse_scene, plain_scene
+
+    path = with_robot(tmp_path, "parts/swap.yaml", {"model": "ur5e", "base": [0.1, -0.4, 120], "tool_length": 0.15,
+                                                    "push_height": 0.02})
+    robot = load_scene(path).robot
+    again = parse_scene(plain_scene(load_scene(path))).robot
+    assert (again.model, again.tool_length, again.push_height) == (robot.model, robot.tool_length, robot.push_height) == ("ur5e", 0.15, 0.02)
+    assert np.allclose(again.base, robot.base) and np.allclose(robot.base, [0.1, -0.4, math.radians(120)])
+
+
 @pytest.mark.parametrize("change, field", [
     ({"model": "kuka"}, "robot.model"),
     ({"base": [2.0, 0.0, 0]}, "robot.base"),
