@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 
 from ..model.files import write_atomic
 from ..model.robot import Robot
-from .reach import ArmReach
+from .reach import FOLLOW_STEPS, ArmReach
 
 __all__ = ["HELD", "JointTrajectory", "joint_trajectory"]
 
@@ -119,7 +119,7 @@ def joint_trajectory(robot: Robot, t: ArrayLike, poses: ArrayLike, heights: Arra
     miss = np.zeros(len(t))
     posture = reach.ready
     for k in range(len(t)):
-        posture, _ = (reach.first if k == 0 else partial(reach.solve, q=posture))(poses[k], height=float(heights[k]))
+        posture, _ = (reach.first if k == 0 else partial(reach.solve, q=posture, steps=FOLLOW_STEPS))(poses[k], height=float(heights[k]))
         q[k] = posture
         miss[k] = reach.pose_error(poses[k], posture, float(heights[k]))
     dt = np.diff(t)

@@ -31,12 +31,15 @@ from numpy.typing import ArrayLike
 from ..model.robot import Robot
 from .arms import ARMS, Arm, mjcf
 
-__all__ = ["ArmReach", "REACHED", "arm_model"]
+__all__ = ["ArmReach", "FOLLOW_STEPS", "REACHED", "arm_model"]
 
 #: Largest pose error (m, and rad times the part of a metre it counts as) of a pose reached.
 REACHED = 1e-4
 _DT = 0.05  # the step mink's velocities are integrated over; a pose is reached in some tens of them
-_STEPS = 200  # most steps towards one pose from a far posture (a path's next pose needs a few)
+_STEPS = 200  # most steps towards one pose from a far posture (a path's first)
+#: Most steps towards a path's next pose from the last one's posture: it needs a few (100 a second
+#: of a slow pusher), and one it cannot reach in these would need a jump, missed either way.
+FOLLOW_STEPS = 20
 _WRISTS = 7  # places of the last joint a path's first pose is tried from
 _DOWN = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]])  # x kept, z down
 
