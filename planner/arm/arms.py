@@ -28,7 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ARMS", "Arm", "mjcf"]
+from ..model.scene import Scene
+
+__all__ = ["ARMS", "Arm", "beyond_reach", "mjcf"]
 
 
 @dataclass(frozen=True)
@@ -58,6 +60,23 @@ class Arm:
     @property
     def joints(self) -> int:
         return len(self.dh)
+
+    @property
+    def shoulder(self) -> float:
+        """Height (m) above the base frame of the point the rest of the arm swings about: joint
+        1's frame origin, on joint 2's axis (the Panda's 0.333 m, the UR5e's 0.1625 m)."""
+        return self.dh[0][1]
+
+    @property
+    def span(self) -> float:
+        """The farthest (m) the flange can be from the shoulder: the lengths between consecutive
+        joint frames past the first, and the flange's offset (triangle inequality: no posture
+        reaches farther). The Panda's is 0.316 + 0.0825 + 0.3928 + 0.088 + 0.107.
+
+        >>> round(ARMS["panda"].span, 4), round(ARMS["ur5e"].span, 4)
+        (0.9863, 1.1498)
+        """
+        return sum(math.hypot(a, d) for a, d, _ in self.dh[1:]) + self.flange
 
 
 _PI = math.pi
@@ -145,3 +164,30 @@ def mjcf(arm: Arm, tool_length: float, base: tuple[float, float, float] = (0.0, 
     out.append(f'<site name="flange" pos="0 0 {arm.flange:.17g}"/>')
     out.append(f'<site name="pusher" pos="0 0 {arm.flange + tool_length:.17g}"/>')
     return "\n".join(filter(None, out + closing))
+
+
+def beyond_reach(scene: Scene, name: str, pose: np.ndarray, slack: float = 0.0) -> float:
+    """How far (m) the scene's arm falls short of holding the pusher flush on any pushable edge of
+    part ``name`` at ``pose``, if the part may be anywhere within ``slack`` of it: the least, over
+    the edges, of the flange's distance from the shoulder beyond :attr:`Arm.span` (the flange is
+    ``tool_length`` straight above the face's middle, ``push_height`` over the table). Positive:
+    no posture of the arm holds the pusher on the part there, certainly; otherwise the bound
+    says nothing (the inverse kinematics tells).
+
+    >>> from dataclasses import replace
+    >>> from planner.model.robot import Robot
+    >>> from planner.model.scene_file import load_scene
+    >>> scene = load_scene("scenes/parts/swap.yaml")
+    >>> scene = replace(scene, robot=Robot("panda", np.array([0.0, -0.4, math.pi / 2]), 0.12))
+    >>> beyond_reach(scene, "red", scene.part("red").start) < 0, beyond_reach(scene, "red", [2.0, 0.0, 0.0]) > 0
+    (True, True)
+    """
+    robot, part = scene.robot, scene.part(name)
+    arm = ARMS[robot.model]
+    x, y, theta = (float(v) for v in pose)
+    c, s = math.cos(theta), math.sin(theta)
+    middles = np.array([part.slider.contact(e, scene.pusher.width).mean(axis=0) for e in part.edges])
+    faces = np.c_[x + c * middles[:, 0] - s * middles[:, 1], y + s * middles[:, 0] + c * middles[:, 1]]
+    flat = np.linalg.norm(faces - robot.base[:2], axis=1)
+    rise = robot.push_height + robot.tool_length - arm.shoulder
+    return float((np.hypot(flat, rise) - slack).min() - arm.span)

@@ -153,13 +153,15 @@ def test_the_independent_check_sees_a_joints_file_that_is_off(tmp_path):
         check_joints(path, tmp_path / "out")
 
 
-def test_a_plan_beyond_the_arms_reach_cannot_be_followed_exit_3(tmp_path):
-    """corridor's part goes corner to corner of a 1 m table: a Panda at one corner cannot reach the other."""
-    path = with_robot(tmp_path, "corridor.yaml", {"model": "panda", "base": [-0.5, -0.5, 45], "tool_length": 0.12})
+def test_a_plan_the_arm_cannot_follow_exits_3_with_its_files_written(tmp_path):
+    """cluttered's start is at the far corner from a Panda in the middle of the opposite side:
+    within the bound of its links end to end, but no posture holds the pusher flange-down there."""
+    path = with_robot(tmp_path, "cluttered.yaml", {"model": "panda", "base": [0.0, 0.5, -90], "tool_length": 0.1,
+                                                   "push_height": 0.02})
     run = plan(str(path), "--trajectory", "--seed", "1", "--out", "out", cwd=tmp_path)
     assert run.returncode == 3, run.stdout + run.stderr
-    assert "arm: CANNOT FOLLOW:" in run.stdout and "arm: cannot hold the pusher at t = " in run.stdout
-    assert (tmp_path / "out" / "corridor.joints.csv").exists()  # written, to be looked at
+    assert "arm: CANNOT FOLLOW:" in run.stdout and "arm: cannot hold the pusher at t = 0.00 s (segment 1)" in run.stdout
+    assert (tmp_path / "out" / "cluttered.joints.csv").exists()  # written, to be looked at
 
 
 def test_a_free_pusher_plan_that_winds_the_wrist_past_its_stop_cannot_be_followed(tmp_path):
@@ -172,6 +174,21 @@ def test_a_free_pusher_plan_that_winds_the_wrist_past_its_stop_cannot_be_followe
     transit = next(k for k, s in enumerate(json.loads((tmp_path / "out" / "junction.json").read_text())
                                            ["segments"], 1) if s["kind"] == "transit")
     assert f"(segment {transit}): " in run.stdout  # missed first where the pusher walks round
+
+
+def test_a_start_out_of_reach_is_bad_input_and_a_goal_out_of_reach_is_certified_unreachable(tmp_path):
+    """corridor's start and goal are at opposite corners of a 1 m table: a Panda at the goal's corner
+    reaches the goal but not the start (1.1 m away); one at the start's corner, the other way round.
+    The reach is the arm's links end to end (0.986 m from the shoulder), a bound no posture beats."""
+    robot = {"model": "panda", "base": [0.5, 0.5, -135], "tool_length": 0.12}
+    run = plan(str(with_robot(tmp_path, "corridor.yaml", robot)), "--out", "out", cwd=tmp_path)
+    assert run.returncode == 1 and run.stdout == "" and not (tmp_path / "out").exists()
+    assert run.stderr.startswith("plan: error: start: the panda cannot hold the pusher on any allowed edge") and \
+        run.stderr.count("\n") == 1, run.stderr
+    robot["base"] = [-0.5, -0.5, 45]
+    run = plan(str(with_robot(tmp_path, "corridor.yaml", robot)), "--out", "out", cwd=tmp_path)
+    assert run.returncode == 2, run.stdout + run.stderr
+    assert "unreachable: out of reach: the panda cannot hold the pusher on any allowed edge at the goal" in run.stdout + run.stderr
 
 
 def test_the_robot_block_is_written_back_as_read(tmp_path):
