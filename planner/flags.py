@@ -108,7 +108,8 @@ $STABLEPUSH_CACHE, else $XDG_CACHE_HOME/stablepush or ~/.cache/stablepush (here:
                    help="for a solved (or loaded) plan, also write <name>.trajectory.csv: the pusher's pose and "
                         "velocity sampled at 100 Hz, jerk-limited, at rest wherever the push or edge changes, no "
                         "point of it faster than 0.05 m/s or accelerating more than 0.5 m/s^2 "
-                        "(planner.execution.trajectory)")
+                        "(planner.execution.trajectory); with a robot: block, also <name>.joints.csv, the arm's "
+                        "joints along it, and exit 3 if the arm cannot follow it (planner.arm, docs/arm.md)")
     p.add_argument("--simulate", type=int, metavar="N",
                    help="run the whole plan open-loop in MuJoCo on N support distributions (a grid, extreme and "
                         "random foot triangles round the CF); exit 3 if a run misses the goal tolerance, slips or "

@@ -14,7 +14,7 @@ __all__ = ["EXTRAS", "have", "needs", "pyplot"]
 
 #: The extra (pyproject.toml) that installs each optional library.
 EXTRAS = {"matplotlib": "figures", "mujoco": "mujoco", "ray": "ray", "ezdxf": "cad", "svgelements": "cad",
-          "trimesh": "cad"}
+          "trimesh": "cad", "mink": "arm"}
 
 
 def needs(module: str) -> str:

@@ -31,6 +31,7 @@ from .bodies import slider_at
 from .files import write_atomic
 from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vector
 from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
+from .robot import Robot, read_robot
 from .scene import ONE_PART, Part, Pusher, Scene
 from .yaml_file import read_yaml
 
@@ -96,7 +97,8 @@ def plain_scene(scene: Scene, options: PlannerOptions | None = None) -> dict[str
     table = {"obstacles": [{"polygon": np.asarray(o.exterior.coords)[:-1].tolist()} for o in scene.obstacles],
              "workspace": {"min": list(scene.workspace[:2]), "max": list(scene.workspace[2:])},
              "tolerance": {"position": scene.tolerance_position, "angle": _degrees(scene.tolerance_angle)},
-             "planner": {key: getattr(options, key) for key in PLANNER_KEYS} | {"margin": options.margin.to_dict()}}
+             "planner": {key: getattr(options, key) for key in PLANNER_KEYS} | {"margin": options.margin.to_dict()},
+             **({"robot": scene.robot.to_dict()} if scene.robot is not None else {})}
     if scene.names == (ONE_PART,):
         part = scene.part()
         return {"name": scene.name, "slider": _plain_part(part), "pusher": {**pusher_data, "edges": list(part.edges)},
@@ -332,7 +334,7 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     """
     if isinstance(data, dict) and "parts" in data:
         return _parse_parts(data, default_name, path)
-    required, optional = ("slider", "pusher", "workspace", "start", "goal"), ("name", "obstacles", "tolerance", "planner")
+    required, optional = ("slider", "pusher", "workspace", "start", "goal"), ("name", "obstacles", "tolerance", "planner", "robot")
     keys(data, "scene", (), required + optional, suggest=("parts",))  # a tray's "part:" is a typo of parts:
     if not any(key in data for key in ONE_PART_KEYS):  # neither form: say both, not what one part misses
         raise SceneError("parts", "missing: a scene has parts: (each with its own start and goal) or slider, start "
@@ -349,7 +351,7 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     goal = read_pose(spec["goal"], "goal", slider, table.obstacles, table.workspace)
     part = Part(ONE_PART, slider, start, goal, edges, cf_uncertainty)
     return Scene(name, (part,), pusher, table.obstacles, table.workspace, table.tolerance_position,
-                 table.tolerance_angle, table.options, path, tuple(notes))
+                 table.tolerance_angle, table.options, path, tuple(notes), table.robot)
 
 
 @dataclass(frozen=True)
@@ -362,6 +364,7 @@ class Table:
     tolerance_position: float
     tolerance_angle: float
     options: PlannerOptions
+    robot: Robot | None = None
 
 
 def read_table(spec: dict, folder: Path, notes: list[str], transit: str) -> Table:
@@ -392,7 +395,8 @@ def read_table(spec: dict, folder: Path, notes: list[str], transit: str) -> Tabl
                                             f"of a plan's headings is about 1e-11 rad), got {math.degrees(tol_ang):g}")
     opts = keys(spec.get("planner", {}), "planner", (), PLANNER_KEYS)
     return Table(obstacles, workspace, tol_pos, tol_ang,
-                 PlannerOptions().merged({**opts, "transit": transit}, prefix="planner."))
+                 PlannerOptions().merged({**opts, "transit": transit}, prefix="planner."),
+                 None if spec.get("robot") is None else read_robot(spec["robot"], workspace))
 
 
 def read_cf_uncertainty(spec: dict, slider: Slider, name: str) -> float:
@@ -420,7 +424,7 @@ def _parse_parts(data: dict, default_name: str, path: str | None) -> Scene:
         if key in data:
             raise SceneError(key, "a scene has parts: (each with its own start and goal) or slider, start and goal, "
                                   "not both")
-    spec = keys(data, "scene", ("parts", "pusher", "workspace"), ("name", "obstacles", "tolerance", "planner"))
+    spec = keys(data, "scene", ("parts", "pusher", "workspace"), ("name", "obstacles", "tolerance", "planner", "robot"))
     name = read_name(spec.get("name", default_name))
     folder, notes = Path(path).parent if path else Path(), []
     pusher, _, transit = read_pusher(spec["pusher"], False)
@@ -444,7 +448,7 @@ def _parse_parts(data: dict, default_name: str, path: str | None) -> Scene:
     for which in ("start", "goal"):
         _apart(parts, which)
     return Scene(name, tuple(parts), pusher, table.obstacles, table.workspace, table.tolerance_position,
-                 table.tolerance_angle, table.options, path, tuple(notes))
+                 table.tolerance_angle, table.options, path, tuple(notes), table.robot)
 
 
 def _part_name(value: Any, field_name: str) -> str:

@@ -117,6 +117,8 @@ class RunOptions:
             from ..execution.mujoco_sim import needs_mujoco  # MuJoCo is only looked for here
 
             needs_mujoco()
+        if self.trajectory and scene is not None and scene.robot is not None and not have("mink"):
+            raise SceneError("trajectory", f"the arm's joints {needs('mink')}")  # found before the work
         if scene is not None:
             self._fit(scene)
         return replace(self, pose_noise=None if noise is None else tuple(abs(v) for v in noise))
@@ -125,6 +127,14 @@ class RunOptions:
         """Refuse what ``scene`` does not take: a part it does not have, or one not named where
         it has several. (A start error of a scene of several parts moves the part the plan moves
         first, which only the plan knows: the simulation checks where it puts it.)"""
+        if scene.robot is not None:
+            from ..arm.arms import beyond_reach  # the arm's numbers, no inverse kinematics
+
+            for k, part in enumerate(scene.parts):
+                if (short := beyond_reach(scene, part.name, part.start)) > 0:
+                    raise SceneError("start" if len(scene.parts) == 1 else f"parts[{k}].start",
+                                     f"the {scene.robot.model} cannot hold the pusher on any allowed edge of the part "
+                                     f"there: the nearest is {short * 1000:.0f} mm beyond the reach of its links")
         if self.part is not None:
             scene.part(self.part)
         elif self.reach is not None and len(scene.parts) > 1:

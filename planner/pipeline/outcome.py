@@ -34,6 +34,7 @@ class Outcome:
     verification: Any = None
     simulation: Any = None
     trajectory: Any = None
+    arm: Any = None  # the arm's joint trajectory along ``trajectory`` (planner.arm.joints), for a scene with a robot
     reach: Any = None
     out: Path | None = None
     files: list[str] = field(default_factory=list)
@@ -41,12 +42,12 @@ class Outcome:
     @property
     def passed(self) -> bool:
         """The checks asked all passed (True where none was asked)."""
-        return all(check is None or check.passed for check in (self.verification, self.simulation))
+        return all(check is None or check.passed for check in (self.verification, self.arm, self.simulation))
 
     @property
     def code(self) -> int:
         """The command's exit code: 0 solved (and every check passed), 2 not solved or certified
-        unreachable, 3 a check failed (a push slipped, a run missed or collided)."""
+        unreachable, 3 a check failed (a push slipped, the arm cannot follow, a run missed or collided)."""
         if self.unreachable or not self.plan.solved:
             return 2
         return 0 if self.passed else 3
@@ -77,6 +78,8 @@ class Outcome:
         lines = [self.headline()]
         if self.verification is not None:
             lines += [*self.verification.lines(), f"{self.verification.summary()} in {self.verification.seconds:.1f} s"]
+        if self.arm is not None:
+            lines += [*self.arm.lines(), self.arm.summary()]
         if self.simulation is not None:
             lines += [*self.simulation.lines(), self.simulation.summary()]
         if len(lines) > 1 and self.out is not None:

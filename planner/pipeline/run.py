@@ -16,6 +16,8 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..actions.margins import with_margins
 from ..model.fields import SceneError, shown
 from ..model.files import atomic_path, staged_folder, write_atomic
@@ -99,7 +101,7 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
              session: Planner | None, reach_map: ReachMap | None) -> Outcome:
     """The checks, the simulation and the map that ``options`` ask for of ``result``."""
     seed = planner_options.seed
-    check = motion = simulation = reach = None
+    check = motion = arm = simulation = reach = None
     if options.verify and result.solved:
         from ..execution.verify import verify  # the re-simulator, loaded only for verify
 
@@ -109,6 +111,11 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
         from ..execution.trajectory import trajectory  # loads ruckig, only for a trajectory
 
         motion = trajectory(scene, result)
+        if scene.robot is not None:
+            from ..arm.joints import joint_trajectory  # loads mink and MuJoCo, only for an arm
+
+            arm = joint_trajectory(scene.robot, motion.t, np.c_[motion.x, motion.y, motion.theta], motion.z,
+                                   motion.segment, motion.part)
     if options.simulate and result.solved:
         simulation = _simulated(scene, options, planner_options, result, session)
     if options.reach:  # the map is about the start, whatever the plan
@@ -118,7 +125,7 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
 
             reach_map = reachable_set
         reach = reach_map(mapped, options.reach, regions=planner_options.regions, margin=planner_options.margin)
-    return Outcome(scene, result, verification=check, simulation=simulation, trajectory=motion, reach=reach)
+    return Outcome(scene, result, verification=check, simulation=simulation, trajectory=motion, arm=arm, reach=reach)
 
 
 def _simulated(scene: Scene, options: RunOptions, planner_options: PlannerOptions, result: Plan,
@@ -192,6 +199,9 @@ def _write(outcome: Outcome, options: RunOptions, planner_options: PlannerOption
         if outcome.trajectory is not None:
             outcome.trajectory.write_csv(stage / f"{name}.trajectory.csv")
             files.append(f"{name}.trajectory.csv")
+            if outcome.arm is not None:
+                outcome.arm.write_csv(stage / f"{name}.joints.csv")
+                files.append(f"{name}.joints.csv")
             if closed and simulation is not None:
                 simulation.write_executed(stage, name)
                 executed = simulation.executed_files(name)

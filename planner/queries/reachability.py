@@ -23,7 +23,11 @@ goal; every certificate allows that much, which keeps it sound:
    centre is not within the tolerance of the connected piece of that region holding the start's.
    The radius is taken a millionth smaller, so a gap exactly as wide as the disk stays open;
 4. *no stable push*: no allowed edge has a stable push, and the start is not within tolerance of
-   the goal (this one needs the stable regions; 1-3 need only geometry).
+   the goal (this one needs the stable regions; 1-3 and 5 need only geometry);
+5. *out of reach* (a scene with a ``robot:``): at every pose within tolerance of the goal, the
+   pusher flush on any allowed edge would put the arm's flange farther from its shoulder than
+   the arm's links reach end to end (:func:`planner.arm.arms.beyond_reach`). The last push ends
+   with the arm holding the pusher there.
 
 A start within tolerance of the goal is reachable by no push at all, and no certificate fires.
 
@@ -49,6 +53,7 @@ from .one_step import goal_verdicts
 from ..model.plan import Plan
 from ..model.segments import Push, Transit
 from ..actions.controls import clearance_margin, controls_or_reason
+from ..arm.arms import beyond_reach
 from ..model.fields import poses
 from ..model.options import PlannerOptions
 from ..model.scene import Scene
@@ -129,6 +134,11 @@ class Certificates:
         start = scene.start if start is None else start
         if scene.within_tolerance(start, goal):
             return None
+        if scene.robot is not None:
+            far = float(np.linalg.norm(scene.slider.vertices, axis=1).max())  # no face middle is farther out
+            if (short := beyond_reach(scene, scene.part().name, goal, scene.tolerance_slack(far))) > 0:
+                return (f"out of reach: the {scene.robot.model} cannot hold the pusher on any allowed edge at the goal "
+                        f"(the nearest is {short * 1000:.0f} mm beyond the reach of its links)")
         edges = scene.edges
         if not any(model.is_clear(goal, e, self.margin) for e in edges):  # else the goal itself has room
             room = f"with the push margin of {self.margin * 1000:.3g} mm"

@@ -1,0 +1,130 @@
+"""The arm's joint trajectory along the pusher's (:func:`joint_trajectory`), and whether the arm can run it.
+
+Each sample of the pusher's trajectory (:mod:`planner.execution.trajectory`: a table pose and a
+height above the table, 100 a second) is reached from the posture of the sample before
+(:class:`~planner.arm.reach.ArmReach`), the first from the arm's ready posture turned towards it.
+So the joints move continuously and stay on one branch; a pose the arm cannot hold from there, a
+wrist that would turn past its stop included, is missed rather than reached by a jump. The arm
+*follows* the trajectory when every sample is reached to :data:`HELD` (m, of the pusher frame's
+origin; its heading to :data:`HELD` rad), no joint moves faster than its speed limit between two
+samples, and every joint frame stays above the table.
+
+>>> import numpy as np
+>>> from planner.model.robot import Robot
+>>> robot = Robot("panda", np.array([0.0, 0.0, 0.0]), 0.12)
+>>> t = np.linspace(0.0, 2.0, 201)  # 10 cm straight away from the base in 2 s
+>>> poses = np.c_[0.45 + 0.05 * t, np.zeros_like(t), np.zeros_like(t)]
+>>> run = joint_trajectory(robot, t, poses, np.zeros_like(t), np.zeros(len(t), dtype=int))
+>>> run.follows, run.summary().startswith("arm: follows: 201 samples")
+(True, True)
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass
+from functools import partial
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..model.files import write_atomic
+from ..model.robot import Robot
+from .reach import FOLLOW_STEPS, ArmReach
+
+__all__ = ["HELD", "JointTrajectory", "joint_trajectory"]
+
+#: Farthest a reached sample may leave the pusher frame from where the trajectory has it: m for
+#: its origin, rad for its axes (the check the joints file must pass asks for 1 mm).
+HELD = 5e-4
+
+
+@dataclass(frozen=True, eq=False)
+class JointTrajectory:
+    """Joint angles per sample of a pusher trajectory, and what the arm could not do.
+
+    ``q`` is ``(n, joints)`` (rad); ``t`` and ``segment`` (from 0) are the pusher trajectory's,
+    ``part`` too for a plan of several parts; ``miss`` is each sample's pusher frame error (m of
+    its origin, rad of its axes, the larger); ``speed`` each joint's largest speed as a share of
+    its limit; ``lowest`` the lowest joint frame's height above the table (m).
+    """
+
+    robot: Robot
+    t: np.ndarray
+    q: np.ndarray
+    segment: np.ndarray
+    miss: np.ndarray
+    speed: np.ndarray
+    lowest: float
+    part: np.ndarray | None = None
+
+    @property
+    def follows(self) -> bool:
+        return bool(self.miss.max(initial=0.0) <= HELD and self.speed.max(initial=0.0) <= 1.0 and self.lowest > 0.0)
+
+    @property
+    def passed(self) -> bool:
+        """As the pipeline's other checks say it: the arm follows the trajectory."""
+        return self.follows
+
+    def lines(self) -> list[str]:
+        """Where the arm cannot follow: the first sample missed, the fastest joint over its limit."""
+        out = []
+        if (missed := np.flatnonzero(self.miss > HELD)).size:
+            k = int(missed[0])
+            out.append(f"arm: cannot hold the pusher at t = {self.t[k]:.2f} s (segment {self.segment[k] + 1}): "
+                       f"{self.miss[k] * 1e3:.1f} mm off, {missed.size} of {len(self.t)} samples missed")
+        if (fast := int(np.argmax(self.speed))) is not None and self.speed[fast] > 1.0:
+            out.append(f"arm: joint {fast + 1} would move at {self.speed[fast]:.2f} times its speed limit")
+        if self.lowest <= 0.0:
+            out.append(f"arm: a joint frame goes {-self.lowest * 1e3:.1f} mm below the table")
+        return out
+
+    def summary(self) -> str:
+        verdict = "follows" if self.follows else "CANNOT FOLLOW"
+        return (f"arm: {verdict}: {len(self.t)} samples, {self.robot.model} ({self.q.shape[1]} joints); worst "
+                f"{self.miss.max(initial=0.0) * 1e3:.3f} mm off, joints at most {self.speed.max(initial=0.0):.0%} "
+                f"of their speed limits, lowest joint frame {self.lowest:.3f} m above the table")
+
+    def to_csv(self) -> str:
+        """``t,q1,...,qn,segment`` (and ``part``), a row per sample; segments numbered from 1."""
+        joints = self.q.shape[1]
+        header = ",".join(["t", *(f"q{k}" for k in range(1, joints + 1)), "segment"] + (["part"] if self.part is not None else []))
+        text = io.StringIO()
+        text.write(header + "\n")
+        for k in range(len(self.t)):
+            row = [f"{self.t[k]:.17g}", *(f"{v + 0.0:.17g}" for v in self.q[k]), str(int(self.segment[k]) + 1)]
+            if self.part is not None:
+                row.append(_quoted(str(self.part[k])))
+            text.write(",".join(row) + "\n")
+        return text.getvalue()
+
+    def write_csv(self, path) -> None:
+        write_atomic(path, self.to_csv())
+
+
+def _quoted(name: str) -> str:
+    """A part's name as a CSV field (quoted where it holds a comma or a quote)."""
+    return f'"{name.replace(chr(34), chr(34) * 2)}"' if any(c in name for c in ',"\n') else name
+
+
+def joint_trajectory(robot: Robot, t: ArrayLike, poses: ArrayLike, heights: ArrayLike, segments: ArrayLike,
+                     parts: ArrayLike | None = None) -> JointTrajectory:
+    """The joint angles of ``robot``'s arm along pusher table poses ``poses`` ``(n, 3)`` at
+    heights ``heights`` above the table and times ``t`` (module docstring)."""
+    t, poses, heights = np.asarray(t, dtype=float), np.asarray(poses, dtype=float), np.asarray(heights, dtype=float)
+    reach = ArmReach(robot)
+    q = np.zeros((len(t), reach.arm.joints))
+    miss = np.zeros(len(t))
+    posture = reach.ready
+    for k in range(len(t)):
+        posture, _ = (reach.first if k == 0 else partial(reach.solve, q=posture, steps=FOLLOW_STEPS))(poses[k], height=float(heights[k]))
+        q[k] = posture
+        miss[k] = reach.pose_error(poses[k], posture, float(heights[k]))
+    dt = np.diff(t)
+    speed = (np.abs(np.diff(q, axis=0)) / np.where(dt > 0, dt, np.inf)[:, None]).max(axis=0, initial=0.0) / reach.arm.speed \
+        if len(t) > 1 else np.zeros(reach.arm.joints)
+    lowest = min((reach.lowest_frame(row) for row in q), default=math.inf)
+    return JointTrajectory(robot, t, q, np.asarray(segments, dtype=int), miss, speed, lowest,
+                           None if parts is None else np.asarray(parts))
