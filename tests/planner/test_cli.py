@@ -562,9 +562,9 @@ def test_help_lists_exit_codes_defaults_and_the_region_cache(region_cache, capsy
 def test_ctrl_c_during_the_search_ends_as_interrupted(tmp_path):
     """SIGINT while OMPL searches (junction on one edge never solves): the run stops at once with
     exit 130 and its one line, writing nothing, instead of ending as if out of time."""
-    run = subprocess.Popen([sys.executable, "-m", "planner.cli", str(SCENES / "junction.yaml"), "--transit", "none",
-                            "--time-limit", "60", "--out", str(tmp_path / "out")],
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, preexec_fn=sigint_default)
+    run = subprocess.Popen(sigint_default([sys.executable, "-m", "planner.cli", str(SCENES / "junction.yaml"),
+                                           "--transit", "none", "--time-limit", "60", "--out", str(tmp_path / "out")]),
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
     time.sleep(3.0)  # imports and regions (about a second, cold) are done: it is searching
     run.send_signal(signal.SIGINT)
     out, err = run.communicate(timeout=30)  # well before the time limit
@@ -591,7 +591,7 @@ def test_a_mistyped_key_gets_a_did_you_mean(tmp_path, capsys):
      "(one part)"),
     # A scene's field named as a flag is (--seed) is the file's, not the flag's.
     (lambda text: text + "\nseed: 3\n", "plan: error: seed: unknown key (known: parts, pusher, workspace, name, "
-                                         "obstacles, tolerance, planner)")])
+                                         "obstacles, tolerance, planner, robot)")])
 def test_a_tray_file_with_a_wrong_key_is_told_about_the_tray_form(change, line, tmp_path, capsys):
     """Issue 41: "part:" for "parts:" suggested "start", and a scene field named like a flag was
     printed as the flag (--part)."""

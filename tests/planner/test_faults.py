@@ -57,11 +57,11 @@ def alive_in_group(pgid: int) -> list[str]:
 
 
 def start(tmp_path: Path, *args: str, cache: Path, **kwargs) -> subprocess.Popen:
-    """A `plan` run in its own session, so that all it starts shares its process group."""
+    """A `plan` run in its own session, so that all it starts shares its process group, with
+    Ctrl-C at its default (tests/ctrl_c.py)."""
     env = {**os.environ, "STABLEPUSH_CACHE": str(cache)}
-    return subprocess.Popen([str(PLAN), *args], cwd=tmp_path, env=env, start_new_session=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=sigint_default,
-                            **kwargs)
+    return subprocess.Popen(sigint_default([str(PLAN), *args]), cwd=tmp_path, env=env, start_new_session=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kwargs)
 
 
 @pytest.fixture

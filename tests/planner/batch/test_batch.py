@@ -309,9 +309,9 @@ def test_a_results_file_that_is_a_pipe_is_one_line_before_any_task(tmp_path, cap
 def test_ctrl_c_while_the_workers_start_is_one_line(tmp_path):
     """Ctrl-C reaches the whole process group, the batch's workers too, which import the
     planner for a second or so: they start with it ignored, so only the command speaks."""
-    runs = [subprocess.Popen([str(PLAN), *SCENES, "--seeds", "1:20", "--jobs", "2", "--out", str(tmp_path / f"o{k}")],
+    runs = [subprocess.Popen(sigint_default([str(PLAN), *SCENES, "--seeds", "1:20", "--jobs", "2", "--out",
+                                             str(tmp_path / f"o{k}")]),
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
-                             preexec_fn=sigint_default,
                              env={**os.environ, "STABLEPUSH_CACHE": str(tmp_path / f"cache{k}")}) for k in range(2)]
     began = time.monotonic()
     for after, run in zip((0.8, 1.4), runs):

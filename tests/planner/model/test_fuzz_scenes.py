@@ -54,7 +54,8 @@ FULL = {
     "planner": {"name": "kpiece", "time_limit": 5, "seed": 7, "regions": "exact", "switch_cost": 0.1},
 }
 #: The first part of every field name a message may give: the file, a flag, or a scene key.
-ROOTS = {"scene", "plan", "--out", "--plan", "--verify", "--seed", "--time-limit", *FULL}
+# "parts": a file of neither form (its slider, start and goal gone) is told of a tray's key too.
+ROOTS = {"scene", "plan", "parts", "--out", "--plan", "--verify", "--seed", "--time-limit", *FULL}
 #: Where a field name's first part ends.
 ROOT_END = re.compile(r"[.\[]")
 
