@@ -11,6 +11,12 @@ and text, dimensions, hatches and the like, are not read, and a note says so.
 ``layer`` keeps the entities on that layer (by name, in any case, as DXF names are); a block
 reference on it draws its whole block. ``name`` reads the block of that name instead of the
 model space, in the block's own frame.
+
+Only ASCII DXF is read: a binary DXF is refused, saying so. A spline through fit points is
+interpolated by ezdxf with a dense matrix (memory and time grow with the square of its points:
+20,000 took 9.2 GB), so a spline may have at most :data:`MAX_FIT_POINTS` of them, and the splines
+of a file :data:`MAX_FIT_POINTS_IN_ALL` and :data:`~planner.model.cad.MAX_POINTS` control points in
+all, before any is drawn.
 """
 
 from __future__ import annotations
@@ -23,9 +29,9 @@ import numpy as np
 import shapely
 
 from ..fields import SceneError, shown
-from . import MAX_POINTS, Selection, Shape, shapes_from_rings
+from . import MAX_ENTITIES, MAX_POINTS, Selection, Shape, flattened, shapes_from_rings
 
-__all__ = ["MAX_ENTITIES", "NEEDS", "read"]
+__all__ = ["MAX_FIT_POINTS", "MAX_FIT_POINTS_IN_ALL", "NEEDS", "read"]
 
 #: The libraries read imports (the cad extra's): imported there, so that this module loads without them.
 NEEDS = ("ezdxf",)
@@ -34,9 +40,12 @@ NEEDS = ("ezdxf",)
 _DRAWN = {"LWPOLYLINE", "POLYLINE", "LINE", "ARC", "CIRCLE", "ELLIPSE", "SPLINE"}
 #: Deepest nesting of block references expanded.
 _MAX_DEPTH = 8
-#: Most entities read, block references expanded: a drawing of parts holds thousands; a few
-#: hundred bytes of blocks of references to blocks would otherwise expand to billions.
-MAX_ENTITIES = 10_000
+#: Most fit points of one spline: ezdxf's interpolation through 1,000 takes 23 MB and 0.05 s
+#: here, and grows with their square. Ten such splines in all keep a file within half a second.
+MAX_FIT_POINTS = 1_000
+MAX_FIT_POINTS_IN_ALL = 10 * MAX_FIT_POINTS
+#: How a binary DXF file begins (AutoCAD's sentinel); ezdxf's reader takes ASCII only.
+_BINARY = b"AutoCAD Binary DXF"
 #: Bézier curves per elliptical arc: 16 keep each within 22.5 degrees, where the curve departs
 #: from the arc by less than 7e-8 of its radius (0.07 mm at the 1 km limit).
 _ARC_CURVES = 16
@@ -47,6 +56,8 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     import ezdxf.path
     import ezdxf.recover
 
+    if raw.startswith(_BINARY):
+        raise SceneError(selection.field, "a binary DXF file, which is not read: save it as ASCII DXF")
     try:
         doc, _ = ezdxf.recover.read(io.BytesIO(raw))
     except Exception as err:  # noqa: BLE001 (untrusted bytes: any failure of the parser is "not DXF")
@@ -59,20 +70,18 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     entities = (e for e in space if selection.layer is None or e.dxf.layer.upper() == selection.layer.upper())
     skipped: Counter[str] = Counter()
     rings, pieces, points = [], [], 0
+    spline_points: Counter[str] = Counter()  # fit and control points of the splines so far
     for entity in _expanded(entities, 0, skipped, selection):
+        what = f"{entity.dxftype()} #{entity.dxf.handle}"
+        if entity.dxftype() == "SPLINE":
+            _count_spline(entity, what, spline_points, selection)
         try:
             path = ezdxf.path.make_path(entity, segments=_ARC_CURVES)
         except Exception as err:  # noqa: BLE001 (a malformed entity: refused rather than left out of an outline)
-            raise SceneError(selection.field, f"{entity.dxftype()} #{entity.dxf.handle} cannot be drawn "
-                                              f"({type(err).__name__}: {err})") from None
+            raise SceneError(selection.field, f"{what} cannot be drawn ({type(err).__name__}: {err})") from None
         for sub in path.sub_paths():
-            selection.check_points(np.array([(v.x, v.y) for v in sub.control_vertices()]).reshape(-1, 2),
-                                   f"{entity.dxftype()} #{entity.dxf.handle}")
-            flat = np.array([(v.x, v.y) for v in sub.flattening(selection.chord)]).reshape(-1, 2)
+            flat = flattened(sub, selection, what, MAX_POINTS - points)
             points += len(flat)
-            if points > MAX_POINTS:
-                raise SceneError(selection.field, f"its curves flatten to more than {MAX_POINTS} points at this "
-                                                  "chord tolerance")
             if sub.is_closed:
                 rings.append(flat[:-1])
             elif len(flat) > 1:
@@ -83,6 +92,20 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     if left_open:
         notes.append(f"{selection.field}: {left_open} open chain(s) of lines or arcs do not close and are not read")
     return shapes_from_rings(rings + chained, selection)
+
+
+def _count_spline(spline, what: str, counted: Counter[str], selection: Selection) -> None:
+    """Add ``spline``'s fit and control points to ``counted``, refusing more than the module's
+    caps (its docstring) before ezdxf draws it."""
+    fit, control = spline.fit_point_count(), spline.control_point_count()
+    if fit > MAX_FIT_POINTS:
+        raise SceneError(selection.field, f"{what} has {fit} fit points, more than {MAX_FIT_POINTS} (a spline "
+                                          "through them costs their square)")
+    counted.update(fit=fit, control=control)
+    if counted["fit"] > MAX_FIT_POINTS_IN_ALL:
+        raise SceneError(selection.field, f"its splines have more than {MAX_FIT_POINTS_IN_ALL} fit points in all")
+    if counted["control"] > MAX_POINTS:
+        raise SceneError(selection.field, f"its splines have more than {MAX_POINTS} control points in all")
 
 
 def _expanded(entities: Iterator, depth: int, skipped: Counter[str], selection: Selection,

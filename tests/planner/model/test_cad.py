@@ -10,6 +10,9 @@ files written here by the libraries' writers or by hand.
 from __future__ import annotations
 
 import math
+import re
+import resource
+import subprocess
 import sys
 import time
 import tracemalloc
@@ -25,10 +28,10 @@ pytest.importorskip("svgelements")
 trimesh = pytest.importorskip("trimesh")
 
 from planner.cli import main  # noqa: E402 (after the skips)
-from planner.model.cad import MAX_FILE_BYTES  # noqa: E402
+from planner.model.cad import MAX_FILE_BYTES, MAX_VERTICES  # noqa: E402
 from planner.model.fields import SceneError  # noqa: E402
 from planner.model.scene_file import load_scene, parse_scene  # noqa: E402
-from test_cli import assert_nothing_written, error_field  # noqa: E402
+from test_cli import PLAN, assert_nothing_written, error_field  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[3]
 PUSHER = {"width": 0.03, "depth": 0.01, "mu": 0.5}
@@ -300,6 +303,42 @@ def part_on_layer(layer: str):
     return lambda folder: dxf_file(folder, lambda msp: rounded_rectangle(msp, layer))
 
 
+def use_fan(folder: Path) -> None:
+    """Issue 41: 1.5 KB of groups of five <use> of the group below, ten levels: 5 ** 10 squares
+    once svgelements expands them (it hung)."""
+    levels = "".join(f'<g id="l{k}">' + "".join(f'<use href="#l{k - 1}" x="{x}"/>' for x in range(5)) + "</g>"
+                     for k in range(1, 11))
+    svg_file(folder, f'<defs><g id="l0"><rect width="1" height="1"/></g>{levels}</defs><use href="#l10"/>')
+
+
+def use_chain(depth: int):
+    """<use> nested ``depth`` deep: each level a group holding one use of the level below."""
+    levels = "".join(f'<g id="l{k}"><use xlink:href="#l{k - 1}"/></g>' for k in range(1, depth + 1))
+    return lambda folder: (folder / "part.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" viewBox="0 0 9 9">'
+        f'<defs><rect id="l0" width="1" height="1"/>{levels}</defs><use xlink:href="#l{depth}"/></svg>')
+
+
+def splines(count: int, fit_points: int):
+    """``count`` splines through ``fit_points`` points round a circle of radius 50 mm."""
+    def draw(msp) -> None:
+        angles = np.linspace(0, 2 * np.pi, fit_points)
+        for k in range(count):
+            msp.add_spline(np.c_[50 * np.cos(angles) + 200 * k, 50 * np.sin(angles)])
+    return lambda folder: dxf_file(folder, draw)
+
+
+def binary_dxf(folder: Path) -> None:
+    doc = ezdxf.new()
+    rounded_rectangle(doc.modelspace())
+    doc.saveas(folder / "part.dxf", fmt="bin")
+
+
+def huge_bulge(folder: Path) -> None:
+    dxf_file(folder, lambda msp: msp.add_lwpolyline([(0, 0, 1e300), (10, 0, 0), (10, 10, 0)], format="xyb",
+                                                     close=True))
+
+
 def svg_text(text: str):
     return lambda folder: (folder / "part.svg").write_text(
         f'<svg xmlns="http://www.w3.org/2000/svg" {text}</svg>')
@@ -348,6 +387,28 @@ BAD = {
                                "slider.file", ["holds 2 parts"]),
     "an unknown key": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "layers": "PART"},
                        "slider.layers", ["did you mean layer?"]),
+    # Issue 41: each ran out of time or memory, or printed more than one line.
+    "SVG <use> fanning out ten levels": (use_fan, {"file": "part.svg", "units": "mm"}, "slider.file",
+                                         ["expands to more than 10000 elements (<use> copies counted)"]),
+    "SVG <use> nested nine deep": (use_chain(9), {"file": "part.svg", "units": "mm"}, "slider.file",
+                                   ["nests <use> more than 8 deep"]),
+    "an SVG <use> of its own group": (svg_text('viewBox="0 0 9 9"><g id="a"><use href="#a"/></g>'),
+                                      {"file": "part.svg", "units": "mm"}, "slider.file",
+                                      ["a <use> refers to an element that holds it"]),
+    "SVG groups nested 150 deep": (svg_text('viewBox="0 0 9 9">' + "<g>" * 150 + '<rect width="1" height="1"/>'
+                                            + "</g>" * 150), {"file": "part.svg", "units": "mm"}, "slider.file",
+                                   ["nests elements more than 100 deep"]),
+    "an SVG path of 200,001 lines": (svg_text('viewBox="0 0 9 9"><path d="M 0 0' + " L 1 1" * 200_001 + '"/>'),
+                                     {"file": "part.svg", "units": "mm"}, "slider.file",
+                                     ["more than 200000 points of path data"]),
+    "a spline through 20,000 points": (splines(1, 20_000), {"file": "part.dxf", "units": "mm"}, "slider.file",
+                                       ["SPLINE #", "has 20000 fit points, more than 1000"]),
+    "eleven splines through 1,000 points": (splines(11, 1000), {"file": "part.dxf", "units": "mm"}, "slider.file",
+                                            ["its splines have more than 10000 fit points in all"]),
+    "a binary DXF": (binary_dxf, {"file": "part.dxf", "units": "mm"}, "slider.file",
+                     ["a binary DXF file, which is not read: save it as ASCII DXF"]),
+    "a bulge of 1e300": (huge_bulge, {"file": "part.dxf", "units": "mm"}, "slider.file",
+                         ["LWPOLYLINE #", "cannot be drawn"]),
 }
 
 
@@ -376,6 +437,9 @@ def test_bad_cad_input_exits_1_with_one_line_and_writes_nothing(case, tmp_path, 
     assert len(captured.err) <= 301
     assert_nothing_written(tmp_path, before)
     assert seconds < 5.0 and peak < 100e6  # bounded by the caps, not by the file (tracemalloc slows it 2-5x)
+    with pytest.raises(SceneError) as raised:  # the library says the same
+        load_scene("scene.yaml")
+    assert captured.err == f"plan: error: {raised.value}\n"
 
 
 def test_without_the_cad_extra_a_file_is_one_line_naming_it(tmp_path, monkeypatch, capsys):
@@ -412,6 +476,82 @@ def test_the_export_holds_the_options_the_flags_set(tmp_path, monkeypatch):
     assert main([str(ROOT / "scenes" / "battery.yaml"), *argv]) == 0
     again = load_scene(tmp_path / "again.yaml")
     assert again.options.transit == "lift" and again.options.switch_cost == 0.1 and again.options.seed == 7
+
+
+#: Issue 41's files that ran out of time or memory, or printed warnings before the error line.
+HEAVY = ["SVG <use> fanning out ten levels", "a spline through 20,000 points", "a bulge of 1e300"]
+FOUR_GB = 4 * 2 ** 30
+
+
+@pytest.mark.parametrize("case", HEAVY)
+def test_issue_41_files_end_at_once_in_one_line_under_a_4_gb_address_space(case, tmp_path):
+    """The command as a user runs it, in a process that cannot have more than 4 GB: one line on
+    stderr (no RuntimeWarning above it), exit 1, within seconds. Before: a hang, 9.2 GB, two
+    warning lines."""
+    make, slider, field, words = BAD[case]
+    make(tmp_path)
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene(slider)))
+    before = {p.name for p in tmp_path.iterdir()}
+    clock = time.monotonic()
+    run = subprocess.run([str(PLAN), "scene.yaml", "--out", "out"], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=120, preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_AS, (FOUR_GB, FOUR_GB)))
+    assert time.monotonic() - clock < 20
+    assert (run.returncode, run.stdout) == (1, "") and error_field(run.stderr) == field
+    assert all(word in run.stderr for word in words), run.stderr
+    assert_nothing_written(tmp_path, before)
+
+
+def circle(radius: float):
+    return lambda folder: dxf_file(folder, lambda msp: msp.add_circle((0, 0), radius), "circle.dxf")
+
+
+def test_an_outline_past_the_vertex_cap_is_read_at_a_coarser_chord_with_a_note(tmp_path):
+    """Issue 41: a circle of radius 999,999 mm at the least chord flattened to 131,073 vertices
+    (the part's edges, each checked against every other: over 120 s). It keeps at most
+    MAX_VERTICES, every one within the chord the note gives of the circle; that chord is within
+    eight times the least any polygon of that many vertices can have (its sagitta): simplifying
+    a regular polygon halves its vertices (1000 are 512: four times the sagitta), and the
+    tolerance doubles until they fit (twice that at most)."""
+    circle(999_999)(tmp_path)
+    part = {"vertices": [[0, 0], [0.08, 0], [0.08, 0.05], [0, 0.05]]}
+    loaded = load(tmp_path, scene(part, [{"file": "circle.dxf", "units": "mm", "chord": 1e-6}],
+                                  workspace={"min": [-1000, -1000], "max": [1000, 1000]},
+                                  start=[990, 990, 0], goal=[980, 990, 0]))
+    (note,) = loaded.notes
+    found = re.fullmatch(r"obstacles\[0\]\.file: an outline keeps (\d+) vertices at chord 1e-06 m, more than 1000: "
+                         r"read at chord (\S+) m", note)
+    assert found and int(found.group(1)) > MAX_VERTICES, note
+    chord = float(found.group(2))
+    outline = np.asarray(loaded.obstacles[0].exterior.coords)[:-1]
+    assert len(outline) <= MAX_VERTICES
+    assert np.abs(np.hypot(*outline.T) - 999.999).max() <= chord
+    assert chord <= 8 * 999.999 * (1 - math.cos(math.pi / MAX_VERTICES))
+
+
+def test_the_command_plans_past_an_outline_read_at_a_coarser_chord_and_says_so(tmp_path, monkeypatch, capsys):
+    circle(500)(tmp_path)  # 4096 vertices at the least chord
+    part = {"vertices": [[-0.04, -0.025], [0.04, -0.025], [0.04, 0.025], [-0.04, 0.025]]}
+    obstacle = {"file": "circle.dxf", "units": "mm", "chord": 1e-6, "at": [0, 0.6, 0]}
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene(part, [obstacle], goal=[0.5, -0.5, 0])))
+    monkeypatch.chdir(tmp_path)
+    assert main(["scene.yaml", "--out", "out"]) == 0
+    err = capsys.readouterr().err
+    assert re.fullmatch(r"plan: note: obstacles\[0\]\.file: an outline keeps \d+ vertices at chord 1e-06 m, more "
+                        r"than 1000: read at chord \S+ m\n", err), err
+
+
+def test_splines_control_points_are_capped_in_all_before_they_are_drawn(tmp_path, monkeypatch):
+    """The cap is MAX_POINTS (a spline of 200,001 control points is an 8 MB file): a tenth of it
+    here, so that a few points make the file."""
+    def draw(msp) -> None:
+        for k in range(2):
+            msp.add_open_spline([(x, 20 * k + (x % 2)) for x in range(12)])
+
+    dxf_file(tmp_path, draw)
+    monkeypatch.setattr("planner.model.cad.dxf.MAX_POINTS", 20)  # the first spline's 12 pass, not 24 in all
+    monkeypatch.setattr("planner.model.cad.dxf.flattened", lambda path, *args: np.zeros((0, 2)))  # no point counted
+    with pytest.raises(SceneError, match="slider.file: its splines have more than 20 control points in all"):
+        load(tmp_path, scene({"file": "part.dxf", "units": "mm"}))
 
 
 # --- the example, planned and verified against its exported scene ------------------------------------
