@@ -196,13 +196,14 @@ def read_slider(value: Any, folder: Path, notes: list[str], name: str = "slider"
 
 def _slider_from_file(value: dict, folder: Path, notes: list[str], name: str, more: tuple[str, ...]) -> Slider:
     """The part a file draws: its outline is what the pusher touches, and its default CF the
-    centroid of its footprint, holes left out (a hole carries no weight)."""
+    centroid of its footprint, holes left out (a hole carries no weight). ``more`` are the keys
+    of the part's own (a part of ``parts:`` has a ``name``), not the file's."""
     from .cad import FILE_KEYS, FILE_OPTIONS, read_shapes
 
     spec = keys(value, name, FILE_KEYS, FILE_OPTIONS + ("cf", "cf_uncertainty") + more)
     shapes = read_shapes({k: v for k, v in spec.items() if k not in more}, name, folder, notes)
     if len(shapes) > 1:
-        raise SceneError(f"{name}.file", f"holds {len(shapes)} parts: pick one with layer or name")
+        raise SceneError(f"{name}.file", f"holds {len(shapes)} parts: pick one with layer or object")
     (shape,) = shapes
     if shape.footprint.area <= 0:
         raise SceneError(f"{name}.file", "the part has no footprint on the table")

@@ -1,7 +1,7 @@
 """Parts and obstacles read from CAD files: DXF drawings (:mod:`.dxf`), SVG drawings (:mod:`.svg`)
 and meshes (:mod:`.mesh`: STL, OBJ, PLY).
 
-Wherever a scene takes a polygon it may name a file instead, ``{file, units, at, layer, name,
+Wherever a scene takes a polygon it may name a file instead, ``{file, units, at, layer, object,
 chord}`` (:data:`FILE_KEYS`, :data:`FILE_OPTIONS`; the README's "Parts and obstacles from CAD
 files"). :func:`read_shapes` reads it into :class:`Shape`\\ s in metres, placed by ``at``: each
 is what the body covers seen from above (``region``, holes open) and what of it rests on the
@@ -45,9 +45,10 @@ if TYPE_CHECKING:
 __all__ = ["CHORD", "FILE_KEYS", "FILE_OPTIONS", "MAX_ENTITIES", "MAX_FILE_BYTES", "MAX_POINTS", "MAX_VERTICES",
            "READERS", "UNITS", "Selection", "Shape", "flattened", "read_shapes", "shapes_from_rings", "without_holes"]
 
-#: Required keys of a file reference, and its optional ones.
+#: Required keys of a file reference, and its optional ones. ``name`` is ``object``'s other name,
+#: where it names nothing else (a part of ``parts:`` has a name of its own).
 FILE_KEYS = ("file", "units")
-FILE_OPTIONS = ("at", "layer", "name", "chord")
+FILE_OPTIONS = ("at", "layer", "object", "name", "chord")
 #: Metres per unit of the file's numbers.
 UNITS = {"mm": 1e-3, "cm": 1e-2, "m": 1.0, "in": 0.0254}
 #: Default chord tolerance, in metres (0.1 mm), and the least one taken (a micron: the least edge
@@ -128,7 +129,9 @@ def read_shapes(spec: dict[str, Any], field: str, folder: Path, notes: list[str]
     chord = number(spec.get("chord", CHORD), f"{field}.chord", positive=True, limit=LENGTH)
     if chord < MIN_CHORD:
         raise SceneError(f"{field}.chord", f"must be at least {MIN_CHORD:g} m, got {shown(chord)}")
-    select = {key: spec.get(key) for key in ("layer", "name")}
+    if "object" in spec and "name" in spec:
+        raise SceneError(f"{field}.name", "is object's other name: give one of them")
+    select = {key: spec.get(key) for key in ("layer", "object", "name")}
     for key, value in select.items():
         if value is not None and (not isinstance(value, str) or not value):
             raise SceneError(f"{field}.{key}", f"must be a non-empty string, got {shown(value)}")
@@ -144,7 +147,8 @@ def read_shapes(spec: dict[str, Any], field: str, folder: Path, notes: list[str]
     except ImportError as err:
         raise SceneError(f"{field}.file", f"reading {path.suffix.lower()} files needs the cad extra: "
                                           f"pip install 'stablepush[cad]' ({err})") from None
-    selection = Selection(select["layer"], select["name"], chord / 2 / scale, LENGTH.bound / scale, f"{field}.file")
+    selection = Selection(select["layer"], select["object"] or select["name"], chord / 2 / scale, LENGTH.bound / scale,
+                          f"{field}.file")
     noted = len(notes)
     with np.errstate(all="ignore"):  # overflow in the libraries (a bulge of 1e300): their output is checked
         shapes = reader.read(raw, path.suffix.lower(), selection, notes)

@@ -9,7 +9,7 @@ joined where they meet end to end, and each closed chain is an outline too. Chai
 and text, dimensions, hatches and the like, are not read, and a note says so.
 
 ``layer`` keeps the entities on that layer (by name, in any case, as DXF names are); a block
-reference on it draws its whole block. ``name`` reads the block of that name instead of the
+reference on it draws its whole block. ``object`` reads the block of that name instead of the
 model space, in the block's own frame.
 
 Only ASCII DXF is read: a binary DXF is refused, saying so. A spline through fit points is

@@ -8,8 +8,8 @@ tolerance of the lowest z. The footprint is what carries the part's weight, so i
 part's default centre of friction. A mesh that touches the table only at points or along edges
 (a cone on its tip, a sphere) has no footprint and is refused.
 
-``name`` picks a body of a file of several named ones (an OBJ's objects, say); meshes have no
-layers.
+``object`` picks a body by name: an OBJ's objects (its ``o`` lines), or the bodies trimesh finds
+and names in other files (``geometry_0``...); meshes have no layers.
 """
 
 from __future__ import annotations
@@ -33,16 +33,17 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     import trimesh
 
     if selection.layer is not None:
-        raise SceneError(selection.field, "a mesh has no layers (name picks one of its bodies)")
+        raise SceneError(selection.field, "a mesh has no layers (object picks one of its bodies)")
+    # An OBJ's objects are bodies of their own, by their names; trimesh would merge them.
+    split = {"split_objects": True} if suffix == ".obj" else {}
     try:
-        loaded = trimesh.load(io.BytesIO(raw), file_type=suffix[1:], process=False)
+        bodies = dict(trimesh.load_scene(io.BytesIO(raw), file_type=suffix[1:], process=False, **split).geometry)
     except Exception as err:  # noqa: BLE001 (untrusted bytes: any failure of the parser is "not a mesh")
         raise SceneError(selection.field, f"not a readable {suffix[1:].upper()} file ({type(err).__name__}: "
                                           f"{err})") from None
-    bodies = dict(loaded.geometry) if isinstance(loaded, trimesh.Scene) else {None: loaded}
     if selection.name is not None:
         if selection.name not in bodies:
-            known = ", ".join(shown(name) for name in bodies if name) or "none"
+            known = ", ".join(shown(name) for name in sorted(bodies)) or "none"
             raise SceneError(selection.field, f"no body named {shown(selection.name)} (bodies: {known})")
         bodies = {selection.name: bodies[selection.name]}
     meshes = [mesh for mesh in bodies.values() if isinstance(mesh, trimesh.Trimesh) and len(mesh.faces)]

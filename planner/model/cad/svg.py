@@ -14,7 +14,7 @@ counter-clockwise), so the part on the table looks as the drawing does on the sc
 its mirror image (a mirrored part is another part).
 
 ``layer`` keeps the elements in the layer of that label (an Inkscape layer, a group with
-``inkscape:groupmode="layer"``), ``name`` the element with that ``id`` (all of it, for a group).
+``inkscape:groupmode="layer"``), ``object`` the element with that ``id`` (all of it, for a group).
 
 svgelements expands each ``<use>`` into a copy of what it refers to, uses within it included, so a
 few kilobytes of uses of groups of uses expand exponentially. Before it sees the file, the file's

@@ -177,7 +177,7 @@ def test_a_layer_picks_one_part_of_several(tmp_path, monkeypatch, capsys):
     assert spare.cf == pytest.approx([0.2, 0.0], abs=5e-5)  # no hole on that layer
     part = load(tmp_path, scene({"file": "part.dxf", "units": "mm", "layer": "PART"})).slider
     assert part.polygon.bounds == pytest.approx((-0.04, -0.025, 0.04, 0.025), abs=1e-4)
-    with pytest.raises(SceneError, match="slider.file: holds 2 parts: pick one with layer or name"):
+    with pytest.raises(SceneError, match="slider.file: holds 2 parts: pick one with layer or object"):
         load(tmp_path, scene({"file": "part.dxf", "units": "mm"}))
 
 
@@ -409,6 +409,8 @@ BAD = {
                      ["a binary DXF file, which is not read: save it as ASCII DXF"]),
     "a bulge of 1e300": (huge_bulge, {"file": "part.dxf", "units": "mm"}, "slider.file",
                          ["LWPOLYLINE #", "cannot be drawn"]),
+    "object and name both": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "object": "A", "name": "A"},
+                             "slider.name", ["is object's other name: give one of them"]),
 }
 
 
@@ -552,6 +554,50 @@ def test_splines_control_points_are_capped_in_all_before_they_are_drawn(tmp_path
     monkeypatch.setattr("planner.model.cad.dxf.flattened", lambda path, *args: np.zeros((0, 2)))  # no point counted
     with pytest.raises(SceneError, match="slider.file: its splines have more than 20 control points in all"):
         load(tmp_path, scene({"file": "part.dxf", "units": "mm"}))
+
+
+def two_boxes_obj(folder: Path) -> None:
+    """An OBJ of two objects: 'left', a 10 mm cube at the origin, and 'right', a 5 mm one at x = 30 mm."""
+    lines, offset = [], 1
+    for name, size, x in (("left", 10, 0), ("right", 5, 30)):
+        box = trimesh.creation.box((size, size, size)).apply_translation((x, 0, size / 2))
+        lines += [f"o {name}", *(f"v {a} {b} {c}" for a, b, c in box.vertices),
+                  *(f"f {i + offset} {j + offset} {k + offset}" for i, j, k in box.faces)]
+        offset += len(box.vertices)
+    (folder / "parts.obj").write_text("\n".join(lines) + "\n")
+
+
+def test_an_obj_object_is_picked_by_its_name(tmp_path):
+    two_boxes_obj(tmp_path)
+    right = load(tmp_path, scene({"file": "parts.obj", "units": "mm", "object": "right"})).slider
+    assert right.polygon.bounds == pytest.approx((0.0275, -0.0025, 0.0325, 0.0025), abs=1e-9)
+    left = load(tmp_path, scene({"file": "parts.obj", "units": "mm", "name": "left"})).slider  # name: the same
+    assert left.polygon.bounds == pytest.approx((-0.005, -0.005, 0.005, 0.005), abs=1e-9)
+    with pytest.raises(SceneError, match=r"slider.file: no body named 'middle' \(bodies: 'left', 'right'\)"):
+        load(tmp_path, scene({"file": "parts.obj", "units": "mm", "object": "middle"}))
+    with pytest.raises(SceneError, match="slider.file: holds 2 parts: pick one with layer or object"):
+        load(tmp_path, scene({"file": "parts.obj", "units": "mm"}))
+
+
+def test_a_trays_parts_name_themselves_and_object_picks_from_the_file(tmp_path, monkeypatch, capsys):
+    """Issue 41: a part's ``name`` (its name in the tray) hid the file's ``name`` selector. In
+    ``parts:`` it names the part alone; ``object`` picks from the file, here the other way round."""
+    two_boxes_obj(tmp_path)
+    parts = [{"name": "left", "file": "parts.obj", "units": "mm", "object": "right", "start": [-0.3, 0, 0],
+              "goal": [0.3, 0, 0]},
+             {"name": "right", "file": "parts.obj", "units": "mm", "object": "left", "start": [0, 0.3, 0],
+              "goal": [0, 0.3, 0]}]
+    data = {"parts": parts, "pusher": PUSHER, "workspace": {"min": [-1, -1], "max": [1, 1]}}
+    tray = load(tmp_path, data)
+    assert tray.names == ("left", "right")
+    assert [p.slider.area for p in tray.parts] == pytest.approx([25e-6, 100e-6])
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(data))
+    monkeypatch.chdir(tmp_path)
+    assert main(["scene.yaml", "--out", "out"]) == 0
+    assert capsys.readouterr().out.startswith("solved: 2 parts")
+    del parts[0]["object"]  # the part's name picks nothing
+    with pytest.raises(SceneError, match=r"parts\[0\].file: holds 2 parts: pick one with layer or object"):
+        load(tmp_path, data)
 
 
 # --- the example, planned and verified against its exported scene ------------------------------------
