@@ -339,6 +339,12 @@ def huge_bulge(folder: Path) -> None:
                                                      close=True))
 
 
+def box_stl(size_in_file: tuple[float, float, float]):
+    """An STL box of ``size_in_file`` (the file's numbers), resting on z = 0."""
+    return lambda folder: trimesh.creation.box(size_in_file).apply_translation(
+        (0, 0, size_in_file[2] / 2)).export(folder / "part.stl")
+
+
 def svg_text(text: str):
     return lambda folder: (folder / "part.svg").write_text(
         f'<svg xmlns="http://www.w3.org/2000/svg" {text}</svg>')
@@ -409,6 +415,12 @@ BAD = {
                      ["a binary DXF file, which is not read: save it as ASCII DXF"]),
     "a bulge of 1e300": (huge_bulge, {"file": "part.dxf", "units": "mm"}, "slider.file",
                          ["LWPOLYLINE #", "cannot be drawn"]),
+    "an STL in metres declared mm": (box_stl((0.08, 0.05, 0.02)), {"file": "part.stl", "units": "mm"}, "slider.units",
+                                     ["um across, less than 1/100 of the pusher's width (30 mm)",
+                                      "is the file in metres? (units: mm)"]),
+    "an STL in mm declared metres": (box_stl((80, 50, 20)), {"file": "part.stl", "units": "m"}, "slider.units",
+                                     ["94.34 m across, more than the workspace's diagonal (2.828 m)",
+                                      "is the file in millimetres? (units: m)"]),
     "object and name both": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "object": "A", "name": "A"},
                              "slider.name", ["is object's other name: give one of them"]),
 }
@@ -481,7 +493,8 @@ def test_the_export_holds_the_options_the_flags_set(tmp_path, monkeypatch):
 
 
 #: Issue 41's files that ran out of time or memory, or printed warnings before the error line.
-HEAVY = ["SVG <use> fanning out ten levels", "a spline through 20,000 points", "a bulge of 1e300"]
+HEAVY = ["SVG <use> fanning out ten levels", "a spline through 20,000 points", "a bulge of 1e300",
+         "an STL in metres declared mm"]
 FOUR_GB = 4 * 2 ** 30
 
 
@@ -489,7 +502,7 @@ FOUR_GB = 4 * 2 ** 30
 def test_issue_41_files_end_at_once_in_one_line_under_a_4_gb_address_space(case, tmp_path):
     """The command as a user runs it, in a process that cannot have more than 4 GB: one line on
     stderr (no RuntimeWarning above it), exit 1, within seconds. Before: a hang, 9.2 GB, two
-    warning lines."""
+    warning lines, 24 GB."""
     make, slider, field, words = BAD[case]
     make(tmp_path)
     (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene(slider)))
@@ -598,6 +611,13 @@ def test_a_trays_parts_name_themselves_and_object_picks_from_the_file(tmp_path, 
     del parts[0]["object"]  # the part's name picks nothing
     with pytest.raises(SceneError, match=r"parts\[0\].file: holds 2 parts: pick one with layer or object"):
         load(tmp_path, data)
+
+
+def test_a_part_of_vertices_far_too_small_for_its_pusher_names_them_in_metres(tmp_path):
+    tiny = {"vertices": [[0, 0], [80e-6, 0], [80e-6, 50e-6], [0, 50e-6]]}
+    with pytest.raises(SceneError, match=r"^slider.vertices: the part is 94.34 um across, less than 1/100 of the "
+                                         r"pusher's width \(30 mm\): the vertices are in metres$"):
+        load(tmp_path, scene(tiny))
 
 
 # --- the example, planned and verified against its exported scene ------------------------------------
