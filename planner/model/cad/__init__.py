@@ -12,7 +12,7 @@ vertices is simplified further, with a note saying to what tolerance.
 
 The readers' libraries (ezdxf, svgelements, trimesh: the ``cad`` extra) are imported only when a
 scene names a file of their kind; without them the scene is refused with one line naming the
-extra. A file is untrusted input: at most :data:`MAX_FILE_BYTES` are read, a drawing draws at
+extra, and their log records are not printed. A file is untrusted input: at most :data:`MAX_FILE_BYTES` are read, a drawing draws at
 most :data:`MAX_ENTITIES` entities or elements (references expanded), coordinates are checked
 against the scene's limits before any curve is flattened, and flattening stops at
 :data:`MAX_POINTS` points, so time and memory are bounded by those numbers, not by the file's.
@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import importlib
 import itertools
+import logging
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -147,6 +148,12 @@ def read_shapes(spec: dict[str, Any], field: str, folder: Path, notes: list[str]
     except ImportError as err:
         raise SceneError(f"{field}.file", f"reading {path.suffix.lower()} files needs the cad extra: "
                                           f"pip install 'stablepush[cad]' ({err})") from None
+    for library in reader.NEEDS:
+        # Their log records (a value ezdxf repaired, say) would reach stderr through Python's
+        # last-resort handler, lines before the error or the outcome: the readers note what matters.
+        logger = logging.getLogger(library)
+        if not logger.handlers:
+            logger.addHandler(logging.NullHandler())
     selection = Selection(select["layer"], select["object"] or select["name"], chord / 2 / scale, LENGTH.bound / scale,
                           f"{field}.file")
     noted = len(notes)

@@ -12,7 +12,8 @@ and text, dimensions, hatches and the like, are not read, and a note says so.
 reference on it draws its whole block. ``object`` reads the block of that name instead of the
 model space, in the block's own frame.
 
-Only ASCII DXF is read: a binary DXF is refused, saying so. A spline through fit points is
+Only ASCII DXF is read: a binary DXF is refused, saying so. What ezdxf repairs as it reads (a
+number it cannot read, taken as the number it finds in it) is noted. A spline through fit points is
 interpolated by ezdxf with a dense matrix (memory and time grow with the square of its points:
 20,000 took 9.2 GB), so a spline may have at most :data:`MAX_FIT_POINTS` of them, and the splines
 of a file :data:`MAX_FIT_POINTS_IN_ALL` and :data:`~planner.model.cad.MAX_POINTS` control points in
@@ -28,7 +29,7 @@ from collections.abc import Iterator
 import numpy as np
 import shapely
 
-from ..fields import SceneError, shown
+from ..fields import SceneError, counted, shown
 from . import MAX_ENTITIES, MAX_POINTS, Selection, Shape, flattened, shapes_from_rings
 
 __all__ = ["MAX_FIT_POINTS", "MAX_FIT_POINTS_IN_ALL", "NEEDS", "read"]
@@ -59,9 +60,12 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     if raw.startswith(_BINARY):
         raise SceneError(selection.field, "a binary DXF file, which is not read: save it as ASCII DXF")
     try:
-        doc, _ = ezdxf.recover.read(io.BytesIO(raw))
+        doc, auditor = ezdxf.recover.read(io.BytesIO(raw))
     except Exception as err:  # noqa: BLE001 (untrusted bytes: any failure of the parser is "not DXF")
         raise SceneError(selection.field, f"not a readable DXF file ({type(err).__name__}: {err})") from None
+    if auditor.errors:  # values it could not read, taken as what it found in them: the drawing may differ
+        notes.append(f"{selection.field}: ezdxf repaired {counted(len(auditor.errors), 'error')} of the file "
+                     f"(the first: {shown(auditor.errors[0].message)})")
     if selection.name is None:
         space = doc.modelspace()
     elif (space := doc.blocks.get(selection.name)) is None:

@@ -620,6 +620,23 @@ def test_a_part_of_vertices_far_too_small_for_its_pusher_names_them_in_metres(tm
         load(tmp_path, scene(tiny))
 
 
+def test_what_ezdxf_repairs_is_a_note_not_its_log_lines(tmp_path):
+    """A coordinate that is not a number ("0.0abc") is read by ezdxf as 0.0, which it logged: two
+    lines Python's last-resort handler printed above the outcome. Now one note says so."""
+    dxf_file(tmp_path, lambda msp: msp.add_lwpolyline([(0, 0), (40, 0), (40, 30), (0, 30)], close=True))
+    text = (tmp_path / "part.dxf").read_text()
+    first = text.index("\n 10\n", text.index("AcDbPolyline")) + 5
+    (tmp_path / "part.dxf").write_text(text[:first] + "0.0abc" + text[text.index("\n", first):])
+    data = scene({"file": "part.dxf", "units": "mm"}, start=[0, 0, 0], goal=[0, 0, 0])
+    note = ("slider.file: ezdxf repaired 2 errors of the file (the first: 'recovered invalid floating point value "
+            '"0.0abc" near line')
+    assert load(tmp_path, data).notes[0].startswith(note)
+    run = subprocess.run([str(PLAN), "scene.yaml", "--out", "out"], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 0 and run.stdout.startswith("solved: 0 pushes")
+    assert run.stderr.startswith(f"plan: note: {note}") and run.stderr.count("\n") == 1, run.stderr
+
+
 # --- the example, planned and verified against its exported scene ------------------------------------
 
 def plans_and_verifies_against_its_export(path: Path, tmp_path: Path) -> dict:
