@@ -5,8 +5,8 @@ read, and block references (INSERT) are expanded into what they draw. Each entit
 ezdxf path; elliptical arcs are first made of 16 cubic Béziers each (at most 22.5 degrees of a
 circle each, off it by less than 7e-8 of the radius), and then every path is flattened to the
 chord tolerance. Closed paths are outlines; the open ones (lines, arcs, open polylines) are
-joined where they meet end to end, and each closed chain is an outline too. Chains that stay open,
-and text, dimensions, hatches and the like, are not read, and a note says so.
+joined where they meet end to end (:mod:`.chains`), and each closed chain is an outline too.
+Chains that stay open, and text, dimensions, hatches and the like, are not read, and a note says so.
 
 ``layer`` keeps the entities on that layer (by name, in any case, as DXF names are); a block
 reference on it draws its whole block. ``object`` reads the block of that name instead of the
@@ -26,11 +26,9 @@ import io
 from collections import Counter
 from collections.abc import Iterator
 
-import numpy as np
-import shapely
-
 from ..fields import SceneError, counted, shown
 from . import MAX_ENTITIES, MAX_POINTS, Selection, Shape, flattened, shapes_from_rings
+from .chains import chains
 
 __all__ = ["MAX_FIT_POINTS", "MAX_FIT_POINTS_IN_ALL", "NEEDS", "read"]
 
@@ -90,7 +88,7 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
                 rings.append(flat[:-1])
             elif len(flat) > 1:
                 pieces.append(flat)
-    chained, left_open = _chains(pieces, selection.chord)
+    chained, left_open = chains(pieces, selection.chord)
     if skipped:
         notes.append(f"{selection.field}: not read: {', '.join(f'{n} {kind}' for kind, n in sorted(skipped.items()))}")
     if left_open:
@@ -128,15 +126,3 @@ def _expanded(entities: Iterator, depth: int, skipped: Counter[str], selection: 
             yield entity
         else:
             skipped[kind] += 1
-
-
-def _chains(pieces: list[np.ndarray], chord: float) -> tuple[list[np.ndarray], int]:
-    """The closed rings that the open polylines ``pieces`` form where they meet end to end (ends
-    within a hundredth of ``chord`` are taken as one), and how many chains stay open."""
-    if not pieces:
-        return [], 0
-    lines = shapely.set_precision([shapely.LineString(piece) for piece in pieces], chord / 100)
-    faces, cuts, dangles, invalid = shapely.polygonize_full([shapely.union_all(lines)])
-    # A loop inside another is a face of its own, so the faces' outer rings are every loop.
-    rings = [np.asarray(face.exterior.coords)[:-1] for face in shapely.get_parts(faces)]
-    return rings, sum(len(shapely.get_parts(g)) for g in (cuts, dangles, invalid))

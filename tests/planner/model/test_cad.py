@@ -328,6 +328,19 @@ def splines(count: int, fit_points: int):
     return lambda folder: dxf_file(folder, draw)
 
 
+def overlapping_arcs(copies: int, spans: int):
+    """``copies`` of ``spans`` arcs of one circle of radius 20 mm, each of a random span: issue 41's
+    fuzzing found their union (how open pieces were joined) took 24 s for 300 and all the memory
+    for 2,000 copies of one."""
+    def draw(msp) -> None:
+        rng = np.random.default_rng(1)
+        for _ in range(spans):
+            start = rng.uniform(0, 360)
+            for _ in range(copies):
+                msp.add_arc((0, 0), 20, start, start + rng.uniform(30, 170))
+    return lambda folder: dxf_file(folder, draw)
+
+
 def binary_dxf(folder: Path) -> None:
     doc = ezdxf.new()
     rounded_rectangle(doc.modelspace())
@@ -411,6 +424,10 @@ BAD = {
                                        ["SPLINE #", "has 20000 fit points, more than 1000"]),
     "eleven splines through 1,000 points": (splines(11, 1000), {"file": "part.dxf", "units": "mm"}, "slider.file",
                                             ["its splines have more than 10000 fit points in all"]),
+    "300 arcs overlapping on one circle": (overlapping_arcs(1, 300), {"file": "part.dxf", "units": "mm"},
+                                           "slider.file", ["holds no closed outline;", "open chain(s)"]),
+    "2,000 copies of one arc": (overlapping_arcs(2000, 1), {"file": "part.dxf", "units": "mm"}, "slider.file",
+                                ["holds no closed outline; 1 open chain(s)"]),
     "a binary DXF": (binary_dxf, {"file": "part.dxf", "units": "mm"}, "slider.file",
                      ["a binary DXF file, which is not read: save it as ASCII DXF"]),
     "a bulge of 1e300": (huge_bulge, {"file": "part.dxf", "units": "mm"}, "slider.file",
@@ -618,6 +635,23 @@ def test_a_part_of_vertices_far_too_small_for_its_pusher_names_them_in_metres(tm
     with pytest.raises(SceneError, match=r"^slider.vertices: the part is 94.34 um across, less than 1/100 of the "
                                          r"pusher's width \(30 mm\): the vertices are in metres$"):
         load(tmp_path, scene(tiny))
+
+
+def test_an_outline_of_arcs_drawn_many_times_over_is_read_once(tmp_path):
+    """Two half circles, each drawn 1,000 times, and a stray line from one of their joints: one
+    outline (a piece drawn twice counts once; a piece leading nowhere is cut off), read at once."""
+    def draw(msp) -> None:
+        for _ in range(1000):
+            msp.add_arc((0, 0), 20, 0, 180)
+            msp.add_arc((0, 0), 20, 180, 360)
+        msp.add_line((20, 0), (40, 0))
+
+    dxf_file(tmp_path, draw)
+    clock = time.perf_counter()
+    loaded = load(tmp_path, scene({"file": "part.dxf", "units": "mm"}))
+    assert time.perf_counter() - clock < 5.0
+    assert math.pi * (20 - 0.1) ** 2 < loaded.slider.area * 1e6 < math.pi * 20 ** 2
+    assert loaded.notes == ("slider.file: 1 open chain(s) of lines or arcs do not close and are not read",)
 
 
 def test_what_ezdxf_repairs_is_a_note_not_its_log_lines(tmp_path):
