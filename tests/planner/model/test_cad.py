@@ -163,6 +163,36 @@ def test_a_mesh_outline_is_its_projection_and_its_cf_the_footprints_centroid(tmp
     assert part.cf == pytest.approx([0.03, 0.0], abs=1e-7)
 
 
+def plate_with_a_hole(outer: float, hole: float, hole_x: float, height: float):
+    """A square plate ``outer`` mm wide with a square hole ``hole`` mm wide centred at (``hole_x``,
+    0), as one mesh whose top and bottom faces are each one patch with a hole (trimesh's own
+    projection needed networkx and rtree, which the cad extra does not install, for those)."""
+    o = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * outer / 2
+    i = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * hole / 2 + [hole_x, 0]
+    vertices = np.vstack([np.c_[ring, np.full(4, z)] for z in (0.0, height) for ring in (o, i)])  # O0 I0 O1 I1
+    ring = [(k, (k + 1) % 4) for k in range(4)]
+    top = [f for a, b in ring for f in ((8 + a, 8 + b, 12 + b), (8 + a, 12 + b, 12 + a))]
+    bottom = [f[::-1] for f in [(a, b, 4 + b) for a, b in ring] + [(a, 4 + b, 4 + a) for a, b in ring]]
+    walls = [f for a, b in ring for f in ((a, b, 8 + b), (a, 8 + b, 8 + a))]
+    walls += [f[::-1] for a, b in ring for f in ((4 + a, 4 + b, 12 + b), (4 + a, 12 + b, 12 + a))]
+    return trimesh.Trimesh(vertices, top + bottom + walls, process=False)
+
+
+def test_a_mesh_whose_faces_have_holes_is_read_and_its_cf_leaves_the_hole(tmp_path, monkeypatch, capsys):
+    """Issue 41's fuzzing: a washer or a plate with a bolt hole as an STL ended in a traceback
+    (ModuleNotFoundError: networkx). Its outline is the plate's; its CF is the footprint's
+    centroid, moved away from the hole: -(10 * 10 * 10) / (40 * 40 - 10 * 10) mm."""
+    plate_with_a_hole(40, 10, 10, 5).export(tmp_path / "plate.stl")
+    part = load(tmp_path, scene({"file": "plate.stl", "units": "mm"})).slider
+    assert part.polygon.bounds == pytest.approx((-0.02, -0.02, 0.02, 0.02))
+    assert part.cf == pytest.approx([-1000 / 1500 * 1e-3, 0], abs=1e-9)
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene({"file": "plate.stl", "units": "mm"},
+                                                              start=[0, 0, 0], goal=[0.3, 0, 0])))
+    monkeypatch.chdir(tmp_path)
+    assert main(["scene.yaml", "--out", "out"]) == 0
+    assert capsys.readouterr().out.startswith("solved: ")
+
+
 # --- selection, units, placement --------------------------------------------------------------------
 
 def two_parts(msp) -> None:
