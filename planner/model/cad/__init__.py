@@ -11,14 +11,14 @@ chord tolerance from the drawing. An outline that would keep more than :data:`MA
 vertices is simplified further, with a note saying to what tolerance.
 
 The readers' libraries (ezdxf, svgelements, trimesh: the ``cad`` extra) are imported only when a
-scene names a file of their kind; without them the scene is refused with one line naming the
-extra, and their log records are not printed. A file is untrusted input: at most :data:`MAX_FILE_BYTES` are read, a drawing draws at
-most :data:`MAX_ENTITIES` entities or elements (references expanded), coordinates are checked
-against the scene's limits before any curve is flattened, and flattening stops at
-:data:`MAX_POINTS` points, so time and memory are bounded by those numbers, not by the file's.
-Floating-point overflow inside the readers' libraries is not reported (a warning line would
-precede the error): what they return is checked to be finite instead.
-What the readers rely on in their libraries is in docs/stack.md, "CAD readers".
+scene names a file of their kind; without them the scene is refused with one line naming the extra,
+and their log records are not printed. A file is untrusted input: at most :data:`MAX_FILE_BYTES`
+are read, a drawing draws at most :data:`MAX_ENTITIES` entities or elements (references expanded),
+coordinates are checked against the scene's limits before any curve is flattened, and flattening
+stops at :data:`MAX_POINTS` points, so time and memory are bounded by those numbers, not by the
+file's. Floating-point overflow inside the readers' libraries is not reported (a warning line would
+precede the error): what they return is checked to be finite instead. What the readers rely on in
+their libraries is in docs/stack.md, "CAD readers".
 """
 
 from __future__ import annotations
@@ -218,7 +218,8 @@ def flattened(path: ezdxf.path.Path, selection: Selection, what: str, room: int)
     selection.check_points(np.array([(v.x, v.y) for v in path.control_vertices()]).reshape(-1, 2), what)
     flat = np.array([(v.x, v.y) for v in itertools.islice(path.flattening(selection.chord), room + 1)]).reshape(-1, 2)
     if len(flat) > room:
-        raise SceneError(selection.field, f"its curves flatten to more than {MAX_POINTS} points at this chord tolerance")
+        raise SceneError(selection.field, f"its curves flatten to more than {MAX_POINTS} points at this chord "
+                                          "tolerance")
     return flat
 
 

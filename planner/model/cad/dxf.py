@@ -23,6 +23,7 @@ all, before any is drawn.
 from __future__ import annotations
 
 import io
+import re
 from collections import Counter
 from collections.abc import Iterator
 
@@ -43,6 +44,9 @@ _MAX_DEPTH = 8
 #: here, and grows with their square. Ten such splines in all keep a file within half a second.
 MAX_FIT_POINTS = 1_000
 MAX_FIT_POINTS_IN_ALL = 10 * MAX_FIT_POINTS
+#: A kind of entity as DXF names them (TEXT, 3DFACE, ACAD_PROXY_ENTITY), and how many kinds a note lists.
+_PLAIN_KIND = re.compile(r"[A-Z0-9_]{1,40}")
+_LISTED = 6
 #: How a binary DXF file begins (AutoCAD's sentinel); ezdxf's reader takes ASCII only.
 _BINARY = b"AutoCAD Binary DXF"
 #: Bézier curves per elliptical arc: 16 keep each within 22.5 degrees, where the curve departs
@@ -90,7 +94,7 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
                 pieces.append(flat)
     chained, left_open = chains(pieces, selection.chord)
     if skipped:
-        notes.append(f"{selection.field}: not read: {', '.join(f'{n} {kind}' for kind, n in sorted(skipped.items()))}")
+        notes.append(f"{selection.field}: not read: {_kinds(skipped)}")
     if left_open:
         notes.append(f"{selection.field}: {left_open} open chain(s) of lines or arcs do not close and are not read")
     return shapes_from_rings(rings + chained, selection)
@@ -108,6 +112,19 @@ def _count_spline(spline, what: str, counted: Counter[str], selection: Selection
         raise SceneError(selection.field, f"its splines have more than {MAX_FIT_POINTS_IN_ALL} fit points in all")
     if counted["control"] > MAX_POINTS:
         raise SceneError(selection.field, f"its splines have more than {MAX_POINTS} control points in all")
+
+
+def _kinds(skipped: Counter[str]) -> str:
+    """The kinds of entity ``skipped`` counts, as a note lists them: at most :data:`_LISTED`, each
+    as its name if it is a plain DXF name (the file names them: one could be a terminal's escape
+    sequence, or a kilobyte long), else quoted from its first 20 characters.
+
+    >>> _kinds(Counter({"TEXT": 2, "HATCH": 1, "\x1b[31m": 1}))
+    "1 '\\\\x1b[31m', 1 HATCH, 2 TEXT"
+    """
+    listed = [f"{n} {kind if _PLAIN_KIND.fullmatch(kind) else shown(kind[:20])}" for kind, n in sorted(skipped.items())]
+    more = len(listed) - _LISTED
+    return ", ".join(listed[:_LISTED]) + (f" and {more} more kinds" if more > 0 else "")
 
 
 def _expanded(entities: Iterator, depth: int, skipped: Counter[str], selection: Selection,
