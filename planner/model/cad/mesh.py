@@ -54,7 +54,9 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
         raise SceneError(selection.field, f"the mesh has more than {MAX_POINTS} triangles")
     if not meshes:
         raise SceneError(selection.field, "the file holds no triangles")
-    for body in meshes:  # a PLY's or OBJ's faces index its vertices as the file says
+    for body in meshes:  # an OBJ's or PLY's vertices and faces are as the file writes them
+        if body.vertices.shape[1:] != (3,):
+            raise SceneError(selection.field, f"its vertices have {body.vertices.shape[1]} coordinates, not x, y, z")
         if (bad := body.faces[(body.faces < 0) | (body.faces >= len(body.vertices))]).size:
             raise SceneError(selection.field, f"a face refers to vertex {bad[0]}, which the mesh does not have "
                                               f"(it has {len(body.vertices)})")

@@ -371,6 +371,12 @@ def overlapping_arcs(copies: int, spans: int):
     return lambda folder: dxf_file(folder, draw)
 
 
+def ply_of_a_missing_vertex(folder: Path) -> None:
+    """A box as ASCII PLY whose last face refers to vertex 99 of its 8."""
+    text = trimesh.creation.box((10, 10, 10)).export(file_type="ply", encoding="ascii").decode().rstrip("\n")
+    (folder / "part.ply").write_text(text.rpartition(" ")[0] + " 99\n")
+
+
 def binary_dxf(folder: Path) -> None:
     doc = ezdxf.new()
     rounded_rectangle(doc.modelspace())
@@ -468,6 +474,11 @@ BAD = {
     "an STL in mm declared metres": (box_stl((80, 50, 20)), {"file": "part.stl", "units": "m"}, "slider.units",
                                      ["94.34 m across, more than the workspace's diagonal (2.828 m)",
                                       "is the file in millimetres? (units: m)"]),
+    "a PLY face of a vertex it lacks": (ply_of_a_missing_vertex, {"file": "part.ply", "units": "mm"}, "slider.file",
+                                        ["a face refers to vertex 99, which the mesh does not have (it has 8)"]),
+    "an OBJ vertex of one coordinate": (lambda folder: (folder / "part.obj").write_text(
+        "v -20\nv 20 -20 0\nv 20 20 0\nf 1 2 3\n"), {"file": "part.obj", "units": "mm"}, "slider.file",
+                                        ["its vertices have 1 coordinates, not x, y, z"]),
     "object and name both": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "object": "A", "name": "A"},
                              "slider.name", ["is object's other name: give one of them"]),
 }
