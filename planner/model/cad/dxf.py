@@ -78,7 +78,8 @@ def read(raw: bytes, suffix: str, selection: Selection, notes: list[str]) -> lis
     rings, pieces, points = [], [], 0
     spline_points: Counter[str] = Counter()  # fit and control points of the splines so far
     for entity in _expanded(entities, 0, skipped, selection):
-        what = f"{entity.dxftype()} #{entity.dxf.handle}"
+        # A block reference's entities are copies without handles: named by their kind alone.
+        what = f"{entity.dxftype()} #{entity.dxf.handle}" if entity.dxf.handle else f"a {entity.dxftype()} of a block"
         if entity.dxftype() == "SPLINE":
             _count_spline(entity, what, spline_points, selection)
         try:
