@@ -39,7 +39,7 @@ def chains(pieces: list[np.ndarray], chord: float) -> tuple[list[np.ndarray], in
         if key not in drawn:
             drawn[key] = k
             ends.append((tuple(snapped[0]), tuple(snapped[-1])))
-    kept = list(drawn.values())
+    kept = [pieces[k] for k in drawn.values()]
     at: dict[tuple, set[int]] = defaultdict(set)  # the pieces (their place in kept) at each end
     for j, (start, end) in enumerate(ends):
         at[start].add(j)
@@ -51,7 +51,7 @@ def chains(pieces: list[np.ndarray], chord: float) -> tuple[list[np.ndarray], in
         component = _component(min(left), ends, at, left)
         left -= component
         if all(degree[node] == 2 for j in component for node in ends[j]):
-            rings.append(_ring(component, ends, at, [pieces[kept[j]] for j in range(len(ends))]))
+            rings.append(_ring(component, ends, at, kept))
         else:
             open_ |= component
     return rings, _count_components(open_, ends)
