@@ -43,8 +43,8 @@ from ..input_file import read_bytes
 if TYPE_CHECKING:
     import ezdxf.path
 
-__all__ = ["CHORD", "FILE_KEYS", "FILE_OPTIONS", "MAX_ENTITIES", "MAX_FILE_BYTES", "MAX_POINTS", "MAX_VERTICES",
-           "READERS", "UNITS", "Selection", "Shape", "flattened", "read_shapes", "shapes_from_rings", "without_holes"]
+__all__ = ["CHORD", "FILE_KEYS", "FILE_OPTIONS", "MAX_ENTITIES", "MAX_FILE_BYTES", "MAX_OVERLAPS", "MAX_POINTS",
+           "MAX_VERTICES", "READERS", "UNITS", "Selection", "Shape", "flattened", "read_shapes", "shapes_from_rings", "without_holes"]
 
 #: Required keys of a file reference, and its optional ones. ``name`` is ``object``'s other name,
 #: where it names nothing else (a part of ``parts:`` has a name of its own).
@@ -70,6 +70,11 @@ MAX_ENTITIES = 10_000
 #: A circle of 10 m radius at the default chord has a thousand; a 1 km one at the least chord
 #: would have 131,073.
 MAX_VERTICES = 1_000
+#: Most pairs of a file's outlines whose extents overlap: each pair is compared (do they cross,
+#: does one hold the other), a few microseconds each. The holes of a plate or a sheet of parts
+#: overlap little (10,000 holes are 20,000 pairs); 10,000 outlines one inside the next are 50
+#: million (107 s and 2.8 GB), and a <use> of a shape copied 729 times 266,000 (12 s).
+MAX_OVERLAPS = 100_000
 #: The reader module for each file suffix.
 READERS = {".dxf": "dxf", ".svg": "svg", ".stl": "mesh", ".obj": "mesh", ".ply": "mesh"}
 
@@ -232,7 +237,8 @@ def shapes_from_rings(rings: list[np.ndarray], selection: Selection) -> list[Sha
     """The bodies that closed ``rings`` (each ``(n, 2)``, file units, not repeating the first
     point) draw: each outline not inside another is a body; one inside exactly one other is a hole
     of it; one inside a hole is a body again (even-odd nesting, as a laser cutter reads a drawing).
-    Outlines may nest but not cross, and none may cross itself.
+    Outlines may nest but not cross, and none may cross itself; at most :data:`MAX_OVERLAPS`
+    pairs of them may overlap in extent (each such pair is compared).
 
     >>> square = np.array([[0, 0], [4, 0], [4, 4], [0, 4]], float)
     >>> shapes = shapes_from_rings([square, square / 4 + 1, square / 8 + 1.25], Selection(None, None, 0.1, 1e3, "f"))
@@ -253,11 +259,17 @@ def shapes_from_rings(rings: list[np.ndarray], selection: Selection) -> list[Sha
         polygons.append(shapely.Polygon(ring))
     if not polygons:
         return []
-    tree = shapely.STRtree([p.exterior for p in polygons])
-    pairs = tree.query([p.exterior for p in polygons], predicate="intersects")
-    crossing = pairs[:, pairs[0] < pairs[1]]
-    if crossing.size:
-        raise SceneError(selection.field, f"outlines {crossing[0, 0]} and {crossing[1, 0]} cross each other (or touch)")
+    exteriors = shapely.get_exterior_ring(polygons)
+    tree, overlaps = shapely.STRtree(exteriors), 0
+    for k, exterior in enumerate(exteriors):  # the first crossing ends it: a thousand copies of one outline cost one pass
+        near = tree.query(exterior)  # whose boxes overlap its own: nothing compared yet
+        overlaps += len(near)
+        if overlaps > MAX_OVERLAPS:
+            raise SceneError(selection.field, f"its outlines nest or overlap too much to check: more than "
+                                              f"{MAX_OVERLAPS} pairs of them overlap in extent")
+        crossing = near[(near > k) & shapely.intersects(exterior, exteriors[near])]
+        if crossing.size:
+            raise SceneError(selection.field, f"outlines {k} and {crossing.min()} cross each other (or touch)")
     inside: list[list[int]] = [[] for _ in polygons]  # the outlines each is inside
     for outer, inner in shapely.STRtree(polygons).query(polygons, predicate="contains_properly").T:
         inside[inner].append(outer)

@@ -3,8 +3,8 @@
 Paths (lines, elliptical arcs, quadratic and cubic Béziers), rect, circle, ellipse, polygon and
 the like are read with every ``transform`` applied; text and images are not read, with a note.
 Each closed subpath is an outline; open ones are not read (a note says how many). Curves become an
-ezdxf path, as a DXF drawing's do (:mod:`.dxf`: arcs as 16 cubic Béziers each), flattened to the
-chord tolerance.
+ezdxf path, as a DXF drawing's do (:mod:`.dxf`: arcs as cubic Béziers of at most 22.5 degrees),
+flattened to the chord tolerance.
 
 Units: the file's numbers are read as written, in its user units (the ``viewBox``'s, which
 drawing programs and laser cutters set to millimetres), and ``units`` says what one is; the
@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import io
 import itertools
+import math
 import re
 from collections import Counter
 from typing import TYPE_CHECKING
@@ -56,7 +57,8 @@ MAX_NESTING = 100
 _HREFS = ("href", "{http://www.w3.org/1999/xlink}href")
 #: A number of path data or a polygon's points (SVG's grammar: ``1.5.5`` is two).
 _NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
-#: Bézier curves per elliptical arc, as for DXF (:mod:`.dxf`).
+#: Bézier curves per full turn of an elliptical arc, at most 22.5 degrees each, as for DXF
+#: (:mod:`.dxf`); an arc of a quarter turn (each of a circle's four) gets four.
 _ARC_CURVES = 16
 
 
@@ -232,7 +234,7 @@ def _path(segments: list) -> tuple[ezdxf.path.Path | None, bool]:
         elif isinstance(segment, svg.QuadraticBezier):
             path.curve3_to((end.x, end.y), (segment.control.x, segment.control.y))
         elif isinstance(segment, svg.Arc) and segment.rx and segment.ry:
-            for cubic in segment.as_cubic_curves(_ARC_CURVES):
+            for cubic in segment.as_cubic_curves(_cubics(segment.sweep)):
                 path.curve4_to((cubic.end.x, cubic.end.y), (cubic.control1.x, cubic.control1.y),
                                (cubic.control2.x, cubic.control2.y))
         elif not isinstance(segment, svg.Move):  # a line, or an arc of no radius, which is one
@@ -242,3 +244,16 @@ def _path(segments: list) -> tuple[ezdxf.path.Path | None, bool]:
     if closed and not path.is_closed:
         path.line_to(path.start)
     return path, closed or path.is_closed
+
+
+def _cubics(sweep: float) -> int:
+    """How many cubic Béziers an arc of ``sweep`` radians is drawn with: one per 22.5 degrees, at
+    least one (a sweep a file's numbers made infinite or NaN gets a full turn's: its points are
+    checked next).
+
+    >>> _cubics(math.pi / 2), _cubics(-2 * math.pi), _cubics(0.01), _cubics(float("nan"))
+    (4, 16, 1, 16)
+    """
+    if not math.isfinite(sweep):
+        return _ARC_CURVES
+    return max(1, math.ceil(_ARC_CURVES * min(abs(sweep), math.tau) / math.tau))
