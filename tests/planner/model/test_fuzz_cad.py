@@ -219,27 +219,27 @@ def element_attributes(draw: Callable) -> str:
     return id_ + transform
 
 
+#: The numbers each plain shape is drawn by.
+SHAPES = {"rect": ("x", "y", "width", "height"), "circle": ("cx", "cy", "r"), "ellipse": ("cx", "cy", "rx", "ry"),
+          "line": ("x1", "y1", "x2", "y2")}
+
+
 @st.composite
 def svg_shapes(draw: Callable) -> str:
-    kind = draw(st.sampled_from(["rect", "circle", "ellipse", "path", "polygon", "line", "text", "use"]))
-    c = lambda: draw(coordinates)  # noqa: E731 (one number, drawn where it is written)
+    """One element of any kind drawn (a shape, a path, a polygon, a text, a use), any numbers."""
+    kind = draw(st.sampled_from([*SHAPES, "path", "polygon", "text", "use"]))
     own = draw(element_attributes())
-    if kind == "rect":
-        return f'<rect x="{c()}" y="{c()}" width="{c()}" height="{c()}"{own}/>'
-    if kind == "circle":
-        return f'<circle cx="{c()}" cy="{c()}" r="{c()}"{own}/>'
-    if kind == "ellipse":
-        return f'<ellipse cx="{c()}" cy="{c()}" rx="{c()}" ry="{c()}"{own}/>'
+    if kind in SHAPES:
+        numbers = " ".join(f'{key}="{draw(coordinates)}"' for key in SHAPES[kind])
+        return f"<{kind} {numbers}{own}/>"
     if kind == "path":
         return f'<path d="{draw(path_data())}"{own}/>'
     if kind == "polygon":
-        return f'<polygon points="{" ".join(c() for _ in range(draw(st.integers(0, 9))))}"{own}/>'
-    if kind == "line":
-        return f'<line x1="{c()}" y1="{c()}" x2="{c()}" y2="{c()}"{own}/>'
+        return f'<polygon points="{" ".join(draw(coordinates) for _ in range(draw(st.integers(0, 9))))}"{own}/>'
     if kind == "text":
-        return f'<text x="{c()}" y="{c()}"{own}>label</text>'
+        return f'<text x="{draw(coordinates)}" y="{draw(coordinates)}"{own}>label</text>'
     href = draw(st.sampled_from([*IDS, "missing", ""]))
-    return f'<use {draw(st.sampled_from(["href", "xlink:href"]))}="#{href}" x="{c()}"{own}/>'
+    return f'<use {draw(st.sampled_from(["href", "xlink:href"]))}="#{href}" x="{draw(coordinates)}"{own}/>'
 
 
 def group(children: list[str], own: str) -> str:
