@@ -1,5 +1,5 @@
 """The README's promises: its two opening commands, CI running the same tests, the quick start's
-commands and their output, the API examples."""
+commands and their output, the API examples, the CAD example."""
 
 from __future__ import annotations
 
@@ -9,6 +9,9 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
+import yaml
 
 from planner.model.extras import have
 
@@ -150,3 +153,29 @@ def test_batch_example_saved_as_a_script_without_a_guard_solves_every_task(tmp_p
     run = subprocess.run([sys.executable, "mu.py"], cwd=tmp_path, capture_output=True, text=True, timeout=120)
     assert (run.returncode, run.stdout) == (0, "['solved', 'solved']\n"), run.stderr
     assert "Traceback" not in run.stderr and "Warning" not in run.stderr, run.stderr
+
+
+def test_the_cad_example_is_the_shipped_scene_and_its_commands_write_under_logs(tmp_path):
+    """The README's CAD scene is scenes/cad/bracket.yaml as shipped (beside the files it names), and
+    its commands, run as written in a scratch folder holding the scenes, plan and verify it and
+    write nothing but under logs/ (they used to leave out/ and bracket-plain.yaml beside scenes/)."""
+    if not (have("ezdxf") and have("svgelements")):
+        pytest.skip("the cad extra is not installed")
+    section = README[README.index("### Parts and obstacles from CAD files"):README.index("### Several parts")]
+    snippet = re.search(r"```yaml\n# (\S+)\n(.*?)```", section, re.S)
+    shipped = ROOT / snippet.group(1)
+    assert yaml.safe_load(snippet.group(2)) == yaml.safe_load(shipped.read_text())
+    scene = yaml.safe_load(shipped.read_text())
+    assert all((shipped.parent / spec["file"]).is_file() for spec in [scene["slider"], *scene["obstacles"]]
+               if "file" in spec)
+    (tmp_path / "scenes").symlink_to(ROOT / "scenes")
+    (tmp_path / "logs").mkdir()  # a checkout has it (its README is tracked)
+    env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
+    commands = re.search(r"```text\n(\$ plan scenes/cad/.*?)```", section, re.S).group(1).splitlines()
+    assert len(commands) == 2
+    for command in commands:
+        run = subprocess.run(command.removeprefix("$ "), shell=True, cwd=tmp_path, env=env, capture_output=True,
+                             text=True, timeout=300)
+        assert run.returncode == 0, (command, run.stderr)
+    assert "verify: passed" in run.stdout
+    assert {p.name for p in tmp_path.iterdir()} == {"scenes", "logs"}  # nothing beside logs/

@@ -32,6 +32,7 @@ from .files import write_atomic
 from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vector
 from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
 from .robot import Robot, read_robot
+from .scale import check_scale
 from .scene import ONE_PART, Part, Pusher, Scene
 from .yaml_file import read_yaml
 
@@ -186,31 +187,36 @@ def _obstacles(value: Any, name: str, folder: Path, notes: list[str]) -> list[sh
     return [shapely.Polygon(corners @ rot.T + [cx, cy])]
 
 
-def read_slider(value: Any, folder: Path, notes: list[str], name: str = "slider",
-                more: tuple[str, ...] = ()) -> Slider:
-    """The part ``value`` describes (its vertices or a CAD file, and its CF), checked; errors
-    name the fields under ``name``, and ``more`` are further keys ``value`` may hold (read by
-    the caller: a multi-part scene's name, start and goal)."""
+def read_slider(value: Any, folder: Path, notes: list[str], pusher: Pusher,
+                workspace: tuple[float, float, float, float], name: str = "slider", more: tuple[str, ...] = ()) -> Slider:
+    """The part ``value`` describes (its vertices or a CAD file, and its CF), checked, also for
+    a size that suits ``pusher`` and ``workspace`` (:func:`.scale.check_scale`); errors name the
+    fields under ``name``, and ``more`` are further keys ``value`` may hold (read by the caller: a
+    multi-part scene's name, start and goal)."""
     if isinstance(value, dict) and "file" in value:
-        return _slider_from_file(value, folder, notes, name, more)
+        return _slider_from_file(value, folder, notes, pusher, workspace, name, more)
     spec = keys(value, name, ("vertices",), ("cf", "cf_uncertainty") + more)
     vertices = _points(spec["vertices"], f"{name}.vertices")
+    check_scale(vertices, pusher.width, workspace, f"{name}.vertices", None)
     return _checked_slider(vertices, spec, f"{name}.vertices", name)
 
 
-def _slider_from_file(value: dict, folder: Path, notes: list[str], name: str, more: tuple[str, ...]) -> Slider:
+def _slider_from_file(value: dict, folder: Path, notes: list[str], pusher: Pusher,
+                      workspace: tuple[float, float, float, float], name: str, more: tuple[str, ...]) -> Slider:
     """The part a file draws: its outline is what the pusher touches, and its default CF the
-    centroid of its footprint, holes left out (a hole carries no weight)."""
+    centroid of its footprint, holes left out (a hole carries no weight). ``more`` are the keys
+    of the part's own (a part of ``parts:`` has a ``name``), not the file's."""
     from .cad import FILE_KEYS, FILE_OPTIONS, read_shapes
 
     spec = keys(value, name, FILE_KEYS, FILE_OPTIONS + ("cf", "cf_uncertainty") + more)
     shapes = read_shapes({k: v for k, v in spec.items() if k not in more}, name, folder, notes)
     if len(shapes) > 1:
-        raise SceneError(f"{name}.file", f"holds {len(shapes)} parts: pick one with layer or name")
+        raise SceneError(f"{name}.file", f"holds {len(shapes)} parts: pick one with layer or object")
     (shape,) = shapes
     if shape.footprint.area <= 0:
         raise SceneError(f"{name}.file", "the part has no footprint on the table")
     vertices = np.asarray(shape.region.exterior.coords)[:-1]
+    check_scale(vertices, pusher.width, workspace, f"{name}.units", spec["units"])
     cf = np.asarray(shape.footprint.centroid.coords[0])
     return _checked_slider(vertices, {"cf": cf.tolist(), **spec}, f"{name}.file", name)
 
@@ -342,11 +348,11 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     spec = keys(data, "scene", required, optional)
     name = read_name(spec.get("name", default_name))
     folder, notes = Path(path).parent if path else Path(), []
-    slider = read_slider(spec["slider"], folder, notes)
-    cf_uncertainty = read_cf_uncertainty(spec["slider"], slider, "slider")
     pusher, listed, transit = read_pusher(spec["pusher"], True)
+    table = read_table(spec, folder, notes, transit)  # the part's size is checked against both
+    slider = read_slider(spec["slider"], folder, notes, pusher, table.workspace)
+    cf_uncertainty = read_cf_uncertainty(spec["slider"], slider, "slider")
     edges = read_edges(listed, slider, "pusher.edges")
-    table = read_table(spec, folder, notes, transit)
     start = read_pose(spec["start"], "start", slider, table.obstacles, table.workspace)
     goal = read_pose(spec["goal"], "goal", slider, table.obstacles, table.workspace)
     part = Part(ONE_PART, slider, start, goal, edges, cf_uncertainty)
@@ -435,7 +441,7 @@ def _parse_parts(data: dict, default_name: str, path: str | None) -> Scene:
     parts: list[Part] = []
     for i, item in enumerate(listed):
         field_name = f"parts[{i}]"
-        slider = read_slider(item, folder, notes, field_name, _PART_KEYS)
+        slider = read_slider(item, folder, notes, pusher, table.workspace, field_name, _PART_KEYS)
         for key in ("name", "start", "goal"):
             if key not in item:
                 raise SceneError(f"{field_name}.{key}", "missing")

@@ -10,6 +10,9 @@ files written here by the libraries' writers or by hand.
 from __future__ import annotations
 
 import math
+import re
+import resource
+import subprocess
 import sys
 import time
 import tracemalloc
@@ -25,10 +28,10 @@ pytest.importorskip("svgelements")
 trimesh = pytest.importorskip("trimesh")
 
 from planner.cli import main  # noqa: E402 (after the skips)
-from planner.model.cad import MAX_FILE_BYTES  # noqa: E402
+from planner.model.cad import MAX_FILE_BYTES, MAX_VERTICES  # noqa: E402
 from planner.model.fields import SceneError  # noqa: E402
 from planner.model.scene_file import load_scene, parse_scene  # noqa: E402
-from test_cli import assert_nothing_written, error_field  # noqa: E402
+from test_cli import PLAN, assert_nothing_written, error_field  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[3]
 PUSHER = {"width": 0.03, "depth": 0.01, "mu": 0.5}
@@ -160,6 +163,36 @@ def test_a_mesh_outline_is_its_projection_and_its_cf_the_footprints_centroid(tmp
     assert part.cf == pytest.approx([0.03, 0.0], abs=1e-7)
 
 
+def plate_with_a_hole(outer: float, hole: float, hole_x: float, height: float):
+    """A square plate ``outer`` mm wide with a square hole ``hole`` mm wide centred at (``hole_x``,
+    0), as one mesh whose top and bottom faces are each one patch with a hole (trimesh's own
+    projection needed networkx and rtree, which the cad extra does not install, for those)."""
+    o = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * outer / 2
+    i = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * hole / 2 + [hole_x, 0]
+    vertices = np.vstack([np.c_[ring, np.full(4, z)] for z in (0.0, height) for ring in (o, i)])  # O0 I0 O1 I1
+    ring = [(k, (k + 1) % 4) for k in range(4)]
+    top = [f for a, b in ring for f in ((8 + a, 8 + b, 12 + b), (8 + a, 12 + b, 12 + a))]
+    bottom = [f[::-1] for f in [(a, b, 4 + b) for a, b in ring] + [(a, 4 + b, 4 + a) for a, b in ring]]
+    walls = [f for a, b in ring for f in ((a, b, 8 + b), (a, 8 + b, 8 + a))]
+    walls += [f[::-1] for a, b in ring for f in ((4 + a, 4 + b, 12 + b), (4 + a, 12 + b, 12 + a))]
+    return trimesh.Trimesh(vertices, top + bottom + walls, process=False)
+
+
+def test_a_mesh_whose_faces_have_holes_is_read_and_its_cf_leaves_the_hole(tmp_path, monkeypatch, capsys):
+    """Issue 41's fuzzing: a washer or a plate with a bolt hole as an STL ended in a traceback
+    (ModuleNotFoundError: networkx). Its outline is the plate's; its CF is the footprint's
+    centroid, moved away from the hole: -(10 * 10 * 10) / (40 * 40 - 10 * 10) mm."""
+    plate_with_a_hole(40, 10, 10, 5).export(tmp_path / "plate.stl")
+    part = load(tmp_path, scene({"file": "plate.stl", "units": "mm"})).slider
+    assert part.polygon.bounds == pytest.approx((-0.02, -0.02, 0.02, 0.02))
+    assert part.cf == pytest.approx([-1000 / 1500 * 1e-3, 0], abs=1e-9)
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene({"file": "plate.stl", "units": "mm"},
+                                                              start=[0, 0, 0], goal=[0.3, 0, 0])))
+    monkeypatch.chdir(tmp_path)
+    assert main(["scene.yaml", "--out", "out"]) == 0
+    assert capsys.readouterr().out.startswith("solved: ")
+
+
 # --- selection, units, placement --------------------------------------------------------------------
 
 def two_parts(msp) -> None:
@@ -174,7 +207,7 @@ def test_a_layer_picks_one_part_of_several(tmp_path, monkeypatch, capsys):
     assert spare.cf == pytest.approx([0.2, 0.0], abs=5e-5)  # no hole on that layer
     part = load(tmp_path, scene({"file": "part.dxf", "units": "mm", "layer": "PART"})).slider
     assert part.polygon.bounds == pytest.approx((-0.04, -0.025, 0.04, 0.025), abs=1e-4)
-    with pytest.raises(SceneError, match="slider.file: holds 2 parts: pick one with layer or name"):
+    with pytest.raises(SceneError, match="slider.file: holds 2 parts: pick one with layer or object"):
         load(tmp_path, scene({"file": "part.dxf", "units": "mm"}))
 
 
@@ -300,6 +333,67 @@ def part_on_layer(layer: str):
     return lambda folder: dxf_file(folder, lambda msp: rounded_rectangle(msp, layer))
 
 
+def use_fan(folder: Path) -> None:
+    """Issue 41: 1.5 KB of groups of five <use> of the group below, ten levels: 5 ** 10 squares
+    once svgelements expands them (it hung)."""
+    levels = "".join(f'<g id="l{k}">' + "".join(f'<use href="#l{k - 1}" x="{x}"/>' for x in range(5)) + "</g>"
+                     for k in range(1, 11))
+    svg_file(folder, f'<defs><g id="l0"><rect width="1" height="1"/></g>{levels}</defs><use href="#l10"/>')
+
+
+def use_chain(depth: int):
+    """<use> nested ``depth`` deep: each level a group holding one use of the level below."""
+    levels = "".join(f'<g id="l{k}"><use xlink:href="#l{k - 1}"/></g>' for k in range(1, depth + 1))
+    return lambda folder: (folder / "part.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" viewBox="0 0 9 9">'
+        f'<defs><rect id="l0" width="1" height="1"/>{levels}</defs><use xlink:href="#l{depth}"/></svg>')
+
+
+def splines(count: int, fit_points: int):
+    """``count`` splines through ``fit_points`` points round a circle of radius 50 mm."""
+    def draw(msp) -> None:
+        angles = np.linspace(0, 2 * np.pi, fit_points)
+        for k in range(count):
+            msp.add_spline(np.c_[50 * np.cos(angles) + 200 * k, 50 * np.sin(angles)])
+    return lambda folder: dxf_file(folder, draw)
+
+
+def overlapping_arcs(copies: int, spans: int):
+    """``copies`` of ``spans`` arcs of one circle of radius 20 mm, each of a random span: issue 41's
+    fuzzing found their union (how open pieces were joined) took 24 s for 300 and 6.5 s for 500
+    copies of one (2,000 took all the memory)."""
+    def draw(msp) -> None:
+        rng = np.random.default_rng(1)
+        for _ in range(spans):
+            start = rng.uniform(0, 360)
+            for _ in range(copies):
+                msp.add_arc((0, 0), 20, start, start + rng.uniform(30, 170))
+    return lambda folder: dxf_file(folder, draw)
+
+
+def ply_of_a_missing_vertex(folder: Path) -> None:
+    """A box as ASCII PLY whose last face refers to vertex 99 of its 8."""
+    text = trimesh.creation.box((10, 10, 10)).export(file_type="ply", encoding="ascii").decode().rstrip("\n")
+    (folder / "part.ply").write_text(text.rpartition(" ")[0] + " 99\n")
+
+
+def binary_dxf(folder: Path) -> None:
+    doc = ezdxf.new()
+    rounded_rectangle(doc.modelspace())
+    doc.saveas(folder / "part.dxf", fmt="bin")
+
+
+def huge_bulge(folder: Path) -> None:
+    dxf_file(folder, lambda msp: msp.add_lwpolyline([(0, 0, 1e300), (10, 0, 0), (10, 10, 0)], format="xyb",
+                                                     close=True))
+
+
+def box_stl(size_in_file: tuple[float, float, float]):
+    """An STL box of ``size_in_file`` (the file's numbers), resting on z = 0."""
+    return lambda folder: trimesh.creation.box(size_in_file).apply_translation(
+        (0, 0, size_in_file[2] / 2)).export(folder / "part.stl")
+
+
 def svg_text(text: str):
     return lambda folder: (folder / "part.svg").write_text(
         f'<svg xmlns="http://www.w3.org/2000/svg" {text}</svg>')
@@ -348,6 +442,53 @@ BAD = {
                                "slider.file", ["holds 2 parts"]),
     "an unknown key": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "layers": "PART"},
                        "slider.layers", ["did you mean layer?"]),
+    # Issue 41: each ran out of time or memory, or printed more than one line.
+    "SVG <use> fanning out ten levels": (use_fan, {"file": "part.svg", "units": "mm"}, "slider.file",
+                                         ["expands to more than 10000 elements (<use> copies counted)"]),
+    "SVG <use> nested nine deep": (use_chain(9), {"file": "part.svg", "units": "mm"}, "slider.file",
+                                   ["nests <use> more than 8 deep"]),
+    "an SVG <use> of its own group": (svg_text('viewBox="0 0 9 9"><g id="a"><use href="#a"/></g>'),
+                                      {"file": "part.svg", "units": "mm"}, "slider.file",
+                                      ["a <use> refers to an element that holds it"]),
+    "SVG groups nested 150 deep": (svg_text('viewBox="0 0 9 9">' + "<g>" * 150 + '<rect width="1" height="1"/>'
+                                            + "</g>" * 150), {"file": "part.svg", "units": "mm"}, "slider.file",
+                                   ["nests elements more than 100 deep"]),
+    "an SVG path of 200,001 lines": (svg_text('viewBox="0 0 9 9"><path d="M 0 0' + " L 1 1" * 200_001 + '"/>'),
+                                     {"file": "part.svg", "units": "mm"}, "slider.file",
+                                     ["more than 200000 points of path data"]),
+    "a circle used 729 times over itself": (lambda folder: svg_file(folder, '<defs><circle id="c0" cx="50" cy="50" r="9"/>'
+                                                                  + "".join(f'<g id="c{k}">' + f'<use href="#c{k - 1}"/>' * 3
+                                                                            + "</g>" for k in range(1, 7)) + '</defs><use href="#c6"/>'),
+                                            {"file": "part.svg", "units": "mm"}, "slider.file",
+                                            ["outlines 0 and 1 cross each other (or touch)"]),
+    "2,000 squares one inside the next": (lambda folder: svg_file(folder, "".join(
+        f'<rect x="{-k}" y="{-k}" width="{2 * k + 1}" height="{2 * k + 1}"/>' for k in range(2000))),
+        {"file": "part.svg", "units": "mm"}, "slider.file", ["nest or overlap too much to check: more than 100000 pairs"]),
+    "a spline through 20,000 points": (splines(1, 20_000), {"file": "part.dxf", "units": "mm"}, "slider.file",
+                                       ["SPLINE #", "has 20000 fit points, more than 1000"]),
+    "21 splines through 500 points": (splines(21, 500), {"file": "part.dxf", "units": "mm"}, "slider.file",
+                                            ["its splines have more than 10000 fit points in all"]),
+    "300 arcs overlapping on one circle": (overlapping_arcs(1, 300), {"file": "part.dxf", "units": "mm"},
+                                           "slider.file", ["holds no closed outline;", "open chain(s)"]),
+    "1,000 copies of one arc": (overlapping_arcs(1000, 1), {"file": "part.dxf", "units": "mm"}, "slider.file",
+                                ["holds no closed outline; 1 open chain(s)"]),
+    "a binary DXF": (binary_dxf, {"file": "part.dxf", "units": "mm"}, "slider.file",
+                     ["a binary DXF file, which is not read: save it as ASCII DXF"]),
+    "a bulge of 1e300": (huge_bulge, {"file": "part.dxf", "units": "mm"}, "slider.file",
+                         ["LWPOLYLINE #", "cannot be drawn"]),
+    "an STL in metres declared mm": (box_stl((0.08, 0.05, 0.02)), {"file": "part.stl", "units": "mm"}, "slider.units",
+                                     ["um across, less than 1/100 of the pusher's width (30 mm)",
+                                      "is the file in metres? (units: mm)"]),
+    "an STL in mm declared metres": (box_stl((80, 50, 20)), {"file": "part.stl", "units": "m"}, "slider.units",
+                                     ["94.34 m across, more than the workspace's diagonal (2.828 m)",
+                                      "is the file in millimetres? (units: m)"]),
+    "a PLY face of a vertex it lacks": (ply_of_a_missing_vertex, {"file": "part.ply", "units": "mm"}, "slider.file",
+                                        ["a face refers to vertex 99, which the mesh does not have (it has 8)"]),
+    "an OBJ vertex of one coordinate": (lambda folder: (folder / "part.obj").write_text(
+        "v -20\nv 20 -20 0\nv 20 20 0\nf 1 2 3\n"), {"file": "part.obj", "units": "mm"}, "slider.file",
+                                        ["its vertices have 1 coordinates, not x, y, z"]),
+    "object and name both": (part_on_layer("PART"), {"file": "part.dxf", "units": "mm", "object": "A", "name": "A"},
+                             "slider.name", ["is object's other name: give one of them"]),
 }
 
 
@@ -376,6 +517,9 @@ def test_bad_cad_input_exits_1_with_one_line_and_writes_nothing(case, tmp_path, 
     assert len(captured.err) <= 301
     assert_nothing_written(tmp_path, before)
     assert seconds < 5.0 and peak < 100e6  # bounded by the caps, not by the file (tracemalloc slows it 2-5x)
+    with pytest.raises(SceneError) as raised:  # the library says the same
+        load_scene("scene.yaml")
+    assert captured.err == f"plan: error: {raised.value}\n"
 
 
 def test_without_the_cad_extra_a_file_is_one_line_naming_it(tmp_path, monkeypatch, capsys):
@@ -412,6 +556,168 @@ def test_the_export_holds_the_options_the_flags_set(tmp_path, monkeypatch):
     assert main([str(ROOT / "scenes" / "battery.yaml"), *argv]) == 0
     again = load_scene(tmp_path / "again.yaml")
     assert again.options.transit == "lift" and again.options.switch_cost == 0.1 and again.options.seed == 7
+
+
+#: Issue 41's files that ran out of time or memory, or printed warnings before the error line.
+HEAVY = ["SVG <use> fanning out ten levels", "a spline through 20,000 points", "a bulge of 1e300",
+         "an STL in metres declared mm"]
+FOUR_GB = 4 * 2 ** 30
+
+
+@pytest.mark.parametrize("case", HEAVY)
+def test_issue_41_files_end_at_once_in_one_line_under_a_4_gb_address_space(case, tmp_path):
+    """The command as a user runs it, in a process that cannot have more than 4 GB: one line on
+    stderr (no RuntimeWarning above it), exit 1, within seconds. Before: a hang, 9.2 GB, two
+    warning lines, 24 GB."""
+    make, slider, field, words = BAD[case]
+    make(tmp_path)
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene(slider)))
+    before = {p.name for p in tmp_path.iterdir()}
+    clock = time.monotonic()
+    run = subprocess.run([str(PLAN), "scene.yaml", "--out", "out"], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=120, preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_AS, (FOUR_GB, FOUR_GB)))
+    assert time.monotonic() - clock < 20
+    assert (run.returncode, run.stdout) == (1, "") and error_field(run.stderr) == field
+    assert all(word in run.stderr for word in words), run.stderr
+    assert_nothing_written(tmp_path, before)
+
+
+def circle(radius: float):
+    return lambda folder: dxf_file(folder, lambda msp: msp.add_circle((0, 0), radius), "circle.dxf")
+
+
+def test_an_outline_past_the_vertex_cap_is_read_at_a_coarser_chord_with_a_note(tmp_path):
+    """Issue 41: a circle of radius 999,999 mm at the least chord flattened to 131,073 vertices
+    (the part's edges, each checked against every other: over 120 s). It keeps at most
+    MAX_VERTICES, every one within the chord the note gives of the circle; that chord is within
+    eight times the least any polygon of that many vertices can have (its sagitta): simplifying
+    a regular polygon halves its vertices (1000 are 512: four times the sagitta), and the
+    tolerance doubles until they fit (twice that at most)."""
+    circle(999_999)(tmp_path)
+    part = {"vertices": [[0, 0], [0.08, 0], [0.08, 0.05], [0, 0.05]]}
+    loaded = load(tmp_path, scene(part, [{"file": "circle.dxf", "units": "mm", "chord": 1e-6}],
+                                  workspace={"min": [-1000, -1000], "max": [1000, 1000]},
+                                  start=[990, 990, 0], goal=[980, 990, 0]))
+    (note,) = loaded.notes
+    found = re.fullmatch(r"obstacles\[0\]\.file: an outline keeps (\d+) vertices at chord 1e-06 m, more than 1000: "
+                         r"read at chord (\S+) m", note)
+    assert found and int(found.group(1)) > MAX_VERTICES, note
+    chord = float(found.group(2))
+    outline = np.asarray(loaded.obstacles[0].exterior.coords)[:-1]
+    assert len(outline) <= MAX_VERTICES
+    assert np.abs(np.hypot(*outline.T) - 999.999).max() <= chord
+    assert chord <= 8 * 999.999 * (1 - math.cos(math.pi / MAX_VERTICES))
+
+
+def test_the_command_plans_past_an_outline_read_at_a_coarser_chord_and_says_so(tmp_path, monkeypatch, capsys):
+    circle(500)(tmp_path)  # 4096 vertices at the least chord
+    part = {"vertices": [[-0.04, -0.025], [0.04, -0.025], [0.04, 0.025], [-0.04, 0.025]]}
+    obstacle = {"file": "circle.dxf", "units": "mm", "chord": 1e-6, "at": [0, 0.6, 0]}
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(scene(part, [obstacle], goal=[0.5, -0.5, 0])))
+    monkeypatch.chdir(tmp_path)
+    assert main(["scene.yaml", "--out", "out"]) == 0
+    err = capsys.readouterr().err
+    assert re.fullmatch(r"plan: note: obstacles\[0\]\.file: an outline keeps \d+ vertices at chord 1e-06 m, more "
+                        r"than 1000: read at chord \S+ m\n", err), err
+
+
+def test_splines_control_points_are_capped_in_all_before_they_are_drawn(tmp_path, monkeypatch):
+    """The cap is MAX_POINTS (a spline of 200,001 control points is an 8 MB file): a tenth of it
+    here, so that a few points make the file."""
+    def draw(msp) -> None:
+        for k in range(2):
+            msp.add_open_spline([(x, 20 * k + (x % 2)) for x in range(12)])
+
+    dxf_file(tmp_path, draw)
+    monkeypatch.setattr("planner.model.cad.dxf.MAX_POINTS", 20)  # the first spline's 12 pass, not 24 in all
+    monkeypatch.setattr("planner.model.cad.dxf.flattened", lambda path, *args: np.zeros((0, 2)))  # no point counted
+    with pytest.raises(SceneError, match="slider.file: its splines have more than 20 control points in all"):
+        load(tmp_path, scene({"file": "part.dxf", "units": "mm"}))
+
+
+def two_boxes_obj(folder: Path) -> None:
+    """An OBJ of two objects: 'left', a 10 mm cube at the origin, and 'right', a 5 mm one at x = 30 mm."""
+    lines, offset = [], 1
+    for name, size, x in (("left", 10, 0), ("right", 5, 30)):
+        box = trimesh.creation.box((size, size, size)).apply_translation((x, 0, size / 2))
+        lines += [f"o {name}", *(f"v {a} {b} {c}" for a, b, c in box.vertices),
+                  *(f"f {i + offset} {j + offset} {k + offset}" for i, j, k in box.faces)]
+        offset += len(box.vertices)
+    (folder / "parts.obj").write_text("\n".join(lines) + "\n")
+
+
+def test_an_obj_object_is_picked_by_its_name(tmp_path):
+    two_boxes_obj(tmp_path)
+    right = load(tmp_path, scene({"file": "parts.obj", "units": "mm", "object": "right"})).slider
+    assert right.polygon.bounds == pytest.approx((0.0275, -0.0025, 0.0325, 0.0025), abs=1e-9)
+    left = load(tmp_path, scene({"file": "parts.obj", "units": "mm", "name": "left"})).slider  # name: the same
+    assert left.polygon.bounds == pytest.approx((-0.005, -0.005, 0.005, 0.005), abs=1e-9)
+    with pytest.raises(SceneError, match=r"slider.file: no body named 'middle' \(bodies: 'left', 'right'\)"):
+        load(tmp_path, scene({"file": "parts.obj", "units": "mm", "object": "middle"}))
+    with pytest.raises(SceneError, match="slider.file: holds 2 parts: pick one with layer or object"):
+        load(tmp_path, scene({"file": "parts.obj", "units": "mm"}))
+
+
+def test_a_trays_parts_name_themselves_and_object_picks_from_the_file(tmp_path, monkeypatch, capsys):
+    """Issue 41: a part's ``name`` (its name in the tray) hid the file's ``name`` selector. In
+    ``parts:`` it names the part alone; ``object`` picks from the file, here the other way round."""
+    two_boxes_obj(tmp_path)
+    parts = [{"name": "left", "file": "parts.obj", "units": "mm", "object": "right", "start": [-0.3, 0, 0],
+              "goal": [0.3, 0, 0]},
+             {"name": "right", "file": "parts.obj", "units": "mm", "object": "left", "start": [0, 0.3, 0],
+              "goal": [0, 0.3, 0]}]
+    data = {"parts": parts, "pusher": PUSHER, "workspace": {"min": [-1, -1], "max": [1, 1]}}
+    tray = load(tmp_path, data)
+    assert tray.names == ("left", "right")
+    assert [p.slider.area for p in tray.parts] == pytest.approx([25e-6, 100e-6])
+    (tmp_path / "scene.yaml").write_text(yaml.safe_dump(data))
+    monkeypatch.chdir(tmp_path)
+    assert main(["scene.yaml", "--out", "out"]) == 0
+    assert capsys.readouterr().out.startswith("solved: 2 parts")
+    del parts[0]["object"]  # the part's name picks nothing
+    with pytest.raises(SceneError, match=r"parts\[0\].file: holds 2 parts: pick one with layer or object"):
+        load(tmp_path, data)
+
+
+def test_a_part_of_vertices_far_too_small_for_its_pusher_names_them_in_metres(tmp_path):
+    tiny = {"vertices": [[0, 0], [80e-6, 0], [80e-6, 50e-6], [0, 50e-6]]}
+    with pytest.raises(SceneError, match=r"^slider.vertices: the part is 94.34 um across, less than 1/100 of the "
+                                         r"pusher's width \(30 mm\): the vertices are in metres$"):
+        load(tmp_path, scene(tiny))
+
+
+def test_an_outline_of_arcs_drawn_many_times_over_is_read_once(tmp_path):
+    """Two half circles, each drawn 1,000 times, and a stray line from one of their joints: one
+    outline (a piece drawn twice counts once; a piece leading nowhere is cut off), read at once."""
+    def draw(msp) -> None:
+        for _ in range(1000):
+            msp.add_arc((0, 0), 20, 0, 180)
+            msp.add_arc((0, 0), 20, 180, 360)
+        msp.add_line((20, 0), (40, 0))
+
+    dxf_file(tmp_path, draw)
+    clock = time.perf_counter()
+    loaded = load(tmp_path, scene({"file": "part.dxf", "units": "mm"}))
+    assert time.perf_counter() - clock < 5.0
+    assert math.pi * (20 - 0.1) ** 2 < loaded.slider.area * 1e6 < math.pi * 20 ** 2
+    assert loaded.notes == ("slider.file: 1 open chain(s) of lines or arcs do not close and are not read",)
+
+
+def test_what_ezdxf_repairs_is_a_note_not_its_log_lines(tmp_path):
+    """A coordinate that is not a number ("0.0abc") is read by ezdxf as 0.0, which it logged: two
+    lines Python's last-resort handler printed above the outcome. Now one note says so."""
+    dxf_file(tmp_path, lambda msp: msp.add_lwpolyline([(0, 0), (40, 0), (40, 30), (0, 30)], close=True))
+    text = (tmp_path / "part.dxf").read_text()
+    first = text.index("\n 10\n", text.index("AcDbPolyline")) + 5
+    (tmp_path / "part.dxf").write_text(text[:first] + "0.0abc" + text[text.index("\n", first):])
+    data = scene({"file": "part.dxf", "units": "mm"}, start=[0, 0, 0], goal=[0, 0, 0])
+    note = ("slider.file: ezdxf repaired 2 errors of the file (the first: 'recovered invalid floating point value "
+            '"0.0abc" near line')
+    assert load(tmp_path, data).notes[0].startswith(note)
+    run = subprocess.run([str(PLAN), "scene.yaml", "--out", "out"], cwd=tmp_path, capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 0 and run.stdout.startswith("solved: 0 pushes")
+    assert run.stderr.startswith(f"plan: note: {note}") and run.stderr.count("\n") == 1, run.stderr
 
 
 # --- the example, planned and verified against its exported scene ------------------------------------
