@@ -270,28 +270,36 @@ def test_a_picture_of_a_multi_part_plan_holds_its_headline(plans, tmp_path):
     assert Image.open(tmp_path / "swap.png").text["Description"] == f"swap: {plans['swap'].headline()}"
 
 
-def test_a_tray_with_a_part_of_two_microns_plans_within_a_memory_cap(tmp_path):
-    """Swap with its red block shrunk to a square of 2 um: the buffer grid was spaced a part radius
-    apart (2.55 TiB asked for, a MemoryError); now each grid is held to a number of cells the
-    table sets (planner.world.grid), so under a 4 GB address space the plan comes in seconds, the
-    tiny part pushed aside and fetched, and replays."""
+def test_a_tray_with_a_tiny_part_plans_within_a_memory_cap_and_one_too_tiny_is_one_line(tmp_path):
+    """Swap with its red block shrunk: the buffer grid was spaced a part radius apart (a square of
+    2 um asked for 2.55 TiB, a MemoryError); now each grid is held to a number of cells the table
+    sets (planner.world.grid), so under a 4 GB address space a square of 0.6 mm (just above
+    the units hint's 1/100 of the pusher's width, planner.model.scale) is planned in seconds, the
+    tiny part pushed aside and fetched, and replays; one of 2 um is refused at once, one line."""
     spec = spec_of("swap")
-    spec["parts"][0]["vertices"] = [[-1e-6, -1e-6], [1e-6, -1e-6], [1e-6, 1e-6], [-1e-6, 1e-6]]
-    path = tmp_path / "tiny.yaml"
-    path.write_text(yaml.safe_dump(spec))
-    script = (f"import resource\nresource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))\n"
-              f"from planner import Planner, load_scene\n"
-              f"print(Planner(load_scene({str(path)!r}), {{'seed': 1, 'time_limit': 30, 'margin': 0}}).plan().to_json())\n")
-    began = time.perf_counter()
-    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
-    assert run.returncode == 0, run.stderr[-3000:]
-    assert time.perf_counter() - began < 120.0
-    data = json.loads(run.stdout)
-    assert data["solved"], data["reason"]
-    moves = [s["part"] for k, s in enumerate(data["segments"])
-             if s["kind"] != "transfer" and (k == 0 or data["segments"][k - 1]["kind"] == "transfer")]
-    assert len(moves) >= 3 and moves.count(moves[0]) == 2  # one of them left at a buffer pose, then fetched
-    replay_parts_plan(spec, data)
+    script = ("import resource, sys\nresource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))\n"
+              "from planner import Planner, SceneError, load_scene\n"
+              "try:\n    scene = load_scene(sys.argv[1])\n"
+              "except SceneError as err:\n    sys.exit(f'error: {err}')\n"
+              "print(Planner(scene, {'seed': 1, 'time_limit': 30, 'margin': 0}).plan().to_json())\n")
+    for half in (3e-4, 1e-6):
+        spec["parts"][0]["vertices"] = [[-half, -half], [half, -half], [half, half], [-half, half]]
+        path = tmp_path / f"tiny-{half}.yaml"
+        path.write_text(yaml.safe_dump(spec))
+        began = time.perf_counter()
+        run = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True, text=True, timeout=300)
+        assert time.perf_counter() - began < 120.0
+        if half < 1e-5:
+            assert run.returncode == 1 and run.stderr.startswith("error: parts[0].vertices: the part is 2.828 um across, less than 1/100 of the pusher")
+            assert run.stderr.count("\n") == 1, run.stderr
+            continue
+        assert run.returncode == 0, run.stderr[-3000:]
+        data = json.loads(run.stdout)
+        assert data["solved"], data["reason"]
+        moves = [s["part"] for k, s in enumerate(data["segments"])
+                 if s["kind"] != "transfer" and (k == 0 or data["segments"][k - 1]["kind"] == "transfer")]
+        assert len(moves) >= 3 and moves.count(moves[0]) == 2  # one of them left at a buffer pose, then fetched
+        replay_parts_plan(spec, data)
 
 
 ASKED = {  # each query of one part, and what it is asked of a scene (or of a session of it)
