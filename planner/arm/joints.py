@@ -21,10 +21,10 @@ samples, and every joint frame stays above the table.
 
 from __future__ import annotations
 
+import csv
 import io
 import math
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -33,7 +33,7 @@ from ..model.files import write_atomic
 from ..model.robot import Robot
 from .reach import FOLLOW_STEPS, ArmReach
 
-__all__ = ["HELD", "JointTrajectory", "joint_trajectory"]
+__all__ = ["HELD", "JointTrajectory", "joint_trajectory", "joints_along"]
 
 #: Farthest a reached sample may leave the pusher frame from where the trajectory has it: m for
 #: its origin, rad for its axes (the check the joints file must pass asks for 1 mm).
@@ -75,7 +75,7 @@ class JointTrajectory:
             k = int(missed[0])
             out.append(f"arm: cannot hold the pusher at t = {self.t[k]:.2f} s (segment {self.segment[k] + 1}): "
                        f"{self.miss[k] * 1e3:.1f} mm off, {missed.size} of {len(self.t)} samples missed")
-        if (fast := int(np.argmax(self.speed))) is not None and self.speed[fast] > 1.0:
+        if self.speed[fast := int(np.argmax(self.speed))] > 1.0:
             out.append(f"arm: joint {fast + 1} would move at {self.speed[fast]:.2f} times its speed limit")
         if self.lowest <= 0.0:
             out.append(f"arm: a joint frame goes {-self.lowest * 1e3:.1f} mm below the table")
@@ -88,25 +88,19 @@ class JointTrajectory:
                 f"of their speed limits, lowest joint frame {self.lowest:.3f} m above the table")
 
     def to_csv(self) -> str:
-        """``t,q1,...,qn,segment`` (and ``part``), a row per sample; segments numbered from 1."""
-        joints = self.q.shape[1]
-        header = ",".join(["t", *(f"q{k}" for k in range(1, joints + 1)), "segment"] + (["part"] if self.part is not None else []))
+        """``t,q1,...,qn,segment`` (and ``part``), a row per sample; segments numbered from 1;
+        floats round-trip (17 digits), as the trajectory's CSV has them."""
         text = io.StringIO()
-        text.write(header + "\n")
+        rows = csv.writer(text, lineterminator="\n")  # a part's name may hold a comma or a quote
+        joints = self.q.shape[1]
+        rows.writerow(["t", *(f"q{k}" for k in range(1, joints + 1)), "segment"] + (["part"] if self.part is not None else []))
         for k in range(len(self.t)):
-            row = [f"{self.t[k]:.17g}", *(f"{v + 0.0:.17g}" for v in self.q[k]), str(int(self.segment[k]) + 1)]
-            if self.part is not None:
-                row.append(_quoted(str(self.part[k])))
-            text.write(",".join(row) + "\n")
+            rows.writerow([f"{self.t[k]:.17g}", *(f"{v + 0.0:.17g}" for v in self.q[k]), int(self.segment[k]) + 1]
+                          + ([str(self.part[k])] if self.part is not None else []))
         return text.getvalue()
 
     def write_csv(self, path) -> None:
         write_atomic(path, self.to_csv())
-
-
-def _quoted(name: str) -> str:
-    """A part's name as a CSV field (quoted where it holds a comma or a quote)."""
-    return f'"{name.replace(chr(34), chr(34) * 2)}"' if any(c in name for c in ',"\n') else name
 
 
 def joint_trajectory(robot: Robot, t: ArrayLike, poses: ArrayLike, heights: ArrayLike, segments: ArrayLike,
@@ -119,7 +113,10 @@ def joint_trajectory(robot: Robot, t: ArrayLike, poses: ArrayLike, heights: Arra
     miss = np.zeros(len(t))
     posture = reach.ready
     for k in range(len(t)):
-        posture, _ = (reach.first if k == 0 else partial(reach.solve, q=posture, steps=FOLLOW_STEPS))(poses[k], height=float(heights[k]))
+        if k == 0:
+            posture, _ = reach.first(poses[k], height=float(heights[k]))
+        else:
+            posture, _ = reach.solve(poses[k], posture, steps=FOLLOW_STEPS, height=float(heights[k]))
         q[k] = posture
         miss[k] = reach.pose_error(poses[k], posture, float(heights[k]))
     dt = np.diff(t)
@@ -128,3 +125,11 @@ def joint_trajectory(robot: Robot, t: ArrayLike, poses: ArrayLike, heights: Arra
     lowest = min((reach.lowest_frame(row) for row in q), default=math.inf)
     return JointTrajectory(robot, t, q, np.asarray(segments, dtype=int), miss, speed, lowest,
                            None if parts is None else np.asarray(parts))
+
+
+def joints_along(robot: Robot, motion) -> JointTrajectory:
+    """:func:`joint_trajectory` along a pusher trajectory ``motion`` (a
+    :class:`planner.execution.trajectory.Trajectory`: its samples' times, poses, heights,
+    segments and, of a tray, parts)."""
+    return joint_trajectory(robot, motion.t, np.c_[motion.x, motion.y, motion.theta], motion.z, motion.segment,
+                            motion.part)

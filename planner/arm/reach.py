@@ -22,6 +22,7 @@ turn past its stop fails to reach rather than jumping.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import mink
 import mujoco
@@ -109,16 +110,15 @@ class ArmReach:
         x, y, _ = (float(v) for v in self.robot.base)
         turn = math.atan2(pose[1] - y, pose[0] - x) - math.atan2(ready[1] - y, ready[0] - x)
         low, high = self.arm.lower, self.arm.upper
-        best, middle = (self.ready, math.inf), (low[-1] + high[-1]) / 2
+        facing = self.ready.copy()
+        facing[0] = float(np.clip(facing[0] + math.remainder(turn, 2 * math.pi), low[0], high[0]))
+        middle = (low[-1] + high[-1]) / 2
+        tried = []
         for wrist in np.linspace(low[-1], high[-1], _WRISTS + 2)[1:-1]:
-            q = self.ready.copy()
-            q[0] = float(np.clip(q[0] + math.remainder(turn, 2 * math.pi), low[0], high[0]))
-            q[-1] = wrist
-            q, miss = self.solve(pose, q, height=height)
-            reached, kept = miss < REACHED, best[1] < REACHED
-            if (reached and (not kept or abs(q[-1] - middle) < abs(best[0][-1] - middle))) or (not kept and miss < best[1]):
-                best = (q, miss)
-        return best
+            facing[-1] = wrist
+            tried.append(self.solve(pose, facing, height=height))
+        # Reached ones first, nearest the middle; else the nearest miss (the first of equals).
+        return min(tried, key=lambda t: (t[1] >= REACHED, abs(t[0][-1] - middle) if t[1] < REACHED else t[1]))
 
     def lowest_frame(self, q: ArrayLike) -> float:
         """The height above the table of the lowest joint frame but the first (which stands on
@@ -146,6 +146,4 @@ class ArmReach:
 
 def _limits(arm: Arm) -> Arm:
     """``arm`` with its limits as arrays (for vectorised checks)."""
-    from dataclasses import replace
-
     return replace(arm, lower=np.array(arm.lower), upper=np.array(arm.upper), speed=np.array(arm.speed))

@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
     if not have("mink"):
         p.exit(1, f"{p.prog}: error: {needs('mink')}\n")
-    from ..arm.joints import joint_trajectory  # loads mink
+    from ..arm.joints import joints_along  # loads mink
 
     model, *base = args.robot
     robot = Robot(model, np.array([float(base[0]), float(base[1]), math.radians(float(base[2]))]), 0.12)
@@ -59,8 +59,7 @@ def main(argv: list[str] | None = None) -> int:
         motion = trajectory(scene, result)
         motion_time = time.perf_counter() - clock
         clock = time.perf_counter()
-        arm = joint_trajectory(robot, motion.t, np.c_[motion.x, motion.y, motion.theta], motion.z, motion.segment,
-                               motion.part)
+        arm = joints_along(robot, motion)
         joints_time = time.perf_counter() - clock
         print(f"| {scene.name} | {model} | {free_time:.2f} s | {robot_time:.2f} s | {len(motion.t)} | "
               f"{motion_time:.2f} s | {joints_time:.2f} s | {len(motion.t) / joints_time:,.0f} | "

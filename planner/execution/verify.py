@@ -357,7 +357,7 @@ class Verification:
         elif self.margin is not None:
             least += f" (planned: {self.margin})"
         if (through := sum(map(bool, (c for m in self.moves for c in m.crossed)))):
-            least += f"; the pusher goes through {self._parts(('a part',))} on {counted(through, 'segment')}"
+            least += f"; the pusher goes through {'the' if len(self.scene.parts) == 1 else 'a'} part on {counted(through, 'segment')}"
         return (f"verify: {'passed' if self.passed else 'FAILED'}: {pushes} x "
                 f"{len(self.kinds)} distributions ({mix}); worst deviation {position:.2e} m, {angle:.2e} rad; "
                 f"chained drift {self.drift[0]:.2e} m, {self.drift[1]:.2e} rad "

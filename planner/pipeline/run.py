@@ -16,8 +16,6 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ..actions.margins import with_margins
 from ..model.fields import SceneError, shown
 from ..model.files import atomic_path, staged_folder, write_atomic
@@ -112,10 +110,9 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
 
         motion = trajectory(scene, result)
         if scene.robot is not None:
-            from ..arm.joints import joint_trajectory  # loads mink and MuJoCo, only for an arm
+            from ..arm.joints import joints_along  # loads mink and MuJoCo, only for an arm
 
-            arm = joint_trajectory(scene.robot, motion.t, np.c_[motion.x, motion.y, motion.theta], motion.z,
-                                   motion.segment, motion.part)
+            arm = joints_along(scene.robot, motion)
     if options.simulate and result.solved:
         simulation = _simulated(scene, options, planner_options, result, session)
     if options.reach:  # the map is about the start, whatever the plan
