@@ -30,7 +30,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..model.robot import Robot
-from .arms import ARMS, Arm, mjcf
+from ..world.reach import family_posture
+from ..model.arms import ARMS, Arm
+from .arms import mjcf
 
 __all__ = ["ArmReach", "FOLLOW_STEPS", "REACHED", "arm_model"]
 
@@ -102,23 +104,33 @@ class ArmReach:
 
     def first(self, pose: ArrayLike, height: float = 0.0) -> tuple[np.ndarray, float]:
         """Joint angles holding the pusher at a path's first pose, and how far from it they
-        leave it (as :meth:`solve`): from the ready posture turned about the first joint to face
-        ``pose``, with the last joint tried at :data:`_WRISTS` places over its range (from one,
-        the wrist may meet its stop before the heading), keeping the reached one whose last joint
-        is nearest the middle of its range (the wrist can turn as far either way from there)."""
-        ready, _ = self.pusher_frame(self.ready)
+        leave it (as :meth:`solve`). The arm starts on its own family of postures, the one the
+        planner's reach zone is drawn on (:func:`planner.world.reach.family_posture`) at the
+        pose's distance from the base, turned about the first joint to face ``pose``, its last
+        joint turned to the pusher's heading (within its stops). Where that is not reached, the last joint is tried at :data:`_WRISTS`
+        places over its range, keeping the reached posture whose other joints are nearest the
+        facing one (else the nearest miss): a reach that swings the whole arm round to spare the
+        wrist leaves joints near their stops, where the path soon cannot be followed."""
         x, y, _ = (float(v) for v in self.robot.base)
-        turn = math.atan2(pose[1] - y, pose[0] - x) - math.atan2(ready[1] - y, ready[0] - x)
         low, high = self.arm.lower, self.arm.upper
-        facing = self.ready.copy()
+        facing = family_posture(self.robot, math.hypot(pose[0] - x, pose[1] - y))
+        facing[-1] = (low[-1] + high[-1]) / 2
+        at, _ = self.pusher_frame(facing)
+        turn = math.atan2(pose[1] - y, pose[0] - x) - math.atan2(at[1] - y, at[0] - x)
         facing[0] = float(np.clip(facing[0] + math.remainder(turn, 2 * math.pi), low[0], high[0]))
-        middle = (low[-1] + high[-1]) / 2
+        # The flange points down, so the last joint turns the pusher's heading the other way.
+        at = self.pusher_frame(facing)[1]
+        off = math.remainder(float(pose[2]) - self.mount - math.atan2(at[1, 0], at[0, 0]), 2 * math.pi)
+        facing[-1] = float(np.clip(facing[-1] - off, low[-1], high[-1]))
+        q, miss = self.solve(pose, facing, height=height)
+        if miss < REACHED:
+            return q, miss
         tried = []
         for wrist in np.linspace(low[-1], high[-1], _WRISTS + 2)[1:-1]:
             facing[-1] = wrist
             tried.append(self.solve(pose, facing, height=height))
-        # Reached ones first, nearest the middle; else the nearest miss (the first of equals).
-        return min(tried, key=lambda t: (t[1] >= REACHED, abs(t[0][-1] - middle) if t[1] < REACHED else t[1]))
+        return min(tried, key=lambda t: (t[1] >= REACHED,
+                                         float(np.linalg.norm(t[0][:-1] - facing[:-1])) if t[1] < REACHED else t[1]))
 
     def lowest_frame(self, q: ArrayLike) -> float:
         """The height above the table of the lowest joint frame but the first (which stands on

@@ -171,5 +171,15 @@ def _check_clear(scene: Scene, plan: Plan) -> None:
                 raise SceneError(f"plan.segments[{k}]", f"takes more than {MAX_CHECKS} clearance computations to "
                                                         "check: a path too long, or too close to obstacles") from None
             if not free:
-                raise SceneError(f"plan.segments[{k}]", f"{_WHAT[type(segment)]} meets an obstacle or a workspace "
-                                                        f"wall of the scene (from the part at {pose_text(pose)})")
+                raise SceneError(f"plan.segments[{k}]", f"{_WHAT[type(segment)]} {_blocked(alone, model, segment)} "
+                                                        f"(from the part at {pose_text(pose)})")
+
+
+def _blocked(scene: Scene, model: CollisionModel, segment: Push | Transit | Transfer) -> str:
+    """What ``segment``, not clear in ``model``, meets: the arm's reach where it is clear without
+    the arm, else an obstacle or a wall."""
+    if model.zone is not None:
+        free = replace(scene, robot=None)
+        if is_clear(free, collision_model(free, [segment]), segment):
+            return f"leaves the {scene.robot.model} arm's reach zone (docs/arm.md)"
+    return "meets an obstacle or a workspace wall of the scene"

@@ -24,12 +24,13 @@ from typing import Any
 
 import numpy as np
 
+from .arms import ARMS
 from .fields import SceneError, keys, number, shown, vector
 
 __all__ = ["MAX_TOOL", "ROBOT_MODELS", "Robot", "read_robot"]
 
-#: The arms a scene may name (their kinematics: :data:`planner.arm.arms.ARMS`).
-ROBOT_MODELS = ("panda", "ur5e")
+#: The arms a scene may name (their kinematics: :data:`planner.model.arms.ARMS`).
+ROBOT_MODELS = tuple(ARMS)
 #: Longest tool and highest push (m): beyond an arm's reach, so a number typed wrong, not a tool.
 MAX_TOOL = 1.0
 

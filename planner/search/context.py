@@ -134,7 +134,8 @@ class SearchWorld:
         model = model or CollisionModel(scene, scene.edges)
         step = step_length(scene)
         if not any(model.is_clear(scene.start, e, step / 2) for e in scene.edges):
-            raise SceneError("start", f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
+            raise SceneError("start", model.out_of_reach(scene.start, scene.edges, step / 2)
+                             or f"the pusher has no room on any allowed edge (needs {step / 2:.4g} m clearance)")
         note = ""
         try:
             controls = edge_controls(scene, deadline, progress, cache, regions=options.regions, margin=options.margin)
@@ -157,7 +158,8 @@ class SearchWorld:
         starts = [k for k, c in enumerate(self.controls) if self.model.is_clear(start, c.edge, room)]
         if not starts:
             if not any(self.model.is_clear(start, e, room) for e in self.scene.edges):
-                raise SceneError("start", f"the pusher has no room on any allowed edge (needs {room:.4g} m clearance)")
+                raise SceneError("start", self.model.out_of_reach(start, self.scene.edges, room)
+                                 or f"the pusher has no room on any allowed edge (needs {room:.4g} m clearance)")
             raise SceneError("start", "the pusher has room only on edges with no stable push")
         return starts
 

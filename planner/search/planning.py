@@ -93,6 +93,8 @@ def solve(context: PlanningContext, goal: np.ndarray) -> Plan:
     request, scene, switch_cost = context.request, context.scene, context.world.options.switch_cost
     if scene.within_tolerance(context.start, goal):
         return context.result(goal, [])
+    if far := context.world.model.out_of_reach(goal, [c.edge for c in context.world.controls], near=scene.tolerance_slack):
+        return context.result(goal, [], f"the goal is {far}")
     region = context.goal_region(goal)
     direct = context.direct(region)
     if direct:

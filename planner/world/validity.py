@@ -32,6 +32,7 @@ from mechanics import transform_points, wrap_angle
 
 from ..model.bodies import body_outline, convex_pieces, pusher_frame_body, pusher_polygon
 from .free_space import SCREEN_SHRINK, disk_free_space
+from .reach import reach_zone
 from .room import Room
 from ..model.scene import Scene
 
@@ -144,6 +145,12 @@ class CollisionModel:
         self.cf_room = disk_free_space(scene, slider.cf_depth * (1.0 - SCREEN_SHRINK))
         shapely.prepare(self.cf_room)
         self.room = Room(scene.obstacles, scene.workspace)
+        # With an arm, the pusher frame must stay in its reach zone: a rim the clearances count as
+        # they count a wall (planner.world.reach).
+        self.zone = None if scene.robot is None else reach_zone(scene.robot)
+        self.robot = None if scene.robot is None else scene.robot.model
+        # Per body, the pusher frame in its frame and how fast it turns (2 over its diameter, rad/m).
+        self._holds: dict[int | str, tuple[float, float, float, float]] = {}
 
     def _add(self, key: int | str, pieces: list[fcl.CollisionObject], outline: np.ndarray) -> None:
         self._bodies[key] = (pieces, outline.tolist(), float(np.linalg.norm(outline, axis=1).max()))
@@ -199,9 +206,13 @@ class CollisionModel:
         at = (float(x), float(y), float(theta))
         placed: list = []  # the pose's fcl transform and obstacles nearest first, made once if asked for
         if key == _PUSHER:
-            return self._body_clearance(at, _PUSHER, enough, placed)
+            body = self._body_clearance(at, _PUSHER, enough, placed)
+            return body if self.zone is None else min(body, self._zone_clearance(at, _PUSHER))
         if key not in self._bodies:
             self.body_pieces(key)
+        zone = math.inf if self.zone is None else self._zone_clearance(at, key)
+        if zone <= 0:
+            return zone
         if self._part_at is not None and self._part_at[0] == at and (self._part_at[1] < self._part_at[2]
                                                                      or self._part_at[2] >= enough):
             part = self._part_at[1]  # exact, or a lower bound at least as high as asked
@@ -209,7 +220,38 @@ class CollisionModel:
             part = self._body_clearance(at, _PART, enough, placed)
             self._part_at = (at, part, enough)
         # Below enough the least is exact; else each is a lower bound at least min(part, enough).
-        return part if part <= 0 else min(part, self._body_clearance(at, key, min(part, enough), placed))
+        return part if part <= 0 else min(part, zone, self._body_clearance(at, key, min(part, zone, enough), placed))
+
+    def out_of_reach(self, pose: ArrayLike, edges, room: float = 0.0, near: Callable[[float], float] | None = None) -> str | None:
+        """Why the arm cannot hold the pusher on any of ``edges`` with the part at ``pose`` (with
+        ``room`` to spare), or None if it can on one or there is no arm. With ``near``, the part
+        may be anywhere within ``near(reach)`` of ``pose`` for a point ``reach`` from its origin
+        (:meth:`planner.model.scene.Scene.tolerance_slack`): the zone's clearance is a lower bound
+        on how far the body moves, inside or out."""
+        at = tuple(float(v) for v in pose)
+        for e in edges:
+            self.body_pieces(e)
+        if self.zone is None or any(self._zone_clearance(at, e) > room - (near(self._bodies[e][2]) if near else 0.0)
+                                    for e in edges):
+            return None
+        return f"out of the {self.robot} arm's reach: its reach zone is {self.zone.text()} (docs/arm.md)"
+
+    def _zone_clearance(self, pose: tuple[float, float, float], key: int | str) -> float:
+        """The reach zone's clearance (:meth:`~planner.world.reach.ReachZone.clearance`) of the
+        pusher of body ``key`` at ``pose`` (an arm's model only)."""
+        if key not in self._holds:
+            outline = np.array(self._bodies[key][1])
+            turn = 2.0 / float(np.linalg.norm(outline[:, None] - outline[None], axis=2).max())
+            if key == _PUSHER:
+                self._holds[key] = (0.0, 0.0, 0.0, turn)
+            else:
+                a, b = self._slider.edge(key)
+                inward = self._slider.inward_normal(key)
+                self._holds[key] = (*((a + b) / 2).tolist(), math.atan2(inward[1], inward[0]), turn)
+        hx, hy, hphi, turn = self._holds[key]
+        x, y, theta = pose
+        c, s = math.cos(theta), math.sin(theta)
+        return self.zone.clearance((x + c * hx - s * hy, y + s * hx + c * hy, theta + hphi), turn)
 
     def _body_clearance(self, pose: tuple[float, float, float], key: int | str, enough: float, placed: list) -> float:
         """:meth:`_clearance` of body ``key`` alone; ``placed`` holds what the bodies at ``pose``

@@ -123,7 +123,7 @@ def plan(*args: str, cwd: Path) -> subprocess.CompletedProcess:
 
 
 CASES = {
-    "parking, panda": ("parking.yaml", {"model": "panda", "base": [0.0, -0.4, 90], "tool_length": 0.12}),
+    "parking, panda": ("parking.yaml", {"model": "panda", "base": [-0.5, 0.2, -30], "tool_length": 0.12}),
     "gap, panda from the far side": ("gap.yaml", {"model": "panda", "base": [0.0, 0.5, -90], "tool_length": 0.1,
                                                   "push_height": 0.02}),
     "swap (a tray), ur5e": ("parts/swap.yaml", {"model": "ur5e", "base": [0.0, -0.4, 90], "tool_length": 0.12}),
@@ -153,27 +153,71 @@ def test_the_independent_check_sees_a_joints_file_that_is_off(tmp_path):
         check_joints(path, tmp_path / "out")
 
 
-def test_a_plan_the_arm_cannot_follow_exits_3_with_its_files_written(tmp_path):
+def test_a_start_out_of_the_reach_zone_is_bad_input(tmp_path):
     """cluttered's start is at the far corner from a Panda in the middle of the opposite side:
-    within the bound of its links end to end, but no posture holds the pusher flange-down there."""
+    within the bound of its links end to end, but outside where it holds the pusher flange-down."""
     path = with_robot(tmp_path, "cluttered.yaml", {"model": "panda", "base": [0.0, 0.5, -90], "tool_length": 0.1,
                                                    "push_height": 0.02})
     run = plan(str(path), "--trajectory", "--seed", "1", "--out", "out", cwd=tmp_path)
-    assert run.returncode == 3, run.stdout + run.stderr
-    assert "arm: CANNOT FOLLOW:" in run.stdout and "arm: cannot hold the pusher at t = 0.00 s (segment 1)" in run.stdout
-    assert (tmp_path / "out" / "cluttered.joints.csv").exists()  # written, to be looked at
+    assert run.returncode == 1 and run.stdout == "" and not (tmp_path / "out").exists()
+    assert run.stderr.startswith("plan: error: start: out of the panda arm's reach: its reach zone is ") and \
+        run.stderr.count("\n") == 1, run.stderr
 
 
-def test_a_free_pusher_plan_that_winds_the_wrist_past_its_stop_cannot_be_followed(tmp_path):
-    """junction's plan walks the pusher round the part (a transit turning it about 180 degrees) with
-    the part in front of a Panda across the table: the wrist meets its stop on the way."""
-    path = with_robot(tmp_path, "junction.yaml", {"model": "panda", "base": [0.0, 0.4, -90], "tool_length": 0.1,
-                                                  "push_height": 0.02})
+def test_a_plan_the_arm_cannot_follow_exits_3_with_its_files_written(tmp_path, monkeypatch, capsys):
+    """With the reach zone widened 30 cm past the arm's reach (as a zone drawn wrong would be),
+    around's plan goes where the arm cannot hold the pusher: the joints check catches it."""
+    import planner.world.reach
+
+    from planner.cli import main
+
+    monkeypatch.setattr(planner.world.reach, "RING_MARGIN", -0.3)
+    code = main([str(ROOT / "scenes" / "arm" / "around.yaml"), "--trajectory", "--seed", "1", "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert code == 3, out
+    assert "arm: CANNOT FOLLOW:" in out and "arm: cannot hold the pusher at t = " in out
+    assert (tmp_path / "out" / "around.joints.csv").exists()  # written, to be looked at
+
+
+def _free_plan_joints(tmp_path: Path, path: Path):
+    """The plan of ``path``'s scene for a free pusher (its robot block taken out), and the joints
+    of ``path``'s arm along its trajectory."""
+    from planner.arm.joints import joints_along
+    from planner.execution.trajectory import trajectory
+    from planner.model.plan_file import read_plan
+    from planner.model.scene_file import load_scene
+
+    spec = yaml.safe_load(path.read_text())
+    robot = spec.pop("robot")
+    free = tmp_path / f"free_{path.name}"
+    free.write_text(yaml.safe_dump(spec))
+    run = plan(str(free), "--seed", "1", "--out", "free", cwd=tmp_path)
+    assert run.returncode == 0, run.stdout + run.stderr
+    scene = load_scene(free)
+    found = read_plan(json.loads((tmp_path / "free" / f"{spec['name']}.json").read_text()))
+    return robot, found, joints_along(load_scene(path).robot, trajectory(scene, found))
+
+
+ARM_AWARE = {
+    # Straight across passes 15 cm from the base: too near for the flange to point down.
+    "around: the free plan passes too near the base": ROOT / "scenes" / "arm" / "around.yaml",
+    # The free plan walks the pusher round the part, turning it past pushing straight at the base.
+    "junction: the free plan winds the wrist": "junction",
+}
+
+
+@pytest.mark.parametrize("scene", ARM_AWARE.values(), ids=ARM_AWARE.keys())
+def test_where_the_free_plan_fails_the_arm_the_arm_aware_plan_is_followed(tmp_path, scene):
+    path = scene if isinstance(scene, Path) else with_robot(
+        tmp_path, "junction.yaml", {"model": "panda", "base": [0.0, 0.4, -90], "tool_length": 0.1, "push_height": 0.02})
+    _, _, free = _free_plan_joints(tmp_path, path)
+    assert not free.follows and any(line.startswith("arm: cannot hold the pusher") for line in free.lines())
+    refused = plan(str(path), "--plan", str(next((tmp_path / "free").glob("*.json"))), "--verify", "1", "--out", "v",
+                   cwd=tmp_path)
+    assert refused.returncode == 1 and "leaves the panda arm's reach zone" in refused.stderr, refused.stderr
     run = plan(str(path), "--trajectory", "--seed", "1", "--out", "out", cwd=tmp_path)
-    assert run.returncode == 3, run.stdout + run.stderr
-    transit = next(k for k, s in enumerate(json.loads((tmp_path / "out" / "junction.json").read_text())
-                                           ["segments"], 1) if s["kind"] == "transit")
-    assert f"(segment {transit}): " in run.stdout  # missed first where the pusher walks round
+    assert run.returncode == 0 and "arm: follows:" in run.stdout, run.stdout + run.stderr
+    check_joints(path, tmp_path / "out")
 
 
 def test_a_start_out_of_reach_is_bad_input_and_a_goal_out_of_reach_is_certified_unreachable(tmp_path):
