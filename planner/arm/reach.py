@@ -43,6 +43,7 @@ _STEPS = 200  # most steps towards one pose from a far posture (a path's first)
 #: Most steps towards a path's next pose from the last one's posture: it needs a few (100 a second
 #: of a slow pusher), and one it cannot reach in these would need a jump, missed either way.
 FOLLOW_STEPS = 20
+_SETTLED = 1e-6  # rad a step: a settling posture that moves less has stopped
 _WRISTS = 7  # places of the last joint a path's first pose is tried from
 _DOWN = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]])  # x kept, z down
 
@@ -122,13 +123,13 @@ class ArmReach:
         at = self.pusher_frame(facing)[1]
         off = math.remainder(float(pose[2]) - self.mount - math.atan2(at[1, 0], at[0, 0]), 2 * math.pi)
         facing[-1] = float(np.clip(facing[-1] - off, low[-1], high[-1]))
-        q, miss = self.solve(pose, facing, height=height)
+        q, miss = self.solve(pose, facing, height=height, settle=True)
         if miss < REACHED:
             return q, miss
         tried = []
         for wrist in np.linspace(low[-1], high[-1], _WRISTS + 2)[1:-1]:
             facing[-1] = wrist
-            tried.append(self.solve(pose, facing, height=height))
+            tried.append(self.solve(pose, facing, height=height, settle=True))
         return min(tried, key=lambda t: (t[1] >= REACHED,
                                          float(np.linalg.norm(t[0][:-1] - facing[:-1])) if t[1] < REACHED else t[1]))
 
@@ -138,22 +139,28 @@ class ArmReach:
         self.configuration.update(np.asarray(q, dtype=float))
         return float(self.configuration.data.xpos[self._links, 2].min())
 
-    def solve(self, pose: ArrayLike, q: ArrayLike, steps: int = _STEPS, height: float = 0.0) -> tuple[np.ndarray, float]:
+    def solve(self, pose: ArrayLike, q: ArrayLike, steps: int = _STEPS, height: float = 0.0,
+              settle: bool = False) -> tuple[np.ndarray, float]:
         """Joint angles holding the pusher at ``pose`` (``height`` above where it pushes), reached
         from ``q``, and how far from it they leave the pusher frame (the norm of its twist error:
-        m, and rad); within :data:`REACHED` it is reached."""
+        m, and rad); within :data:`REACHED` it is reached. With ``settle``, the steps go on once
+        it is reached until the joints stop moving: the arm's redundant joints come to where the
+        posture task holds them, so that the next pose's steps move them no more than the pose
+        asks (else the first step after a path's first pose swings them there at once)."""
         self.configuration.update(np.asarray(q, dtype=float))
         origin, rotation = self.target(pose, height)
         self.task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rotation), origin))
         miss = math.inf
         for _ in range(steps):
             miss = float(np.linalg.norm(self.task.compute_error(self.configuration)))
-            if miss < REACHED:
+            if miss < REACHED and not settle:
                 break
             velocity = mink.solve_ik(self.configuration, [self.task, self.posture], _DT, "daqp", damping=1e-6,
                                      limits=self.limits)
+            if miss < REACHED and float(np.abs(velocity).max()) * _DT < _SETTLED:
+                break
             self.configuration.integrate_inplace(velocity, _DT)
-        return self.configuration.q.copy(), miss
+        return self.configuration.q.copy(), float(np.linalg.norm(self.task.compute_error(self.configuration)))
 
 
 def _limits(arm: Arm) -> Arm:

@@ -1,20 +1,28 @@
-"""Benchmark: what the arm costs (a scene's ``robot:`` block, :mod:`planner.arm`).
+"""Benchmark: what planning for the arm costs, and what it buys (a scene's ``robot:`` block).
 
-``python -m planner.bench.arm scenes/parking.yaml --robot panda 0 -0.4 90`` plans each scene with
-seed 1 as it is and with the robot block given (the flag's model, base x, y and yaw in degrees, the
-tool 0.12 m long), then the trajectory and the arm's joints along it. It prints a Markdown table,
-one row per scene: planning time without and with the block, the trajectory's samples and time,
-the joints' time, inverse kinematics solves per second (a sample each, after the first pose's),
-and whether the arm follows. Needs the arm extra. (The planner does not yet plan for the arm, so
-the two planning times differ only by the scene's reading: the column is there for when it does.)
+``python -m planner.bench.arm`` plans each of the scenes with an arm (default: ``scenes/arm/*.yaml``;
+``--robot MODEL X Y YAW`` gives scenes without a block one, its tool 0.12 m long) with seeds 1 to
+``--seeds``, once for the arm and once for a free pusher (the block taken out), then runs the
+arm's joints along each seed-1 plan's trajectory. It prints a Markdown table, one row per scene:
+
+* the median planning time for a free pusher and for the arm, and their ratio. The planner calls
+  no inverse kinematics: the arm is its reach zone (:mod:`planner.world.reach`), a clearance the
+  collision checks count, drawn once per arm, tool and push height (the ``zone`` column, cold);
+* whether the arm follows the free pusher's plan and the arm's (:mod:`planner.arm.joints`);
+* the arm plan's trajectory samples, the time its joints took and inverse kinematics solves a
+  second (a sample each).
+
+Needs the arm extra.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import statistics
 import time
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -23,47 +31,67 @@ from ..model.extras import have, needs
 from ..model.robot import Robot
 from ..model.scene_file import load_scene
 from ..queries.session import plan
+from ..world import reach
 
 __all__ = ["HEADER", "main"]
 
-HEADER = ("| scene | robot | planning (free) | planning (robot) | samples | trajectory | joints | IK solves/s | "
-          "arm |\n|---|---|---|---|---|---|---|---|---|")
+ARM_SCENES = Path(__file__).resolve().parents[2] / "scenes" / "arm"
+HEADER = ("| scene | robot | zone | planning (free) | planning (arm) | arm / free | free plan: arm | arm plan: arm | "
+          "samples | joints | IK solves/s |\n|---|---|---|---|---|---|---|---|---|---|---|")
+
+
+def _timed(scene, seeds: int) -> tuple[float, list]:
+    """The median planning time of ``scene`` over seeds 1 to ``seeds``, and the plans."""
+    times, plans = [], []
+    for seed in range(1, seeds + 1):
+        clock = time.perf_counter()
+        plans.append(plan(scene, seed=seed))
+        times.append(time.perf_counter() - clock)
+    return statistics.median(times), plans
 
 
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m planner.bench.arm", description=__doc__.splitlines()[0])
-    p.add_argument("scenes", nargs="+", help="scene files (YAML)")
-    p.add_argument("--robot", nargs=4, metavar=("MODEL", "X", "Y", "YAW"), default=["panda", "0", "-0.4", "90"],
-                   help="the arm and its base (m, m, degrees); default panda 0 -0.4 90")
+    p.add_argument("scenes", nargs="*", help="scene files (YAML); default: scenes/arm/*.yaml")
+    p.add_argument("--robot", nargs=4, metavar=("MODEL", "X", "Y", "YAW"),
+                   help="the arm and its base (m, m, degrees) of scenes without a robot block")
+    p.add_argument("--seeds", type=int, default=3, help="seeds 1 to N (default 3)")
     args = p.parse_args(argv)
     if not have("mink"):
         p.exit(1, f"{p.prog}: error: {needs('mink')}\n")
     from ..arm.joints import joints_along  # loads mink
 
-    model, *base = args.robot
-    robot = Robot(model, np.array([float(base[0]), float(base[1]), math.radians(float(base[2]))]), 0.12)
     print(HEADER, flush=True)
-    for path in args.scenes:
-        free = load_scene(path)
+    for path in args.scenes or sorted(ARM_SCENES.glob("*.yaml")):
+        scene = load_scene(path)
+        if scene.robot is None:
+            if args.robot is None:
+                p.exit(1, f"{p.prog}: error: {path} has no robot block: give one with --robot\n")
+            model, x, y, yaw = args.robot
+            scene = replace(scene, robot=Robot(model, np.array([float(x), float(y), math.radians(float(yaw))]), 0.12))
+        robot = scene.robot
+        reach._family.cache_clear()
         clock = time.perf_counter()
-        result = plan(free, seed=1)
-        free_time = time.perf_counter() - clock
-        scene = replace(free, robot=robot)
-        clock = time.perf_counter()
-        result = plan(scene, seed=1)
-        robot_time = time.perf_counter() - clock
-        if not result.solved:
-            print(f"| {scene.name} | {model} | {free_time:.2f} s | {robot_time:.2f} s | not solved | | | | |", flush=True)
+        reach.reach_zone(robot)
+        zone_time = time.perf_counter() - clock
+        free_time, free_plans = _timed(replace(scene, robot=None), args.seeds)
+        arm_time, arm_plans = _timed(scene, args.seeds)
+
+        def followed(found) -> str:
+            return "not solved" if not found.solved else (
+                "follows" if joints_along(robot, trajectory(scene, found)).follows else "cannot follow")
+
+        row = (f"| {scene.name} | {robot.model} | {zone_time * 1e3:.0f} ms | {free_time:.2f} s | {arm_time:.2f} s | "
+               f"{arm_time / free_time:.2f} | {followed(free_plans[0])} | ")
+        if not arm_plans[0].solved:
+            print(row + "not solved | | | |", flush=True)
             continue
-        clock = time.perf_counter()
-        motion = trajectory(scene, result)
-        motion_time = time.perf_counter() - clock
+        motion = trajectory(scene, arm_plans[0])
         clock = time.perf_counter()
         arm = joints_along(robot, motion)
         joints_time = time.perf_counter() - clock
-        print(f"| {scene.name} | {model} | {free_time:.2f} s | {robot_time:.2f} s | {len(motion.t)} | "
-              f"{motion_time:.2f} s | {joints_time:.2f} s | {len(motion.t) / joints_time:,.0f} | "
-              f"{'follows' if arm.follows else 'cannot follow'} |", flush=True)
+        print(row + f"{'follows' if arm.follows else 'cannot follow'} | {len(motion.t)} | {joints_time:.2f} s | "
+                    f"{len(motion.t) / joints_time:,.0f} |", flush=True)
     return 0
 
 

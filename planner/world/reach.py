@@ -70,7 +70,7 @@ WRIST_MARGIN = math.radians(5.0)
 #: Panda with a 0.12 m tool: 188.2 at 0.50 m, 175.5 at 0.70 m, 172.2 at 0.74 m, 168.5 at 0.78 m;
 #: docs/arm.md). Between these points it is interpolated, held at the ends, and never above 180.
 WRIST = {"panda": ((0.50, 188.2), (0.70, 175.5), (0.74, 172.2), (0.78, 168.5))}
-_GRID = 361  # samples of each of the two bending joints gridded (a step of about 0.5 degree)
+_GRID = 181  # samples of each of the two bending joints gridded (a step of about 1 degree)
 _PLANAR = {"panda": (1, 3, 5), "ur5e": (1, 2, 3)}  # the bending joints (from 0) of the planar family
 
 

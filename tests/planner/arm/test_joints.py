@@ -124,15 +124,14 @@ def plan(*args: str, cwd: Path) -> subprocess.CompletedProcess:
 
 CASES = {
     "parking, panda": ("parking.yaml", {"model": "panda", "base": [-0.5, 0.2, -30], "tool_length": 0.12}),
-    "gap, panda from the far side": ("gap.yaml", {"model": "panda", "base": [0.0, 0.5, -90], "tool_length": 0.1,
-                                                  "push_height": 0.02}),
     "swap (a tray), ur5e": ("parts/swap.yaml", {"model": "ur5e", "base": [0.0, -0.4, 90], "tool_length": 0.12}),
+    "arm/tray (shipped, a tray), ur5e": ("arm/tray.yaml", None),
 }
 
 
 @pytest.mark.parametrize("scene, robot", CASES.values(), ids=CASES.keys())
 def test_the_joints_file_holds_the_pusher_where_the_trajectory_has_it(tmp_path, scene, robot):
-    path = with_robot(tmp_path, scene, robot)
+    path = ROOT / "scenes" / scene if robot is None else with_robot(tmp_path, scene, robot)
     run = plan(str(path), "--trajectory", "--seed", "1", "--out", "out", cwd=tmp_path)
     assert run.returncode == 0, run.stdout + run.stderr
     assert "arm: follows:" in run.stdout
@@ -180,37 +179,35 @@ def test_a_plan_the_arm_cannot_follow_exits_3_with_its_files_written(tmp_path, m
 
 
 def _free_plan_joints(tmp_path: Path, path: Path):
-    """The plan of ``path``'s scene for a free pusher (its robot block taken out), and the joints
-    of ``path``'s arm along its trajectory."""
+    """The joints of ``path``'s arm along the trajectory of the plan of ``path``'s scene for a
+    free pusher (its robot block taken out; the plan written under ``free``)."""
     from planner.arm.joints import joints_along
     from planner.execution.trajectory import trajectory
     from planner.model.plan_file import read_plan
     from planner.model.scene_file import load_scene
 
     spec = yaml.safe_load(path.read_text())
-    robot = spec.pop("robot")
+    del spec["robot"]
     free = tmp_path / f"free_{path.name}"
     free.write_text(yaml.safe_dump(spec))
     run = plan(str(free), "--seed", "1", "--out", "free", cwd=tmp_path)
     assert run.returncode == 0, run.stdout + run.stderr
     scene = load_scene(free)
     found = read_plan(json.loads((tmp_path / "free" / f"{spec['name']}.json").read_text()))
-    return robot, found, joints_along(load_scene(path).robot, trajectory(scene, found))
+    return joints_along(load_scene(path).robot, trajectory(scene, found))
 
 
 ARM_AWARE = {
     # Straight across passes 15 cm from the base: too near for the flange to point down.
     "around: the free plan passes too near the base": ROOT / "scenes" / "arm" / "around.yaml",
     # The free plan walks the pusher round the part, turning it past pushing straight at the base.
-    "junction: the free plan winds the wrist": "junction",
+    "wrist: the free plan winds the wrist": ROOT / "scenes" / "arm" / "wrist.yaml",
 }
 
 
-@pytest.mark.parametrize("scene", ARM_AWARE.values(), ids=ARM_AWARE.keys())
-def test_where_the_free_plan_fails_the_arm_the_arm_aware_plan_is_followed(tmp_path, scene):
-    path = scene if isinstance(scene, Path) else with_robot(
-        tmp_path, "junction.yaml", {"model": "panda", "base": [0.0, 0.4, -90], "tool_length": 0.1, "push_height": 0.02})
-    _, _, free = _free_plan_joints(tmp_path, path)
+@pytest.mark.parametrize("path", ARM_AWARE.values(), ids=ARM_AWARE.keys())
+def test_where_the_free_plan_fails_the_arm_the_arm_aware_plan_is_followed(tmp_path, path):
+    free = _free_plan_joints(tmp_path, path)
     assert not free.follows and any(line.startswith("arm: cannot hold the pusher") for line in free.lines())
     refused = plan(str(path), "--plan", str(next((tmp_path / "free").glob("*.json"))), "--verify", "1", "--out", "v",
                    cwd=tmp_path)
