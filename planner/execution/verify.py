@@ -503,7 +503,9 @@ def _deviation(slider: Slider, simulated: np.ndarray, planned: ArrayLike) -> tup
 
 def _meets(scene: Scene, move: Move, poses: dict[str, np.ndarray], other: str) -> bool:
     """Whether a push or transit of ``move`` is not clear of part ``other`` at its pose in ``poses``."""
-    only = replace(scene.move_scene(move.part, poses, others=False), obstacles=(scene.body(other, poses[other]),))
+    # The part alone in the way, and no arm: the arm's reach is fit's business.
+    only = replace(scene.move_scene(move.part, poses, others=False), obstacles=(scene.body(other, poses[other]),),
+                   robot=None, heights=())
     model = collision_model(only, move.segments)
     return not all(is_clear(only, model, s) for s in move.segments)
 
@@ -522,7 +524,7 @@ def _goes_through(scene: Scene, segment: Transit | Transfer, name: str, pose: np
     low, high = np.minimum(path.min(axis=0), inner.bounds[:2]), np.maximum(path.max(axis=0), inner.bounds[2:])
     room = 1.0 + scene.pusher.width + scene.pusher.depth
     alone = replace(scene.move_scene(name, {**scene.starts, name: pose}, others=False),
-                    obstacles=tuple(getattr(inner, "geoms", (inner,))),
+                    obstacles=tuple(getattr(inner, "geoms", (inner,))), robot=None, heights=(),
                     workspace=tuple(float(v) for v in (*(low - room), *(high + room))))
     model = CollisionModel(alone, [])
     return not all(model.pusher_move_is_free(a, b, depth / 2) for a, b in in_plane_moves(segment))

@@ -47,10 +47,15 @@ from .fields import SceneError, shown
 from .options import PlannerOptions
 from .robot import Robot
 
-__all__ = ["ONE_PART", "Part", "Pusher", "Scene"]
+__all__ = ["OBSTACLE_HEIGHT", "ONE_PART", "PART_HEIGHT", "Part", "Pusher", "Scene"]
 
 #: The name of the part of a scene file with ``slider:`` (a scene of one part).
 ONE_PART = "part"
+#: An obstacle's height when its entry gives none (m): a fixture's wall, lower than either arm's
+#: links come with a tool of 0.1 m or more (docs/arm.md).
+OBSTACLE_HEIGHT = 0.05
+#: How high a part stands above the table (m), as an obstacle to the arm: parts are flat.
+PART_HEIGHT = 0.01
 
 
 @dataclass(frozen=True)
@@ -94,6 +99,15 @@ class Scene:
     path: str | None = None  # the file it was read from
     notes: tuple[str, ...] = ()  # what was not read from the CAD files it names (text, open chains)
     robot: Robot | None = None  # the arm holding the pusher (None: a pusher that floats)
+    #: The first obstacles' heights above the table (m); those after them, the other parts that
+    #: :meth:`move_scene` and the transfers stand in the way, are as high as a part
+    #: (:data:`PART_HEIGHT`). Only an arm's links can meet an obstacle's top (planner.world.reach).
+    heights: tuple[float, ...] = ()
+
+    @property
+    def obstacle_heights(self) -> tuple[float, ...]:
+        """Each obstacle's height above the table (m), in :attr:`obstacles`' order."""
+        return tuple(self.heights[:len(self.obstacles)]) + (PART_HEIGHT,) * (len(self.obstacles) - len(self.heights))
 
     @property
     def names(self) -> tuple[str, ...]:

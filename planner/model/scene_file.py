@@ -33,7 +33,7 @@ from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vec
 from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
 from .robot import Robot, read_robot
 from .scale import check_scale
-from .scene import ONE_PART, Part, Pusher, Scene
+from .scene import OBSTACLE_HEIGHT, ONE_PART, Part, Pusher, Scene
 from .yaml_file import read_yaml
 
 __all__ = ["MIN_SIZE", "MIN_TOLERANCE", "MU_RANGE", "PLANNER_KEYS", "Table", "load_scene", "parse_scene",
@@ -95,7 +95,8 @@ def plain_scene(scene: Scene, options: PlannerOptions | None = None) -> dict[str
     options = scene.options if options is None else options
     pusher_data = {"width": pusher.width, "depth": pusher.depth,
                    "mu": pusher.mu if pusher.mu_high is None else [pusher.mu, pusher.mu_high], "transit": options.transit}
-    table = {"obstacles": [{"polygon": np.asarray(o.exterior.coords)[:-1].tolist()} for o in scene.obstacles],
+    table = {"obstacles": [{"polygon": np.asarray(o.exterior.coords)[:-1].tolist(), "height": h}
+                           for o, h in zip(scene.obstacles, scene.obstacle_heights)],
              "workspace": {"min": list(scene.workspace[:2]), "max": list(scene.workspace[2:])},
              "tolerance": {"position": scene.tolerance_position, "angle": _degrees(scene.tolerance_angle)},
              "planner": {key: getattr(options, key) for key in PLANNER_KEYS} | {"margin": options.margin.to_dict()},
@@ -163,16 +164,26 @@ def _simple_polygon(pts: np.ndarray, name: str) -> shapely.Polygon:
     return shapely.Polygon(pts)
 
 
-def _obstacles(value: Any, name: str, folder: Path, notes: list[str]) -> list[shapely.Polygon]:
-    """The obstacles of one entry of ``obstacles``: a polygon, a box, or those a file draws (each
-    of its bodies, cut where it has holes: :func:`.cad.without_holes`)."""
+def _obstacles(value: Any, name: str, folder: Path, notes: list[str]) -> tuple[list[shapely.Polygon], float]:
+    """The obstacles of one entry of ``obstacles`` and their height: a polygon, a box, or those a
+    file draws (each of its bodies, cut where it has holes: :func:`.cad.without_holes`), with an
+    optional ``height`` (m, default :data:`.scene.OBSTACLE_HEIGHT`)."""
+    if isinstance(value, dict) and "height" in value:
+        height = number(value["height"], f"{name}.height", positive=True, limit=LENGTH)
+        return _obstacles({k: v for k, v in value.items() if k != "height"}, name, folder, notes)[0], height
+    return _outlines(value, name, folder, notes), OBSTACLE_HEIGHT
+
+
+def _outlines(value: Any, name: str, folder: Path, notes: list[str]) -> list[shapely.Polygon]:
+    """The outlines :func:`_obstacles` reads."""
     if isinstance(value, dict) and "file" in value:
         from .cad import FILE_KEYS, FILE_OPTIONS, read_shapes, without_holes
 
         shapes = read_shapes(keys(value, name, FILE_KEYS, FILE_OPTIONS), name, folder, notes)
         return [piece for shape in shapes for piece in without_holes(shape.region)]
     if not isinstance(value, dict) or len(value) != 1 or next(iter(value)) not in ("polygon", "box"):
-        raise SceneError(name, "must be {polygon: [[x, y], ...]}, {box: {center, size, angle}} or {file, units}")
+        raise SceneError(name, "must be {polygon: [[x, y], ...]}, {box: {center, size, angle}} or {file, units}, "
+                               "each with an optional height")
     if "polygon" in value:
         return [_polygon(value["polygon"], f"{name}.polygon")]
     box = keys(value["box"], f"{name}.box", ("center", "size"), ("angle",))
@@ -357,7 +368,7 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     goal = read_pose(spec["goal"], "goal", slider, table.obstacles, table.workspace)
     part = Part(ONE_PART, slider, start, goal, edges, cf_uncertainty)
     return Scene(name, (part,), pusher, table.obstacles, table.workspace, table.tolerance_position,
-                 table.tolerance_angle, table.options, path, tuple(notes), table.robot)
+                 table.tolerance_angle, table.options, path, tuple(notes), table.robot, table.heights)
 
 
 @dataclass(frozen=True)
@@ -371,6 +382,7 @@ class Table:
     tolerance_angle: float
     options: PlannerOptions
     robot: Robot | None = None
+    heights: tuple[float, ...] = ()  # the obstacles' (Scene.heights)
 
 
 def read_table(spec: dict, folder: Path, notes: list[str], transit: str) -> Table:
@@ -380,7 +392,9 @@ def read_table(spec: dict, folder: Path, notes: list[str], transit: str) -> Tabl
     obstacles_spec = [] if spec.get("obstacles") is None else spec["obstacles"]  # None: a bare "obstacles:"
     if not isinstance(obstacles_spec, list):
         raise SceneError("obstacles", "must be a list")
-    obstacles = tuple(p for k, o in enumerate(obstacles_spec) for p in _obstacles(o, f"obstacles[{k}]", folder, notes))
+    read = [_obstacles(o, f"obstacles[{k}]", folder, notes) for k, o in enumerate(obstacles_spec)]
+    obstacles = tuple(p for outlines, _ in read for p in outlines)
+    heights = tuple(h for outlines, h in read for _ in outlines)
     ws = keys(spec["workspace"], "workspace", ("min", "max"))
     lo, hi = vector(ws["min"], "workspace.min", 2, LENGTH), vector(ws["max"], "workspace.max", 2, LENGTH)
     if not np.all(hi > lo):
@@ -402,7 +416,7 @@ def read_table(spec: dict, folder: Path, notes: list[str], transit: str) -> Tabl
     opts = keys(spec.get("planner", {}), "planner", (), PLANNER_KEYS)
     return Table(obstacles, workspace, tol_pos, tol_ang,
                  PlannerOptions().merged({**opts, "transit": transit}, prefix="planner."),
-                 None if spec.get("robot") is None else read_robot(spec["robot"], workspace))
+                 None if spec.get("robot") is None else read_robot(spec["robot"], workspace), heights)
 
 
 def read_cf_uncertainty(spec: dict, slider: Slider, name: str) -> float:
@@ -454,7 +468,7 @@ def _parse_parts(data: dict, default_name: str, path: str | None) -> Scene:
     for which in ("start", "goal"):
         _apart(parts, which)
     return Scene(name, tuple(parts), pusher, table.obstacles, table.workspace, table.tolerance_position,
-                 table.tolerance_angle, table.options, path, tuple(notes), table.robot)
+                 table.tolerance_angle, table.options, path, tuple(notes), table.robot, table.heights)
 
 
 def _part_name(value: Any, field_name: str) -> str:

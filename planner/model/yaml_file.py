@@ -32,7 +32,7 @@ import yaml
 from .fields import SceneError, member, shown
 from .input_file import read_text
 
-__all__ = ["MAX_BYTES", "MAX_DEPTH", "MAX_NODES", "read_bytes", "read_yaml"]
+__all__ = ["MAX_BYTES", "MAX_DEPTH", "MAX_NODES", "read_yaml"]
 
 #: Largest file read: a scene is a few kilobytes; a megabyte holds parts of thousands of
 #: vertices and still parses in a few seconds.

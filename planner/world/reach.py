@@ -23,9 +23,10 @@ frame's table pose alone, so the planner checks them as it checks obstacles, by 
   without crossing the band about pushing straight at the base, where the plan changes edge or
   lifts instead. The bound is the wrist's reach as the arm's inverse kinematics
   (:mod:`planner.arm.reach`) measures it, less :data:`WRIST_MARGIN`: its other joints take up
-  some of the turn, more the nearer the pusher is to the base (:data:`WRIST`: 177 degrees up to
-  0.70 m from a Panda's base, down to 170 at its outer rim). A last joint of a full turn or more
-  (the UR5e's +-2 pi) leaves ``psi`` free.
+  some of the turn, more the nearer the pusher is to the base (:data:`WRIST`: 175 degrees up to
+  0.50 m from a Panda's base, 170.5 at 0.70 m, 163.5 at its outer rim). The UR5e's last joint turns two
+  whole turns: its bound is the cap, 180 degrees less the margin, which keeps its wrist within
+  half a turn of where a path starts it.
 
 :meth:`ReachZone.clearance` is a lower bound on how far the pusher's body must move (in the
 collision model's metric: a point's speed plus the body's reach times its turn rate) before it
@@ -64,12 +65,15 @@ __all__ = ["RING_MARGIN", "WRIST", "WRIST_MARGIN", "ReachZone", "family_posture"
 RING_MARGIN = 0.02
 #: How far inside the wrist's measured reach (rad, 5 degrees) the zone's bound on ``|psi|`` is.
 WRIST_MARGIN = math.radians(5.0)
-#: Per arm whose last joint turns less than a full turn, how far ``|psi|`` turns from zero before
+#: Per arm, how far ``|psi|`` turns from zero before
 #: the wrist comes within 0.05 rad of its stop, following the inverse kinematics from pushing
 #: straight away at ``(distance from the base (m), degrees)``, the lesser of the two ways (the
 #: Panda with a 0.12 m tool: 188.2 at 0.50 m, 175.5 at 0.70 m, 172.2 at 0.74 m, 168.5 at 0.78 m;
 #: docs/arm.md). Between these points it is interpolated, held at the ends, and never above 180.
-WRIST = {"panda": ((0.50, 188.2), (0.70, 175.5), (0.74, 172.2), (0.78, 168.5))}
+WRIST = {"panda": ((0.50, 188.2), (0.70, 175.5), (0.74, 172.2), (0.78, 168.5)),
+         # The UR5e's last joint turns two whole turns: the cap. A random scene's plan that took
+         # the pusher round the base near its inner rim turned it 270 degrees on one edge.
+         "ur5e": ((0.0, 360.0),)}
 _GRID = 181  # samples of each of the two bending joints gridded (a step of about 1 degree)
 _PLANAR = {"panda": (1, 3, 5), "ur5e": (1, 2, 3)}  # the bending joints (from 0) of the planar family
 
@@ -85,6 +89,33 @@ class ReachZone:
     inner: float
     outer: float
     wrist: tuple[tuple[float, ...], tuple[float, ...]] | None = None
+    #: The lowest the arm's links come above the table (m), and where they reach on the table's
+    #: plane: within ``spread`` (m) of the segment from ``back`` behind the base to ``ahead``
+    #: beyond the pusher, on the line through both (:meth:`shadow`). Only an obstacle taller
+    #: than ``floor`` can meet the arm, and only there.
+    floor: float = math.inf
+    back: float = 0.0
+    ahead: float = 0.0
+    spread: float = 0.0
+
+    def shadow(self, x: float, y: float) -> tuple[tuple[float, float], tuple[float, float]]:
+        """The ends of the segment whose ``spread`` holds the arm on the table's plane, the pusher
+        frame at ``(x, y)``; its ends move at most :meth:`shadow_rate` times as fast as the pusher.
+
+        >>> ReachZone((0.0, 0.0), 0.2, 0.8, back=0.1, ahead=0.05).shadow(0.5, 0.0)
+        ((-0.1, 0.0), (0.55, 0.0))
+        """
+        dx, dy = x - self.centre[0], y - self.centre[1]
+        rho = math.hypot(dx, dy)
+        ux, uy = dx / rho, dy / rho
+        return ((self.centre[0] - self.back * ux, self.centre[1] - self.back * uy),
+                (x + self.ahead * ux, y + self.ahead * uy))
+
+    @property
+    def shadow_rate(self) -> float:
+        """How many times as fast as the pusher the ends of :meth:`shadow` move at most: the
+        direction from the base turns at most at the pusher's speed over ``inner``."""
+        return 1.0 + max(self.back, self.ahead) / self.inner
 
     def bound(self, rho: float) -> float:
         """The bound on ``|psi|`` (rad) at ``rho`` (m) from the base; infinite without one.
@@ -214,6 +245,27 @@ def _family(model: str, tool_length: float, push_height: float) -> tuple[np.ndar
     return np.concatenate(radii), np.concatenate(postures)
 
 
+def _footprint(arm: Arm, postures: np.ndarray, tool_length: float) -> tuple[float, float, float, float]:
+    """Where ``arm``'s link capsules are over ``postures`` (joint 1 at zero): their lowest point
+    above the table, and on the table's plane how far behind the base and beyond the pusher
+    their joint frames go along the line through both, and how far from that line, plus a
+    capsule's radius (a capsule lies between two frames, and a distance to a segment is convex):
+    ``(floor, back, ahead, spread)`` (m)."""
+    chain = _chain(arm, postures)
+    flange = chain[-1]
+    pusher = flange[:, :2, 3] + tool_length * flange[:, :2, 2]
+    points = np.stack([f[:, :3, 3] for f in chain[1:]], axis=1)  # (postures, frames, 3)
+    radii = np.r_[np.full(len(chain) - 2, arm.radius), 0.8 * arm.radius]  # the flange's capsule is thinner
+    floor = float((points[:, :, 2] - radii).min())
+    rho = np.linalg.norm(pusher, axis=1)
+    u = pusher / rho[:, None]
+    along = np.einsum("pfk,pk->pf", points[:, :, :2], u)  # m from the base towards the pusher
+    across = np.abs(points[:, :, 0] * u[:, None, 1] - points[:, :, 1] * u[:, None, 0])
+    back = float(np.maximum(-along, 0.0).max())
+    ahead = float(np.maximum(along - rho[:, None], 0.0).max())
+    return floor, back, ahead, float((across + radii).max())
+
+
 def family_posture(robot: Robot, rho: float) -> np.ndarray:
     """A posture of ``robot``'s planar family holding the pusher at the push height about ``rho``
     (m) from the base axis (the nearest it has), joint 1 at zero: of those within 5 mm of the
@@ -235,10 +287,15 @@ def family_posture(robot: Robot, rho: float) -> np.ndarray:
 def reach_zone(robot: Robot) -> ReachZone:
     """The reach zone of ``robot`` (module docstring); empty (``inner > outer``) where the planar
     family never holds the pusher at the push height."""
-    radii, _ = _family(robot.model, float(robot.tool_length), float(robot.push_height))
-    inner, outer = (float(radii.min()), float(radii.max())) if radii.size else (math.inf, -math.inf)
+    radii, postures = _family(robot.model, float(robot.tool_length), float(robot.push_height))
+    if not radii.size:
+        return ReachZone((float(robot.base[0]), float(robot.base[1])), math.inf, -math.inf)
     wrist = None
     if robot.model in WRIST:
         rho, degrees = zip(*WRIST[robot.model])
         wrist = (rho, tuple(min(math.pi, math.radians(d)) - WRIST_MARGIN for d in degrees))
-    return ReachZone((float(robot.base[0]), float(robot.base[1])), inner + RING_MARGIN, outer - RING_MARGIN, wrist)
+    # The postures the arm takes (family_posture's, every centimetre of the zone's ring), not
+    # every one of the family: some fold the elbow low or behind the base, where the arm does not go.
+    inner, outer = float(radii.min()) + RING_MARGIN, float(radii.max()) - RING_MARGIN
+    taken = np.array([family_posture(robot, rho) for rho in np.linspace(inner, outer, max(2, int((outer - inner) / 0.01)))])
+    return ReachZone((float(robot.base[0]), float(robot.base[1])), inner, outer, wrist, *_footprint(ARMS[robot.model], taken, float(robot.tool_length)))

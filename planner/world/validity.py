@@ -149,6 +149,12 @@ class CollisionModel:
         # they count a wall (planner.world.reach).
         self.zone = None if scene.robot is None else reach_zone(scene.robot)
         self.robot = None if scene.robot is None else scene.robot.model
+        # The obstacles tall enough for the arm's links to meet (none, mostly: planner.world.reach).
+        tall = [] if self.zone is None else [o for o, h in zip(scene.obstacles, scene.obstacle_heights)
+                                             if h > self.zone.floor]
+        self._tall = shapely.union_all(tall) if tall else None
+        if self._tall is not None:
+            shapely.prepare(self._tall)
         # Per body, the pusher frame in its frame and how fast it turns (2 over its diameter, rad/m).
         self._holds: dict[int | str, tuple[float, float, float, float]] = {}
 
@@ -228,17 +234,23 @@ class CollisionModel:
         may be anywhere within ``near(reach)`` of ``pose`` for a point ``reach`` from its origin
         (:meth:`planner.model.scene.Scene.tolerance_slack`): the zone's clearance is a lower bound
         on how far the body moves, inside or out."""
+        if self.zone is None:
+            return None
         at = tuple(float(v) for v in pose)
         for e in edges:
             self.body_pieces(e)
-        if self.zone is None or any(self._zone_clearance(at, e) > room - (near(self._bodies[e][2]) if near else 0.0)
-                                    for e in edges):
+        least = {e: room - (near(self._bodies[e][2]) if near else 0.0) for e in edges}
+        if any(self._zone_clearance(at, e) > least[e] for e in edges):
             return None
+        if any(self._zone_clearance(at, e, shadow=False) > least[e] for e in edges):
+            return (f"out of the {self.robot} arm's reach: its links would pass over an obstacle taller than the "
+                    f"{self.zone.floor:.3f} m they keep above the table (docs/arm.md)")
         return f"out of the {self.robot} arm's reach: its reach zone is {self.zone.text()} (docs/arm.md)"
 
-    def _zone_clearance(self, pose: tuple[float, float, float], key: int | str) -> float:
+    def _zone_clearance(self, pose: tuple[float, float, float], key: int | str, shadow: bool = True) -> float:
         """The reach zone's clearance (:meth:`~planner.world.reach.ReachZone.clearance`) of the
-        pusher of body ``key`` at ``pose`` (an arm's model only)."""
+        pusher of body ``key`` at ``pose`` (an arm's model only), and with ``shadow`` of the arm's
+        links over the obstacles taller than they keep above the table."""
         if key not in self._holds:
             outline = np.array(self._bodies[key][1])
             turn = 2.0 / float(np.linalg.norm(outline[:, None] - outline[None], axis=2).max())
@@ -251,7 +263,15 @@ class CollisionModel:
         hx, hy, hphi, turn = self._holds[key]
         x, y, theta = pose
         c, s = math.cos(theta), math.sin(theta)
-        return self.zone.clearance((x + c * hx - s * hy, y + s * hx + c * hy, theta + hphi), turn)
+        px, py = x + c * hx - s * hy, y + s * hx + c * hy
+        zone = self.zone.clearance((px, py, theta + hphi), turn)
+        if self._tall is None or zone <= 0 or not shadow:
+            return zone
+        # The arm's links over the tall obstacles: the points of the segment they stand within
+        # move no faster than its ends (planner.world.reach.ReachZone.shadow).
+        # (A float: a numpy one's comparisons give numpy booleans, which OMPL's callbacks refuse.)
+        shadow = float(shapely.distance(shapely.LineString(self.zone.shadow(px, py)), self._tall)) - self.zone.spread
+        return min(zone, shadow / self.zone.shadow_rate)
 
     def _body_clearance(self, pose: tuple[float, float, float], key: int | str, enough: float, placed: list) -> float:
         """:meth:`_clearance` of body ``key`` alone; ``placed`` holds what the bodies at ``pose``

@@ -75,7 +75,7 @@ def test_a_wall_across_a_push_is_refused_naming_that_push(tmp_path, capsys):
 
 def test_a_wall_across_a_transit_is_refused_naming_that_transit(tmp_path):
     """A post where the pusher walks round the part, clear of the part itself and of every push."""
-    scene, plan = load_scene(ROOT / "scenes" / "junction.yaml"), load_plan(BEST / "junction.json")
+    plan = load_plan(BEST / "junction.json")
     k = next(i for i, s in enumerate(plan.segments) if s.kind == "transit")
     path = plan.segments[k].pusher_path
     where = path[len(path) // 2, :2]

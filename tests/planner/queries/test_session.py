@@ -5,7 +5,6 @@ checks of the public API's arguments."""
 from __future__ import annotations
 
 import ast
-import copy
 import inspect
 import math
 import re
