@@ -75,6 +75,10 @@ WRIST = {"panda": ((0.50, 188.2), (0.70, 175.5), (0.74, 172.2), (0.78, 168.5)),
          # the pusher round the base near its inner rim turned it 270 degrees on one edge.
          "ur5e": ((0.0, 360.0),)}
 _GRID = 181  # samples of each of the two bending joints gridded (a step of about 1 degree)
+#: How far from a distance asked for (m) family_posture looks for the posture nearest the ready
+#: one: a grid step moves the pusher up to about 1.2 cm, and with 5 mm the nearest crossings of
+#: the UR5e's elbow-up postures were sometimes all too far, leaving an elbow-down one 7 cm up.
+NEAR = 0.02
 _PLANAR = {"panda": (1, 3, 5), "ur5e": (1, 2, 3)}  # the bending joints (from 0) of the planar family
 
 
@@ -268,8 +272,8 @@ def _footprint(arm: Arm, postures: np.ndarray, tool_length: float) -> tuple[floa
 
 def family_posture(robot: Robot, rho: float) -> np.ndarray:
     """A posture of ``robot``'s planar family holding the pusher at the push height about ``rho``
-    (m) from the base axis (the nearest it has), joint 1 at zero: of those within 5 mm of the
-    nearest, the one nearest the ready posture. Where the arm's inverse kinematics starts a path.
+    (m) from the base axis (the nearest it has), joint 1 at zero: of those within :data:`NEAR` of
+    the nearest, the one nearest the ready posture. Where the arm's inverse kinematics starts a path.
 
     >>> from planner.model.robot import Robot
     >>> q = family_posture(Robot("panda", np.zeros(3), 0.12), 0.5)
@@ -280,7 +284,7 @@ def family_posture(robot: Robot, rho: float) -> np.ndarray:
     if not radii.size:
         return np.array(ARMS[robot.model].ready, dtype=float)
     gap = np.abs(radii - rho)
-    near = gap <= gap.min() + 0.005
+    near = gap <= gap.min() + NEAR
     return postures[near][np.argmin(np.linalg.norm(postures[near] - ARMS[robot.model].ready, axis=1))].copy()
 
 
