@@ -85,6 +85,11 @@ other than the one it moves (or, on a transfer, leaves), so a push that shoves a
 caught. A run fails if any part ends outside its goal tolerance, the pusher slips or any such
 contact happens. Every run begins with the pusher behind the first move's first contact, moving
 in (:func:`.approach.lead_in_pose`), and may be perturbed (:func:`perturbations`).
+
+**With a robot** (a scene's ``robot:`` block) the pusher prism is on the arm's flange and the
+arm's servos follow the joint trajectory (:mod:`.arm_sim`): the same parts, contacts and checks,
+slip measured at the simulated pusher from when it touches the part, and the arm's links touching
+anything a fault too.
 """
 
 from __future__ import annotations
@@ -751,6 +756,12 @@ class World:
         heading = math.atan2(axes[1, 0], axes[0, 0]) + self.arm.mount
         return np.array([x, y, z - self.arm.robot.push_height, math.remainder(heading, 2 * math.pi)])
 
+    def touches(self, name: str) -> bool:
+        """Whether the pusher touches part ``name`` now."""
+        contacts = self.data.contact
+        pairs = contacts.geom[(contacts.dist < 0) & (contacts.geom == self.pusher_geom).any(axis=1)]
+        return any(self.owner.get(g) == name for g in pairs.ravel())
+
     def sample(self, planned: ArrayLike) -> tuple[float, np.ndarray]:
         """With the arm: how far (m) the pusher frame's origin is from ``planned`` ``(x, y, z)``
         (the trajectory's sample), and the points the arm is drawn through: its bodies' origins
@@ -881,7 +892,9 @@ def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], 
         if arm is not None:
             tracking[row], points = world.sample([motion.x[row], motion.y[row], motion.z[row]])
             drawn.append(points)
-        if motion.contact[row]:
+        # With the arm, from the first sample the pusher touches the part: a servo lags, and the gap
+        # it closes as the push begins is not slip.
+        if motion.contact[row] and (arm is None or world.touches(steps[k][0])):
             # The face midpoint in the pushed part's frame, against where it was when this push began.
             face = relative_pose(tracks[steps[k][0]][row],
                                  world.pusher_pose([motion.x[row], motion.y[row], motion.theta[row]]))[:2]

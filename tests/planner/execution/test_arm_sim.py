@@ -138,7 +138,8 @@ def with_robot(tmp_path: Path, scene: str, robot: dict) -> Path:
 @pytest.mark.slow
 @pytest.mark.parametrize("scene, robot", [
     ("parts/swap.yaml", {"model": "ur5e", "base": [0.0, -0.4, 90], "tool_length": 0.12}),
-], ids=["swap (a tray), ur5e"])
+    ("junction.yaml", {"model": "panda", "base": [0.0, 0.4, -90], "tool_length": 0.1, "push_height": 0.02}),
+], ids=["swap (a tray), ur5e", "junction, panda"])
 def test_the_arm_delivers_other_scenes(tmp_path, scene, robot):
     run = plan(str(with_robot(tmp_path, scene, robot)), "--simulate", "2", cwd=tmp_path)
     assert run.returncode == 0, run.stdout + run.stderr
