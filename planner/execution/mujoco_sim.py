@@ -636,7 +636,8 @@ class Simulation(Runs):
                 f"{sum(r.seconds for r in self.runs):.1f} s")
 
 
-#: The pusher as a function of a run's clock: ``u -> ((x, y, z, theta), their rates)``.
+#: The pusher as a function of a run's clock: ``u -> ((x, y, z, theta), their rates)``; or, with
+#: the arm, its joints' reference: ``u -> (angles, rates)``.
 Driver = Callable[[float], tuple[ArrayLike, ArrayLike]]
 
 
@@ -690,7 +691,6 @@ class World:
             self.table = model.geom("table").id
             # The arm's bodies, last in the model and a chain: in order from its base to its flange.
             self.bodies = list(range(model.body("base").id, model.nbody))
-            self.reference = _table_driver(arm.t, np.hstack([arm.q, arm.qd]), arm.count)
             return
         self.qpos = self.model.joint("pusher_x").qposadr[0] + np.arange(4)
         self.qvel = self.model.joint("pusher_x").dofadr[0] + np.arange(4)
@@ -719,11 +719,11 @@ class World:
     def _actuate(self, pusher: Driver, u: float) -> ArrayLike:
         """Set the pusher to ``pusher(u)``: ``(x, y, z, theta)`` and their rates; and push it by
         the force that gives it, by the step's end, the rates ``pusher`` has then (module
-        docstring, "The model"). Returns its pose. With the arm, its servos are given the
-        reference's joint angles and rates at ``u`` instead (:mod:`.arm_sim`)."""
+        docstring, "The model"). Returns its pose. With the arm, ``pusher(u)`` is the joints'
+        reference angles and rates, given to its servos (:mod:`.arm_sim`)."""
         data = self.data
         if self.arm is not None:
-            q, qd = self._drive(self.reference, u)
+            q, qd = self._drive(pusher, u)
             data.ctrl[:] = self.arm.controls(np.asarray(q), qd)
             return self.pusher_now()
         pose, rate = self._ahead if self._ahead is not None else self._drive(pusher, u)
@@ -865,8 +865,9 @@ def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], 
 
         def pusher(u: float) -> tuple[list[float], list[float]]:
             return led(u) if u < lead.duration else follow(u - lead.duration)
-    else:  # the arm follows its own reference (World._actuate)
-        world, pusher = World(scene, supports, mu, setup.starts, setup.bumps, arm), None
+    else:  # the arm's joints follow their reference (World._actuate)
+        world = World(scene, supports, mu, setup.starts, setup.bumps, arm)
+        pusher = _table_driver(arm.t, np.hstack([arm.q, arm.qd]), arm.count)
 
     steps = plan.steps
     # The pusher may touch the part of its segment, and on a transfer the part it leaves: a transit

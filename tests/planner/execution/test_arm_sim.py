@@ -146,6 +146,21 @@ def test_the_arm_delivers_other_scenes(tmp_path, scene, robot):
     assert f"pusher held by the {robot['model']} arm" in run.stdout
 
 
+@pytest.mark.slow
+def test_simulate_with_an_arm_that_cannot_follow_says_so_and_exits_3(tmp_path, monkeypatch, capsys):
+    """--simulate without --trajectory checks the joints itself: with the reach zone widened 30 cm
+    past the arm's reach (as in test_joints.py), around's plan goes where the arm cannot hold the
+    pusher, and the run is not passed off as the arm's success."""
+    import planner.world.reach
+    from planner.cli import main
+
+    monkeypatch.setattr(planner.world.reach, "RING_MARGIN", -0.3)
+    code = main([str(AROUND), "--simulate", "1", "--seed", "1", "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert code == 3, out
+    assert "arm: CANNOT FOLLOW:" in out and "simulate 1/1" in out
+
+
 def test_closed_loop_with_a_robot_is_one_line(tmp_path):
     run = plan(str(AROUND), "--simulate", "1", "--closed-loop", cwd=tmp_path)
     assert run.returncode == 1 and run.stderr.count("\n") == 1 and "--closed-loop: not with a robot yet" in run.stderr
