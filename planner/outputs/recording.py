@@ -375,7 +375,7 @@ def _log_arm(rec: rr.RecordingStream, simulation: Simulation, times: np.ndarray)
     rec.send_columns("world/arm", indexes=[rr.TimeColumn("step", sequence=np.arange(len(times))),
                                            rr.TimeColumn("time", duration=times)],
                      columns=rr.LineStrips3D.columns(strips=simulation.worst.arm[samples]))
-    rec.log("world/arm", rr.LineStrips3D.from_fields(colors=_DARK, radii=_BOLD,
+    rec.log("world/arm", rr.LineStrips3D.from_fields(colors=_SIMULATED, radii=_BOLD,
                                                      labels=[f"{simulation.arm.robot.model} (MuJoCo)"]), static=True)
 
 
