@@ -45,8 +45,8 @@ def mjcf(arm: Arm, tool_length: float, base: tuple[float, float, float] = (0.0, 
     ``link1`` ...; geoms use the default class ``link``, which the caller defines.
 
     The simulation adds to it: ``tool``, MJCF put in the body that carries the flange (in that
-    body's frame, whose axes are the flange's), holds the pusher; ``attributes`` are given to every
-    body (gravity compensation, a default class for the joints).
+    body's frame, whose axes are the flange's), holds the pusher; ``attributes`` (with a leading
+    space) are given to every body: gravity compensation, a default class for the joints.
 
     >>> xml = mjcf(ARMS["panda"], 0.12)
     >>> xml.count("<joint "), xml.count('name="pusher"'), xml.count('name="flange"')
