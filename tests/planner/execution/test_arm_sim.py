@@ -11,8 +11,6 @@ reported by name; the recording's arm starts at the robot's base.
 from __future__ import annotations
 
 import math
-import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -31,6 +29,7 @@ from planner.execution.arm_sim import SimArm  # noqa: E402
 from planner.model.robot import Robot  # noqa: E402
 from planner.model.bodies import pusher_frame_body  # noqa: E402
 from planner.queries.session import Planner  # noqa: E402
+from robot_scenes import plan, with_robot  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[3]
 AROUND = ROOT / "scenes" / "arm" / "around.yaml"
@@ -100,11 +99,6 @@ def test_a_link_on_the_table_is_reported_by_name(around):
     assert not run.passed and any(what == "the arm's link7 touches the table" for _, what in run.faults), run.faults
 
 
-def plan(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "planner.cli", *args], capture_output=True, text=True, cwd=cwd,
-                          timeout=600, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
-
-
 def test_simulate_with_the_arm_from_the_command_line(tmp_path):
     from rerun.chunk import RrdReader
 
@@ -125,14 +119,6 @@ def test_simulate_with_the_arm_from_the_command_line(tmp_path):
     base = yaml.safe_load(AROUND.read_text())["robot"]["base"]
     assert np.allclose(first[0], [base[0], base[1], 0.0], atol=1e-9)  # the arm drawn from its base
     assert abs(first[-1][2] - 0.01) < 0.003  # to the pusher frame, push_height over the table
-
-
-def with_robot(tmp_path: Path, scene: str, robot: dict) -> Path:
-    spec = yaml.safe_load((ROOT / "scenes" / scene).read_text())
-    spec["robot"] = robot
-    path = tmp_path / Path(scene).name
-    path.write_text(yaml.safe_dump(spec))
-    return path
 
 
 @pytest.mark.slow
