@@ -37,18 +37,23 @@ def _capsule(start: np.ndarray, end: np.ndarray, radius: float, name: str) -> st
     return f'<geom name="{name}" type="capsule" fromto="{points}" size="{radius:.17g}" class="link"/>'
 
 
-def mjcf(arm: Arm, tool_length: float, base: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> str:
+def mjcf(arm: Arm, tool_length: float, base: tuple[float, float, float] = (0.0, 0.0, 0.0), *,
+         tool: str = "", attributes: str = "") -> str:
     """The MJCF ``<body>`` of ``arm`` (no ``<mujoco>`` around it), its base frame at ``base``
     ``(x, y, yaw)`` on the table (z = 0), with a site ``pusher`` ``tool_length`` beyond the flange
     along its z axis and a site ``flange`` at the flange. Joints are ``joint1`` ... and bodies
     ``link1`` ...; geoms use the default class ``link``, which the caller defines.
+
+    The simulation adds to it: ``tool``, MJCF put in the body that carries the flange (in that
+    body's frame, whose axes are the flange's), holds the pusher; ``attributes`` (with a leading
+    space) are given to every body: gravity compensation, a default class for the joints.
 
     >>> xml = mjcf(ARMS["panda"], 0.12)
     >>> xml.count("<joint "), xml.count('name="pusher"'), xml.count('name="flange"')
     (7, 1, 1)
     """
     x, y, yaw = base
-    out = [f'<body name="base" pos="{x:.17g} {y:.17g} 0" quat="{math.cos(yaw / 2):.17g} 0 0 {math.sin(yaw / 2):.17g}">']
+    out = [f'<body name="base" pos="{x:.17g} {y:.17g} 0" quat="{math.cos(yaw / 2):.17g} 0 0 {math.sin(yaw / 2):.17g}"{attributes}>']
     closing = ["</body>"]
     inertia = 0.4 * arm.radius ** 2  # per kg: a solid ball of the capsules' radius
     for k, (a, d, alpha) in enumerate(arm.dh, 1):
@@ -59,23 +64,24 @@ def mjcf(arm: Arm, tool_length: float, base: tuple[float, float, float] = (0.0, 
             # which Tz(d) only slides along, so the body sits at Rx(alpha) (a, 0, d).
             pos = _rot_x(alpha, np.array([a, 0.0, d]))
             out.append(_capsule(np.zeros(3), pos, arm.radius, f"shape{k}"))
-            out.append(f'<body name="link{k}" pos="{" ".join(f"{v:.17g}" for v in pos)}" quat="{_quat_x(alpha)}">')
+            out.append(f'<body name="link{k}" pos="{" ".join(f"{v:.17g}" for v in pos)}" quat="{_quat_x(alpha)}"{attributes}>')
             out.append(f'<joint name="joint{k}" axis="0 0 1" range="{arm.lower[k - 1]:.17g} {arm.upper[k - 1]:.17g}"/>')
             out.append(held)
         else:
             # Rz(q) Tz(d) Tx(a) Rx(alpha): the hinge turns at the frame before; the next frame sits at (a, 0, d).
-            out.append(f'<body name="link{k}">')
+            out.append(f'<body name="link{k}"{attributes}>')
             out.append(f'<joint name="joint{k}" axis="0 0 1" range="{arm.lower[k - 1]:.17g} {arm.upper[k - 1]:.17g}"/>')
             out.append(held)
             end = np.array([a, 0.0, d])
             out.append(_capsule(np.zeros(3), np.array([0.0, 0.0, d]), arm.radius, f"shape{k}a"))
             out.append(_capsule(np.array([0.0, 0.0, d]), end, arm.radius, f"shape{k}b"))
-            out.append(f'<body name="frame{k}" pos="{a:.17g} 0 {d:.17g}" quat="{_quat_x(alpha)}">')
+            out.append(f'<body name="frame{k}" pos="{a:.17g} 0 {d:.17g}" quat="{_quat_x(alpha)}"{attributes}>')
             closing.append("</body>")
         closing.append("</body>")
     out.append(_capsule(np.zeros(3), np.array([0.0, 0.0, arm.flange]), arm.radius * 0.8, "shape_flange"))
     out.append(f'<site name="flange" pos="0 0 {arm.flange:.17g}"/>')
     out.append(f'<site name="pusher" pos="0 0 {arm.flange + tool_length:.17g}"/>')
+    out.append(tool)
     return "\n".join(filter(None, out + closing))
 
 

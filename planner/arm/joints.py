@@ -104,17 +104,21 @@ class JointTrajectory:
 
 
 def joint_trajectory(robot: Robot, t: ArrayLike, poses: ArrayLike, heights: ArrayLike, segments: ArrayLike,
-                     parts: ArrayLike | None = None) -> JointTrajectory:
+                     parts: ArrayLike | None = None, start: ArrayLike | None = None) -> JointTrajectory:
     """The joint angles of ``robot``'s arm along pusher table poses ``poses`` ``(n, 3)`` at
-    heights ``heights`` above the table and times ``t`` (module docstring)."""
+    heights ``heights`` above the table and times ``t`` (module docstring); the first sample
+    reached from the posture ``start`` if given (a path that must join one the arm is on), else
+    from :meth:`ArmReach.first`'s."""
     t, poses, heights = np.asarray(t, dtype=float), np.asarray(poses, dtype=float), np.asarray(heights, dtype=float)
     reach = ArmReach(robot)
     q = np.zeros((len(t), reach.arm.joints))
     miss = np.zeros(len(t))
     posture = reach.ready
     for k in range(len(t)):
-        if k == 0:
+        if k == 0 and start is None:
             posture, _ = reach.first(poses[k], height=float(heights[k]))
+        elif k == 0:
+            posture, _ = reach.solve(poses[k], start, height=float(heights[k]))
         else:
             posture, _ = reach.solve(poses[k], posture, steps=FOLLOW_STEPS, height=float(heights[k]))
         q[k] = posture

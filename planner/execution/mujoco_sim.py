@@ -85,6 +85,11 @@ other than the one it moves (or, on a transfer, leaves), so a push that shoves a
 caught. A run fails if any part ends outside its goal tolerance, the pusher slips or any such
 contact happens. Every run begins with the pusher behind the first move's first contact, moving
 in (:func:`.approach.lead_in_pose`), and may be perturbed (:func:`perturbations`).
+
+**With a robot** (a scene's ``robot:`` block) the pusher prism is on the arm's flange and the
+arm's servos follow the joint trajectory (:mod:`.arm_sim`): the same parts, contacts and checks,
+slip measured at the simulated pusher from when it touches the part, and the arm's links touching
+anything a fault too.
 """
 
 from __future__ import annotations
@@ -96,7 +101,7 @@ import time
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import NamedTuple, TypeVar
+from typing import TYPE_CHECKING, NamedTuple, TypeVar
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -117,6 +122,10 @@ from ..model.scene_file import placement_fault
 from ..world.validity import CollisionModel
 from .approach import first_edge, lead_in_pose
 from .trajectory import Trajectory, planned_part, trajectory
+
+if TYPE_CHECKING:  # the arm's model needs mink: loaded only for a scene with a robot
+    from ..arm.joints import JointTrajectory
+    from .arm_sim import SimArm
 
 __all__ = ["DIVERGED", "MAX_RUNS", "MISSING", "SLIP", "TABLE_MU", "TIMESTEP", "ByPart", "Feet", "Perturbed", "Run", "Runs", "Simulation", "World", "feet",
            "foot_sets", "mjcf", "needs_mujoco", "perturbations", "simulate", "support_centre", "write_mjcf"]
@@ -265,19 +274,38 @@ def _table(scene: Scene) -> tuple[list[str], list[str], list[str]]:
     return assets, world, blocks
 
 
+#: Height of the pusher prism, m: above the parts.
+PUSHER_TOP = THICKNESS + 2 * FOOT + 0.01
+
+
+def _free_pusher() -> str:
+    """The free pusher's body: the prism on x, y, z and heading joints (module docstring)."""
+    return f"""<body name="pusher" gravcomp="1">
+      <joint name="pusher_x" type="slide" axis="1 0 0"/>
+      <joint name="pusher_y" type="slide" axis="0 1 0"/>
+      <joint name="pusher_z" type="slide" axis="0 0 1"/>
+      <joint name="pusher_theta" type="hinge" axis="0 0 1"/>
+      <inertial pos="0 0 0" mass="{PUSHER_MASS}" diaginertia="{_numbers([PUSHER_MASS * 0.01] * 3)}"/>
+      <geom name="pusher" type="mesh" mesh="pusher" rgba=".1 .1 .1 1"/>
+    </body>"""
+
+
 def _document(scene: Scene, assets: list[str], world: list[str], bodies: list[str], pairs: list[str],
-             keys: list[str]) -> str:
+              keys: list[str], arm: SimArm | None = None) -> str:
     """The MJCF document of ``scene``: the options, the table plane, ``world``'s geoms, the parts'
-    ``bodies``, the pusher (a prism of its outline on x, y, z and heading joints, last in the
-    joints' order), the contact ``pairs`` and the ``keys``."""
+    ``bodies``, the pusher (a prism of its outline on x, y, z and heading joints, or on ``arm``'s
+    flange, :mod:`.arm_sim`; last in the joints' order), the contact ``pairs`` and the ``keys``."""
     xmin, ymin, xmax, ymax = scene.workspace
     span = max(xmax - xmin, ymax - ymin)
-    top = THICKNESS + 2 * FOOT + 0.01
-    assets = assets + [_prism("pusher", pusher_frame_body(scene.pusher.width, scene.pusher.depth), 0.0, top)]
-    return f"""<mujoco model={quoteattr(scene.name)}>
-  <option timestep="{TIMESTEP}" gravity="0 0 {-GRAVITY:g}" cone="elliptic" impratio="10" solver="Newton" iterations="50" tolerance="1e-10" noslip_iterations="{NOSLIP_ITERATIONS}"/>
+    assets = assets + [_prism("pusher", pusher_frame_body(scene.pusher.width, scene.pusher.depth), 0.0, PUSHER_TOP)]
+    pusher = _free_pusher() if arm is None else arm.body(PUSHER_TOP)
+    # The arm's servos are stiff dampers: integrated implicitly (arm_sim's docstring).
+    integrator = "" if arm is None else ' integrator="implicitfast"'
+    actuators = "" if arm is None else f"<actuator>{''.join(arm.actuators())}</actuator>"
+    return f"""<mujoco model={quoteattr(scene.name)}>{"" if arm is None else '<compiler angle="radian"/>'}
+  <option timestep="{TIMESTEP}" gravity="0 0 {-GRAVITY:g}" cone="elliptic" impratio="10" solver="Newton" iterations="50" tolerance="1e-10" noslip_iterations="{NOSLIP_ITERATIONS}"{integrator}/>
   <default>
-    <geom contype="0" conaffinity="0"/>
+    <geom contype="0" conaffinity="0"/>{"" if arm is None else arm.defaults()}
   </default>
   <asset>
     {chr(10).join('    ' + a for a in assets).strip()}
@@ -286,18 +314,11 @@ def _document(scene: Scene, assets: list[str], world: list[str], bodies: list[st
     <geom name="table" type="plane" size="{_numbers([span, span, 0.1])}" pos="{_numbers([(xmin + xmax) / 2, (ymin + ymax) / 2, 0])}" rgba=".9 .9 .85 1"/>
     {chr(10).join('    ' + w for w in world).strip()}
     {chr(10).join('    ' + b for b in bodies).strip()}
-    <body name="pusher" gravcomp="1">
-      <joint name="pusher_x" type="slide" axis="1 0 0"/>
-      <joint name="pusher_y" type="slide" axis="0 1 0"/>
-      <joint name="pusher_z" type="slide" axis="0 0 1"/>
-      <joint name="pusher_theta" type="hinge" axis="0 0 1"/>
-      <inertial pos="0 0 0" mass="{PUSHER_MASS}" diaginertia="{_numbers([PUSHER_MASS * 0.01] * 3)}"/>
-      <geom name="pusher" type="mesh" mesh="pusher" rgba=".1 .1 .1 1"/>
-    </body>
+    {pusher}
   </worldbody>
   <contact>
     {chr(10).join('    ' + p for p in pairs).strip()}
-  </contact>
+  </contact>{actuators}
   <keyframe>
     {chr(10).join('    ' + k for k in keys).strip()}
   </keyframe>
@@ -359,7 +380,8 @@ def _names(scene: Scene) -> list[tuple[str, str]]:
 
 
 def mjcf(scene: Scene, supports: Mapping[str, Feet], mu: float | None = None,
-         starts: Mapping[str, ArrayLike] | None = None, keys: ArrayLike | None = None) -> str:
+         starts: Mapping[str, ArrayLike] | None = None, keys: ArrayLike | None = None,
+         arm: SimArm | None = None) -> str:
     """The MuJoCo model (MJCF XML) of ``scene`` with each part on its ``supports`` feet (by part
     name), starting at ``starts`` (default: the scene's starts), and pusher-part friction ``mu``
     (default: the planned ``scene.pusher.mu``); module docstring, "The model". The bodies are
@@ -367,10 +389,14 @@ def mjcf(scene: Scene, supports: Mapping[str, Feet], mu: float | None = None,
 
     ``keys``, rows ``(t, each part's x, y, theta in scene order, pusher x, y, z, theta)``, become
     keyframes ``t=<t>`` (the first named ``start``) so that a viewer can step along a run; without
-    them the one keyframe ``start`` has the parts at ``starts`` and the pusher at the world origin."""
+    them the one keyframe ``start`` has the parts at ``starts`` and the pusher at the world origin.
+
+    With ``arm`` (:mod:`.arm_sim`) the pusher is on the arm's flange, the keys end with the arm's
+    joint angles instead of the pusher's pose, and ``start`` has the arm at its reference's first."""
     mu = scene.pusher.mu if mu is None else mu
     starts = scene.starts if starts is None else starts
     assets, world, blocks = _table(scene)
+    tail, rest = (4, np.zeros(4)) if arm is None else (arm.count, arm.q[0])
     bodies, pairs, geoms = [], [], []
     for (name, prefix), part in zip(_names(scene), scene.parts):
         more, body, own, feet_pairs = _part_body(name, prefix, part.slider, supports[part.name])
@@ -383,26 +409,29 @@ def mjcf(scene: Scene, supports: Mapping[str, Feet], mu: float | None = None,
         # Parts against parts, with the table's friction: a part shoved by another moves as it would.
         pairs += [f'<pair geom1="{g}" geom2="{h}" condim="3" friction="{TABLE_MU} {TABLE_MU} 0 0 0"/>'
                   for g in own for other in geoms[k + 1:] for h in other]
+    if arm is not None:
+        pairs += arm.pairs(["table", *blocks, *(g for own in geoms for g in own)])
     feet_counts = [len(supports[name].points) for name in scene.names]
     if keys is None:
-        frames = [f'<key name="start" qpos="{_qpos([starts[n] for n in scene.names], feet_counts, np.zeros(4))}"/>']
+        frames = [f'<key name="start" qpos="{_qpos([starts[n] for n in scene.names], feet_counts, rest)}"/>']
     else:
         frames = [f'<key name="{"start" if k == 0 else f"t={row[0]:.2f}"}" time="{row[0]:.17g}" '
-                  f'qpos="{_qpos(np.reshape(row[1:-4], (-1, 3)), feet_counts, row[-4:])}"/>'
+                  f'qpos="{_qpos(np.reshape(row[1:-tail], (-1, 3)), feet_counts, row[-tail:])}"/>'
                   for k, row in enumerate(np.asarray(keys))]
-    return _document(scene, assets, world, bodies, pairs, frames)
+    return _document(scene, assets, world, bodies, pairs, frames, arm)
 
 
 def _qpos(poses: list[ArrayLike], feet_counts: list[int], pusher: ArrayLike) -> str:
     """A keyframe's ``qpos``: the joints in model order are each part's three and one per foot (at
-    rest: 0), in scene order, then the pusher's four."""
+    rest: 0), in scene order, then the pusher's four (or the arm's)."""
     return _numbers([*(v for pose, k in zip(poses, feet_counts) for v in (*pose, *np.zeros(k))), *pusher])
 
 
 def write_mjcf(path: str | Path, scene: Scene, supports: Mapping[str, Feet], mu: float | None = None,
-               starts: Mapping[str, ArrayLike] | None = None, keys: ArrayLike | None = None) -> None:
+               starts: Mapping[str, ArrayLike] | None = None, keys: ArrayLike | None = None,
+               arm: SimArm | None = None) -> None:
     """Write :func:`mjcf` to ``path`` atomically (:func:`planner.model.files.write_atomic`)."""
-    write_atomic(path, mjcf(scene, supports, mu, starts, keys))
+    write_atomic(path, mjcf(scene, supports, mu, starts, keys, arm))
 
 
 def needs_mujoco() -> None:
@@ -483,6 +512,12 @@ class Run(ByPart):
     segment_deviation, segment_slip : tuple of float
         ``deviation`` and ``slip`` of each plan segment alone (:attr:`Plan.segments`, transfers
         included; slip 0 off a push), so that a failure can be traced to where it began.
+    tracking : float or None
+        With the arm (:mod:`.arm_sim`): the largest distance (m) of the pusher frame's origin from
+        where the trajectory has it, over the samples; None for the free pusher, which is set there.
+    arm : (n, k, 3) ndarray or None
+        With the arm: the points it is drawn through at each trajectory sample (its base, joint
+        frames, flange and pusher frame's origin; :meth:`World.sample`).
 
     ``feet`` and ``poses`` are the one part's, for a run of one part; ``goal_error`` and
     ``final_error`` the part's farthest off, for any run.
@@ -501,6 +536,8 @@ class Run(ByPart):
     tracks: dict[str, np.ndarray]
     segment_deviation: tuple[float, ...]
     segment_slip: tuple[float, ...]
+    tracking: float | None = None
+    arm: np.ndarray | None = None
 
     @property
     def final_error(self) -> tuple[float, float]:
@@ -514,6 +551,7 @@ class Run(ByPart):
         """The run's line, numbered ``k`` of ``n``; with several parts it names the parts its
         errors are of, the parts that miss their goals and the first few contacts that must not happen."""
         several = len(self.supports) > 1
+        arm = self.tracking is not None
 
         def of(name: str) -> str:
             return f" ({name})" if several else ""
@@ -524,14 +562,16 @@ class Run(ByPart):
         blown = [what for _, what in self.faults if what.startswith(DIVERGED)]
         faults = blown[:1] or ([] if self.in_goal else [f"misses the goal{': ' + missed if several else ''}"]) + (
             ["SLIPS"] if self.slip > SLIP else []) + (
-            [f"collides ({self.collisions} samples{': ' + touches if several else ''})"] if self.collisions else [])
+            [f"collides ({self.collisions} samples{': ' + touches if several or arm else ''})"] if self.collisions else [])
         kinds = ", ".join(sorted({f.kind for f in self.supports.values()}))
         goal, final = _worst(self.goal_errors), _worst(self.final_errors)
         return (f"simulate {k}/{n} ({kinds}, {'+'.join(str(len(f.points)) for f in self.supports.values())} feet): "
                 f"goal error {self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad{of(goal)}; from the plan's end "
                 f"{self.final_error[0]:.2e} m, {self.final_error[1]:.2e} rad{of(final)}; path deviation "
                 f"{self.deviation:.2e} m{_where(self.segment_deviation)}; slip {self.slip:.2e} m"
-                f"{_where(self.segment_slip)}; {self.seconds:.1f} s for {self.simulated:.1f} s: "
+                f"{_where(self.segment_slip)}; "
+                f"{f'pusher tracking {self.tracking * 1e3:.2f} mm (the arm); ' if arm else ''}"
+                f"{self.seconds:.1f} s for {self.simulated:.1f} s: "
                 f"{', '.join(faults) if faults else 'ok'}")
 
 
@@ -563,6 +603,7 @@ class Simulation(Runs):
     motion: Trajectory
     starts: dict[str, np.ndarray]  # where the parts are placed: the plan's starts, the first moved by any start error
     planned: dict[str, np.ndarray]  # each part's planned pose at each of motion's samples
+    arm: SimArm | None = None  # the arm that held the pusher (arm_sim), for a scene with a robot
 
     #: Seconds between the keyframes :meth:`write_mjcf` writes along the run.
     KEY_EVERY = 1.0
@@ -575,11 +616,12 @@ class Simulation(Runs):
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:
         """Write the first run's model (:func:`mjcf`) to ``path`` atomically, with keyframes of the
         planned parts and the pusher every :attr:`KEY_EVERY` s of the trajectory and at its end
-        (MuJoCo's viewer steps through them)."""
+        (MuJoCo's viewer steps through them); with the arm, its model and its joint angles."""
         m = self.motion
         rows = np.unique(np.append(np.searchsorted(m.t, np.arange(0.0, m.duration, self.KEY_EVERY)), len(m.t) - 1))
-        keys = np.column_stack([m.t, *(self.planned[n] for n in scene.names), m.x, m.y, m.z, np.unwrap(m.theta)])[rows]
-        write_mjcf(path, scene, self.runs[0].supports, self.mu, self.starts, keys)
+        pusher = [m.x, m.y, m.z, np.unwrap(m.theta)] if self.arm is None else list(self.arm.joints.q.T)
+        keys = np.column_stack([m.t, *(self.planned[n] for n in scene.names), *pusher])[rows]
+        write_mjcf(path, scene, self.runs[0].supports, self.mu, self.starts, keys, self.arm)
 
     def summary(self) -> str:
         parts = len(self.starts)
@@ -589,10 +631,13 @@ class Simulation(Runs):
                 f"(MuJoCo, pusher mu {self.mu:g}, table mu {TABLE_MU:g}); "
                 f"{f'at least {delivered}/{parts} parts delivered in every run; ' if parts > 1 else ''}"
                 f"worst goal error {max(r.goal_error[0] for r in self.runs):.2e} m, "
-                f"worst slip {max(r.slip for r in self.runs):.2e} m, {sum(r.seconds for r in self.runs):.1f} s")
+                f"worst slip {max(r.slip for r in self.runs):.2e} m, "
+                f"{'' if self.arm is None else f'pusher held by the {self.arm.robot.model} arm, worst tracking {max(r.tracking for r in self.runs) * 1e3:.2f} mm, '}"
+                f"{sum(r.seconds for r in self.runs):.1f} s")
 
 
-#: The pusher as a function of a run's clock: ``u -> ((x, y, z, theta), their rates)``.
+#: The pusher as a function of a run's clock: ``u -> ((x, y, z, theta), their rates)``; or, with
+#: the arm, its joints' reference: ``u -> (angles, rates)``.
 Driver = Callable[[float], tuple[ArrayLike, ArrayLike]]
 
 
@@ -608,7 +653,7 @@ class World:
     reset state or stepping on for ever."""
 
     def __init__(self, scene: Scene, supports: Mapping[str, Feet], mu: float | None,
-                 starts: Mapping[str, ArrayLike], bumps: tuple = ()):
+                 starts: Mapping[str, ArrayLike], bumps: tuple = (), arm: SimArm | None = None):
         import mujoco  # only when simulating: a plan run without --simulate never loads it
 
         # MuJoCo prints its warnings on the terminal, thousands a second from a run that keeps
@@ -619,8 +664,8 @@ class World:
         self.unstable = [int(w) for w in (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
                                           mujoco.mjtWarning.mjWARN_BADQACC)]
         self.mujoco = mujoco
-        self.scene = scene
-        self.model = mujoco.MjModel.from_xml_string(mjcf(scene, supports, mu, starts))
+        self.scene, self.arm = scene, arm
+        self.model = mujoco.MjModel.from_xml_string(mjcf(scene, supports, mu, starts, arm=arm))
         self.data = mujoco.MjData(self.model)
         mujoco.mj_resetDataKeyframe(self.model, self.data, self.model.key("start").id)
         names = list(zip(_names(scene), scene.parts))
@@ -632,29 +677,34 @@ class World:
         self.blocks = {self.model.geom(i).id for i in range(self.model.ngeom)
                        if self.model.geom(i).name.startswith(("wall", "obstacle"))}
         self.pusher_geom = self.model.geom("pusher").id
-        self.qpos = self.model.joint("pusher_x").qposadr[0] + np.arange(4)
-        self.qvel = self.model.joint("pusher_x").dofadr[0] + np.arange(4)
-        # The pusher's acceleration (zero off its dofs) and the force that gives it: step_to's.
-        self.accel, self.force = np.zeros(self.model.nv), np.zeros(self.model.nv)
+        self._hold()
         self.bumps = sorted(bumps)
         self.pusher = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
 
+    def _hold(self) -> None:
+        """Find what drives the pusher: its joints' positions and velocities, or the arm's site,
+        bodies and link geoms."""
+        model, arm = self.model, self.arm
+        if arm is not None:
+            self.site, self.flange = model.site("pusher").id, model.site("flange").id
+            self.link_ids = {model.geom(name).id: link for name, link in arm.links.items()}
+            self.table = model.geom("table").id
+            # The arm's bodies, last in the model and a chain: in order from its base to its flange.
+            self.bodies = list(range(model.body("base").id, model.nbody))
+            return
+        self.qpos = self.model.joint("pusher_x").qposadr[0] + np.arange(4)
+        self.qvel = self.model.joint("pusher_x").dofadr[0] + np.arange(4)
+        # The pusher's acceleration (zero off its dofs) and the force that gives it: _actuate's.
+        self.accel, self.force = np.zeros(self.model.nv), np.zeros(self.model.nv)
+
     def step_to(self, t: float, pusher: Driver) -> None:
-        """Step to ``t`` (MuJoCo's clock), the pusher set before every step to ``pusher(u)``:
-        ``(x, y, z, theta)`` and their rates, at rest before ``u = 0``; and pushed by the force
-        that gives it, by the step's end, the rates ``pusher`` has then (module docstring, "The
-        model")."""
+        """Step to ``t`` (MuJoCo's clock), the pusher driven before every step by ``pusher(u)``
+        (:meth:`_actuate`), at rest before ``u = 0``."""
         data = self.data
-        ahead = None
+        self._ahead = None
         while data.time < t - TIMESTEP / 2 and self.diverged is None:
             u = data.time - SETTLE
-            pose, rate = ahead if ahead is not None else self._drive(pusher, u)
-            ahead = self._drive(pusher, u + TIMESTEP)
-            data.qpos[self.qpos] = pose
-            data.qvel[self.qvel] = rate
-            self.accel[self.qvel] = (np.asarray(ahead[1]) - rate) / TIMESTEP
-            self.mujoco.mj_mulM(self.model, data, self.force, self.accel)
-            data.qfrc_applied[self.qvel] = self.force[self.qvel]
+            pose = self._actuate(pusher, u)
             while self.bumps and self.bumps[0][0] <= u:
                 # A knock: the part is where it was moved to, at rest, and not into the pusher,
                 # which is rigid: a knock towards it leaves the part against its face.
@@ -666,11 +716,61 @@ class World:
                 said = _LAST_WARNING.pop().split(". ")[0] if _LAST_WARNING else "a non-finite state"
                 self.diverged = f"{DIVERGED} at {max(u, 0.0):.2f} s (MuJoCo: {said})"
 
+    def _actuate(self, pusher: Driver, u: float) -> ArrayLike:
+        """Set the pusher to ``pusher(u)``: ``(x, y, z, theta)`` and their rates; and push it by
+        the force that gives it, by the step's end, the rates ``pusher`` has then (module
+        docstring, "The model"). Returns its pose. With the arm, ``pusher(u)`` is the joints'
+        reference angles and rates, given to its servos (:mod:`.arm_sim`)."""
+        data = self.data
+        if self.arm is not None:
+            q, qd = self._drive(pusher, u)
+            data.ctrl[:] = self.arm.controls(np.asarray(q), qd)
+            return self.pusher_now()
+        pose, rate = self._ahead if self._ahead is not None else self._drive(pusher, u)
+        self._ahead = self._drive(pusher, u + TIMESTEP)
+        data.qpos[self.qpos] = pose
+        data.qvel[self.qvel] = rate
+        self.accel[self.qvel] = (np.asarray(self._ahead[1]) - rate) / TIMESTEP
+        self.mujoco.mj_mulM(self.model, data, self.force, self.accel)
+        data.qfrc_applied[self.qvel] = self.force[self.qvel]
+        return pose
+
     @staticmethod
     def _drive(pusher: Driver, u: float) -> tuple[ArrayLike, np.ndarray]:
         """``pusher(u)``, at rest before ``u = 0``."""
         pose, rate = pusher(max(u, 0.0))
-        return pose, np.asarray(rate, dtype=float) if u >= 0 else np.zeros(4)
+        return pose, np.asarray(rate, dtype=float) if u >= 0 else np.zeros(np.shape(rate))
+
+    def pusher_pose(self, planned: ArrayLike) -> ArrayLike:
+        """The pusher's ``(x, y, theta)`` at a trajectory sample where the trajectory has it at
+        ``planned``: there, for the free pusher, which is set to the trajectory; where the arm
+        holds it."""
+        return planned if self.arm is None else self.pusher_now()[[0, 1, 3]]
+
+    def pusher_now(self) -> np.ndarray:
+        """The pusher's ``(x, y, z, theta)`` as the arm holds it: its frame's origin, its height
+        above ``push_height`` and its heading."""
+        data = self.data
+        x, y, z = data.site_xpos[self.site]
+        axes = data.site_xmat[self.site].reshape(3, 3)
+        heading = math.atan2(axes[1, 0], axes[0, 0]) + self.arm.mount
+        return np.array([x, y, z - self.arm.robot.push_height, math.remainder(heading, 2 * math.pi)])
+
+    def touches(self, name: str) -> bool:
+        """Whether the pusher touches part ``name`` now."""
+        contacts = self.data.contact
+        pairs = contacts.geom[(contacts.dist < 0) & (contacts.geom == self.pusher_geom).any(axis=1)]
+        return any(self.owner.get(g) == name for g in pairs.ravel())
+
+    def sample(self, planned: ArrayLike) -> tuple[float, np.ndarray]:
+        """With the arm: how far (m) the pusher frame's origin is from ``planned`` ``(x, y, z)``
+        (the trajectory's sample), and the points the arm is drawn through: its bodies' origins
+        from the base on, the flange and the pusher frame's origin."""
+        data = self.data
+        x, y, z = planned
+        at = data.site_xpos[self.site]
+        points = np.vstack([data.xpos[self.bodies], data.site_xpos[self.flange], at])
+        return float(np.linalg.norm(at - [x, y, self.arm.robot.push_height + z])), points
 
     def _off_pusher(self, name: str, part: np.ndarray, pusher: ArrayLike) -> np.ndarray:
         """Part ``name`` at ``part`` moved along the pusher's +x, by :data:`BUMP_STEP` steps, until
@@ -690,7 +790,8 @@ class World:
 
     def faults(self, allowed: Collection[str]) -> list[str]:
         """The contacts on now that must not happen, in words: a part against another part, a wall
-        or an obstacle, or the pusher against a part not named in ``allowed``."""
+        or an obstacle, the pusher against a part not named in ``allowed``, or an arm's link
+        against anything."""
         out = [self.diverged] if self.diverged else []
         contacts = self.data.contact
         # The feet always press into the table: only a touching pair with a part's geom is looked at.
@@ -703,6 +804,17 @@ class World:
                 out.append(f"{touched[0]} touches a wall or obstacle")
             elif touched and self.pusher_geom in pair and touched[0] not in allowed:
                 out.append(f"the pusher touches {touched[0]}")
+        return out if self.arm is None else out + self._link_faults(pairs)
+
+    def _link_faults(self, pairs: np.ndarray) -> list[str]:
+        """The arm's links touching anything among the touching geom ``pairs``: ``the arm's link4
+        touches the table`` (or ``a wall or obstacle``, or a part by name)."""
+        out = []
+        for a, b in pairs[np.isin(pairs, list(self.link_ids)).any(axis=1)].tolist():
+            link, other = (a, b) if a in self.link_ids else (b, a)
+            what = ("the table" if other == self.table else self.owner[other] if other in self.owner
+                    else "a wall or obstacle")
+            out.append(f"the arm's {self.link_ids[link]} touches {what}")
         return out
 
 
@@ -711,16 +823,22 @@ def _follower(motion: Trajectory) -> Driver:
     held at the ends)."""
     table = np.column_stack([motion.x, motion.y, motion.z, np.unwrap(motion.theta), motion.vx, motion.vy,
                              np.gradient(motion.z, motion.t) if len(motion.t) > 1 else np.zeros(1), motion.omega])
-    times = motion.t.tolist()
+    return _table_driver(motion.t, table, 4)
+
+
+def _table_driver(t: ArrayLike, table: np.ndarray, split: int) -> Driver:
+    """``u -> (row[:split], row[split:])`` of ``table``'s rows at times ``t``, linear between
+    them, held at the ends."""
+    times = np.asarray(t, dtype=float).tolist()
 
     def at(u: float) -> tuple[np.ndarray, np.ndarray]:
-        # Called twice a step (World.step_to): one bisection for the eight columns, not eight searches.
+        # Called once or twice a step (World.step_to): one bisection for every column, not one each.
         k = bisect.bisect_right(times, u)
         if k == 0 or k == len(times):
             row = table[min(k, len(times) - 1)]
         else:
             row = table[k - 1] + (u - times[k - 1]) / (times[k] - times[k - 1]) * (table[k] - table[k - 1])
-        return row[:4], row[4:]
+        return row[:split], row[split:]
 
     return at
 
@@ -737,14 +855,19 @@ class Perturbed(NamedTuple):
     planned: dict[str, np.ndarray]
 
 
-def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], mu: float | None) -> Run:
+def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], mu: float | None,
+         arm: SimArm | None = None) -> Run:
     clock = time.perf_counter()
-    world = World(scene, supports, mu, setup.starts, setup.bumps)
     lead, motion = setup.lead, setup.motion
-    led, follow = _follower(lead), _follower(motion)
+    if arm is None:
+        world = World(scene, supports, mu, setup.starts, setup.bumps)
+        led, follow = _follower(lead), _follower(motion)
 
-    def pusher(u: float) -> tuple[list[float], list[float]]:
-        return led(u) if u < lead.duration else follow(u - lead.duration)
+        def pusher(u: float) -> tuple[list[float], list[float]]:
+            return led(u) if u < lead.duration else follow(u - lead.duration)
+    else:  # the arm's joints follow their reference (World._actuate)
+        world = World(scene, supports, mu, setup.starts, setup.bumps, arm)
+        pusher = _table_driver(arm.t, np.hstack([arm.q, arm.qd]), arm.count)
 
     steps = plan.steps
     # The pusher may touch the part of its segment, and on a transfer the part it leaves: a transit
@@ -754,6 +877,7 @@ def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], 
     tracks = {name: np.empty((len(times), 3)) for name in scene.names}
     collisions, faults, seen = 0, [], set()
     slips, firsts = np.zeros(len(steps)), {}
+    tracking, drawn = np.zeros(len(times)), []
     world.step_to(SETTLE + lead.duration, pusher)
     for row, t in enumerate(times):
         world.step_to(t, pusher)
@@ -766,9 +890,15 @@ def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], 
             if fault not in seen:
                 seen.add(fault)
                 faults.append((float(motion.t[row]), fault))
-        if motion.contact[row]:
+        if arm is not None:
+            tracking[row], points = world.sample([motion.x[row], motion.y[row], motion.z[row]])
+            drawn.append(points)
+        # With the arm, from the first sample the pusher touches the part: a servo lags, and the gap
+        # it closes as the push begins is not slip.
+        if motion.contact[row] and (arm is None or world.touches(steps[k][0])):
             # The face midpoint in the pushed part's frame, against where it was when this push began.
-            face = relative_pose(tracks[steps[k][0]][row], [motion.x[row], motion.y[row], motion.theta[row]])[:2]
+            face = relative_pose(tracks[steps[k][0]][row],
+                                 world.pusher_pose([motion.x[row], motion.y[row], motion.theta[row]]))[:2]
             first = firsts.setdefault(k, face)
             slips[k] = max(slips[k], float(np.linalg.norm(face - first)))
     gap = np.max([_cf_gap(scene.part(name).slider.cf, track, setup.planned[name]) for name, track in tracks.items()],
@@ -779,7 +909,8 @@ def _run(scene: Scene, plan: Plan, setup: Perturbed, supports: dict[str, Feet], 
                {name: pose_error(end, plan.finals[name]) for name, end in ends.items()},
                {name: scene.delivered(name, end) for name, end in ends.items()}, float(gap.max()),
                float(slips.max(initial=0.0)), collisions, tuple(faults), time.perf_counter() - clock,
-               float(motion.duration + lead.duration), tracks, deviations, tuple(float(v) for v in slips))
+               float(motion.duration + lead.duration), tracks, deviations, tuple(float(v) for v in slips),
+               None if arm is None else float(tracking.max()), None if arm is None else np.array(drawn))
 
 
 def _cf_gap(cf: np.ndarray, poses: np.ndarray, planned: np.ndarray) -> np.ndarray:
@@ -866,7 +997,7 @@ def perturbations(scene: Scene, plan: Plan, model: CollisionModel | None = None,
 
 def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
              cf_offset: ArrayLike = (0.0, 0.0), start_error: ArrayLike = (0.0, 0.0, 0.0),
-             bumps: ArrayLike = ()) -> Simulation:
+             bumps: ArrayLike = (), joints: JointTrajectory | None = None) -> Simulation:
     """Run ``plan``, of one part or several, open-loop in MuJoCo once per foot set: run ``k`` puts
     every part on the ``k``-th of its own :func:`feet` (module docstring).
 
@@ -884,6 +1015,10 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
         Moves every support's centre of pressure from its part's CF, slider frame (m).
     start_error, bumps : array_like
         The first moved part's start off the plan's, and knocks during the run (:func:`perturbations`).
+    joints : JointTrajectory, optional
+        For a scene with a robot, whose arm holds the pusher (:mod:`.arm_sim`): the joint
+        trajectory its servos follow along the plan's trajectory; default
+        :func:`planner.arm.joints.joints_along` it.
 
     Every run begins with the pusher behind the first contact, moving in (:func:`.approach.lead_in_pose`).
 
@@ -900,5 +1035,10 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
     needs_mujoco()
     sets = foot_sets(scene, n, seed, cf_offset)
     setup = perturbations(scene, plan, None, start_error, bumps)
-    runs = tuple(_run(scene, plan, setup, supports, mu) for supports in sets)
-    return Simulation(runs, scene.pusher.mu if mu is None else mu, setup.motion, setup.starts, setup.planned)
+    arm = None
+    if scene.robot is not None:
+        from .arm_sim import sim_arm  # loads mink: only for an arm
+
+        arm = sim_arm(scene.robot, setup.lead, setup.motion, joints)
+    runs = tuple(_run(scene, plan, setup, supports, mu, arm) for supports in sets)
+    return Simulation(runs, scene.pusher.mu if mu is None else mu, setup.motion, setup.starts, setup.planned, arm)

@@ -39,6 +39,8 @@ class Arm:
     ``radius`` is the links' capsule radius (m); ``masses`` the links' masses (kg), each held at
     its joint's frame in the model (its inertia a solid ball of the capsule's radius): the position
     actuators of the simulation need loads of the right size, not the exact distribution.
+    ``kp`` and ``kv`` are the simulation's joint servo gains (N m/rad, N m s/rad) and ``torque``
+    the joints' torque limits (N m), per joint (``docs/arm.md``, "The arm in the simulation").
     """
 
     name: str
@@ -51,6 +53,9 @@ class Arm:
     ready: tuple[float, ...]
     radius: float
     masses: tuple[float, ...]
+    kp: tuple[float, ...]
+    kv: tuple[float, ...]
+    torque: tuple[float, ...]
 
     @property
     def joints(self) -> int:
@@ -86,7 +91,10 @@ ARMS = {
         (2.175, 2.175, 2.175, 2.175, 2.61, 2.61, 2.61),
         (0.0, -_PI / 4, 0.0, -3 * _PI / 4, 0.0, _PI / 2, _PI / 4),
         0.06,
-        (4.971, 0.647, 3.229, 3.588, 1.226, 1.667, 0.736)),
+        (4.971, 0.647, 3.229, 3.588, 1.226, 1.667, 0.736),
+        (4500.0, 4500.0, 3500.0, 3500.0, 2000.0, 2000.0, 2000.0),
+        (450.0, 450.0, 350.0, 350.0, 200.0, 200.0, 200.0),
+        (87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0)),
     "ur5e": Arm(
         "ur5e", "standard",
         ((0.0, 0.1625, _PI / 2), (-0.425, 0.0, 0.0), (-0.3922, 0.0, 0.0), (0.0, 0.1333, _PI / 2),
@@ -97,5 +105,8 @@ ARMS = {
         (_PI,) * 6,
         (0.0, -_PI / 2, _PI / 2, -_PI / 2, -_PI / 2, 0.0),
         0.05,
-        (3.761, 8.058, 2.846, 1.37, 1.3, 0.365)),
+        (3.761, 8.058, 2.846, 1.37, 1.3, 0.365),
+        (2000.0, 2000.0, 2000.0, 500.0, 500.0, 500.0),
+        (400.0, 400.0, 400.0, 100.0, 100.0, 100.0),
+        (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)),
 }

@@ -87,7 +87,10 @@ With a :class:`~planner.execution.mujoco_sim.Simulation` (``plan --simulate N``)
   every frame: the trajectory sample at the frame's plan time
   (:attr:`~planner.execution.trajectory.Trajectory.plan_time`), so the two outlines part where
   the run leaves the plan and one hides the other while it follows;
-* ``/log/simulate`` -- ``TextLog``, the simulation's summary row (``WARN`` when it failed).
+* ``/log/simulate`` -- ``TextLog``, the simulation's summary row (``WARN`` when it failed);
+* ``/world/arm`` -- for a scene with a robot (any number of parts), the arm of that run as
+  MuJoCo moved it, at every frame: a line through its bodies' origins from the base on, the
+  flange and the pusher frame's origin, in 3-D over the table.
 
 With a :class:`~planner.execution.closed_loop.ClosedLoop` (``plan --simulate N --closed-loop``),
 also, per run ``k`` (from 1, as the output lines number them), on the ``time`` timeline but on
@@ -365,6 +368,17 @@ def _log_simulated(rec: rr.RecordingStream, scene: Scene, simulation: Simulation
     _log_text(rec, "log/simulate", [simulation.summary()], "INFO" if simulation.passed else "WARN")
 
 
+def _log_arm(rec: rr.RecordingStream, simulation: Simulation, times: np.ndarray) -> None:
+    """``/world/arm`` at every frame (module docstring)."""
+    clock = simulation.motion.plan_time
+    samples = np.clip(np.searchsorted(clock, times + 1e-12, side="right") - 1, 0, len(clock) - 1)
+    rec.send_columns("world/arm", indexes=[rr.TimeColumn("step", sequence=np.arange(len(times))),
+                                           rr.TimeColumn("time", duration=times)],
+                     columns=rr.LineStrips3D.columns(strips=simulation.worst.arm[samples]))
+    rec.log("world/arm", rr.LineStrips3D.from_fields(colors=_SIMULATED, radii=_BOLD,
+                                                     labels=[f"{simulation.arm.robot.model} (MuJoCo)"]), static=True)
+
+
 def _log_closed_loop(rec: rr.RecordingStream, scene: Scene, loop: ClosedLoop) -> None:
     """Each closed-loop run's part, pusher, executed path and re-plans, and ``/log/closed_loop``
     (module docstring)."""
@@ -531,6 +545,8 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
                 _log_ghost(rec, plan, verification, shown)
             if simulation is not None and one:
                 _log_simulated(rec, scene, simulation, shown.times)
+            if simulation is not None and simulation.arm is not None:
+                _log_arm(rec, simulation, shown.times)
             if closed_loop is not None and one:
                 _log_closed_loop(rec, scene, closed_loop)
         if reach is not None:

@@ -117,11 +117,21 @@ class RunOptions:
             from ..execution.mujoco_sim import needs_mujoco  # MuJoCo is only looked for here
 
             needs_mujoco()
-        if self.trajectory and scene is not None and scene.robot is not None and not have("mink"):
-            raise SceneError("trajectory", f"the arm's joints {needs('mink')}")  # found before the work
+        if scene is not None and scene.robot is not None:
+            self._fit_arm()
         if scene is not None:
             self._fit(scene)
         return replace(self, pose_noise=None if noise is None else tuple(abs(v) for v in noise))
+
+    def _fit_arm(self) -> None:
+        """Refuse, before the work, what needs the arm's joints (written, or followed by the arm
+        in the simulation) without mink; and a closed loop, which drives a free pusher, not the arm."""
+        if self.simulate is not None and self.closed_loop:
+            raise SceneError("closed_loop", "not with a robot yet: the closed loop moves a free pusher, not the arm "
+                                            "(docs/arm.md)")
+        for name, asked in (("trajectory", self.trajectory), ("simulate", self.simulate is not None)):
+            if asked and not have("mink"):
+                raise SceneError(name, f"the arm's joints {needs('mink')}")
 
     def _fit(self, scene: Scene) -> None:
         """Refuse what ``scene`` does not take: a part it does not have, or one not named where

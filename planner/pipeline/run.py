@@ -105,16 +105,18 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
 
         check = verify(scene, result, options.verify, seed, transit=planner_options.transit,
                        regions=planner_options.regions)
-    if options.trajectory and result.solved:
+    # The arm's joints are checked wherever they are used: written, or followed in the simulation.
+    if result.solved and (options.trajectory or (options.simulate and scene.robot is not None)):
         from ..execution.trajectory import trajectory  # loads ruckig, only for a trajectory
 
-        motion = trajectory(scene, result)
+        moved = trajectory(scene, result)
+        motion = moved if options.trajectory else None
         if scene.robot is not None:
             from ..arm.joints import joints_along  # loads mink and MuJoCo, only for an arm
 
-            arm = joints_along(scene.robot, motion)
+            arm = joints_along(scene.robot, moved)
     if options.simulate and result.solved:
-        simulation = _simulated(scene, options, planner_options, result, session)
+        simulation = _simulated(scene, options, planner_options, result, session, arm)
     if options.reach:  # the map is about the start, whatever the plan
         mapped = scene if options.part is None else scene.move_scene(options.part, scene.starts)
         if reach_map is None:
@@ -126,16 +128,17 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
 
 
 def _simulated(scene: Scene, options: RunOptions, planner_options: PlannerOptions, result: Plan,
-               session: Planner | None):
-    """The MuJoCo runs of ``result`` (MuJoCo is loaded only now): open loop, or closed loop on
-    ``session`` (made now, with ``planner_options``, for a plan read from a file), whose re-plans
-    join ``result``."""
+               session: Planner | None, joints=None):
+    """The MuJoCo runs of ``result`` (MuJoCo is loaded only now): open loop, the scene's arm (if
+    any) following ``joints``, or closed loop on ``session`` (made now, with ``planner_options``,
+    for a plan read from a file), whose re-plans join ``result``."""
     seed, cf_offset = planner_options.seed, options.sim_cf_offset or (0.0, 0.0)
     start_error = options.start_error or (0.0, 0.0, 0.0)
     if not options.closed_loop:
         from ..execution.mujoco_sim import simulate
 
-        return simulate(scene, result, options.simulate, seed, options.sim_mu, cf_offset, start_error, options.bumps)
+        return simulate(scene, result, options.simulate, seed, options.sim_mu, cf_offset, start_error, options.bumps,
+                        joints)
     from ..execution.closed_loop import closed_loop
 
     if session is None:

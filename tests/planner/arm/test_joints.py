@@ -14,8 +14,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +21,8 @@ import pytest
 import yaml
 
 pytest.importorskip("mink", reason="the arm extra is not installed: pip install 'stablepush[arm]'")
+
+from robot_scenes import plan, with_robot  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -107,19 +107,6 @@ def check_joints(scene_file: Path, out: Path) -> dict:
                  speed=float((speeds / np.array(arm["speed"])).max()))
     assert worst <= 1e-3 and tilt <= 1.0 and found["spread"] <= 0.5 and lowest > 0.0, found
     return found
-
-
-def with_robot(tmp_path: Path, scene: str, robot: dict) -> Path:
-    spec = yaml.safe_load((ROOT / "scenes" / scene).read_text())
-    spec["robot"] = robot
-    path = tmp_path / Path(scene).name
-    path.write_text(yaml.safe_dump(spec))
-    return path
-
-
-def plan(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "planner.cli", *args], capture_output=True, text=True, cwd=cwd,
-                          timeout=300, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
 
 
 CASES = {
