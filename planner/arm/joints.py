@@ -120,7 +120,10 @@ def joint_trajectory(robot: Robot, t: ArrayLike, poses: ArrayLike, heights: Arra
         elif k == 0:
             posture, _ = reach.solve(poses[k], start, height=float(heights[k]))
         else:
-            posture, _ = reach.solve(poses[k], posture, steps=FOLLOW_STEPS, height=float(heights[k]))
+            # Within the samples' interval, as the arm would move (the speed check then has the rest).
+            gap = float(t[k] - t[k - 1])
+            posture, _ = reach.solve(poses[k], posture, steps=FOLLOW_STEPS, height=float(heights[k]),
+                                     within=gap if gap > 0 else None)
         q[k] = posture
         miss[k] = reach.pose_error(poses[k], posture, float(heights[k]))
     dt = np.diff(t)

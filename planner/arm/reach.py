@@ -34,7 +34,7 @@ from ..world.reach import family_posture
 from ..model.arms import ARMS, Arm
 from .arms import mjcf
 
-__all__ = ["ArmReach", "FOLLOW_STEPS", "REACHED", "arm_model"]
+__all__ = ["ArmReach", "FOLLOW_STEPS", "REACHED", "SPEED_SHARE", "arm_model"]
 
 #: Largest pose error (m, and rad times the part of a metre it counts as) of a pose reached.
 REACHED = 1e-4
@@ -44,6 +44,8 @@ _STEPS = 200  # most steps towards one pose from a far posture (a path's first)
 #: of a slow pusher), and one it cannot reach in these would need a jump, missed either way.
 FOLLOW_STEPS = 20
 _SETTLED = 1e-6  # rad a step: a settling posture that moves less has stopped
+#: The share of each joint's speed limit a path is followed within (the rest is the check's margin).
+SPEED_SHARE = 0.95
 _WRISTS = 7  # places of the last joint a path's first pose is tried from
 _DOWN = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]])  # x kept, z down
 
@@ -70,6 +72,7 @@ class ArmReach:
         self.ready = np.array(self.arm.ready, dtype=float)
         self.posture.set_target(self.ready)
         self.limits = [mink.ConfigurationLimit(self.model)]
+        self.speeds = mink.VelocityLimit(self.model, {f"joint{k}": SPEED_SHARE * v for k, v in enumerate(self.arm.speed, 1)})
         self.mount = self._mount()
         # The joint frames that can come near the table: every link's but the first, on the base.
         self._links = [self.model.body(f"link{k}").id for k in range(2, self.arm.joints + 1)]
@@ -140,26 +143,34 @@ class ArmReach:
         return float(self.configuration.data.xpos[self._links, 2].min())
 
     def solve(self, pose: ArrayLike, q: ArrayLike, steps: int = _STEPS, height: float = 0.0,
-              settle: bool = False) -> tuple[np.ndarray, float]:
+              settle: bool = False, within: float | None = None) -> tuple[np.ndarray, float]:
         """Joint angles holding the pusher at ``pose`` (``height`` above where it pushes), reached
         from ``q``, and how far from it they leave the pusher frame (the norm of its twist error:
         m, and rad); within :data:`REACHED` it is reached. With ``settle``, the steps go on once
         it is reached until the joints stop moving: the arm's redundant joints come to where the
         posture task holds them, so that the next pose's steps move them no more than the pose
-        asks (else the first step after a path's first pose swings them there at once)."""
+        asks (else the first step after a path's first pose swings them there at once). With
+        ``within`` (s), each step moves the joints over that time no faster than :data:`SPEED_SHARE`
+        of their speed limits (mink's velocity limit) and as little as the pose asks: a path's next
+        pose, reached as the arm would reach it."""
         self.configuration.update(np.asarray(q, dtype=float))
         origin, rotation = self.target(pose, height)
         self.task.set_target(mink.SE3.from_rotation_and_translation(mink.SO3.from_matrix(rotation), origin))
+        # Along a path: one step over the whole interval reaches a near pose exactly (to second
+        # order), within the arm's speeds; and no posture task, so the redundant joints move as
+        # little as the pose asks (the least joint motion, the solver's damping) and never swing
+        # to where the posture task's optimum jumps (joint 5 once went at 44 times its limit).
+        dt, limits, tasks = ((_DT, self.limits, [self.task, self.posture]) if within is None
+                             else (within, self.limits + [self.speeds], [self.task]))
         miss = math.inf
         for _ in range(steps):
             miss = float(np.linalg.norm(self.task.compute_error(self.configuration)))
             if miss < REACHED and not settle:
                 break
-            velocity = mink.solve_ik(self.configuration, [self.task, self.posture], _DT, "daqp", damping=1e-6,
-                                     limits=self.limits)
-            if miss < REACHED and float(np.abs(velocity).max()) * _DT < _SETTLED:
+            velocity = mink.solve_ik(self.configuration, tasks, dt, "daqp", damping=1e-6, limits=limits)
+            if miss < REACHED and float(np.abs(velocity).max()) * dt < _SETTLED:
                 break
-            self.configuration.integrate_inplace(velocity, _DT)
+            self.configuration.integrate_inplace(velocity, dt)
         return self.configuration.q.copy(), float(np.linalg.norm(self.task.compute_error(self.configuration)))
 
 

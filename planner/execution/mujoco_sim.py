@@ -9,7 +9,8 @@ every part of the scene in it, one run loop, one report; a scene of one part is 
 part-part contacts.
 
 **The model** (:func:`mjcf`). A table (plane), the workspace walls and the obstacles as prisms
-(non-convex ones as their :func:`~planner.model.bodies.convex_pieces`), each part as one body made
+(non-convex ones as their :func:`~planner.model.bodies.convex_pieces`; an obstacle as tall as its
+``height:``, the walls :data:`WALL_HEIGHT`), each part as one body made
 of the convex pieces of its polygon (thin prisms), and the pusher as a prism of the pusher body's
 outline. A part does not lie on its face: it stands on a few small spherical *feet*, each a
 body of its own that slides vertically in the part and weighs its share ``w_i`` of the support
@@ -265,10 +266,10 @@ def _table(scene: Scene) -> tuple[list[str], list[str], list[str]]:
     for name, (c, h) in zip(blocks, walls):
         world.append(f'<geom name="{name}" type="box" pos="{_numbers([*c, WALL_HEIGHT / 2])}" '
                      f'size="{_numbers([*h, WALL_HEIGHT / 2])}" rgba=".5 .5 .5 1"/>')
-    for i, obstacle in enumerate(scene.obstacles):
+    for i, (obstacle, height) in enumerate(zip(scene.obstacles, scene.obstacle_heights)):
         for j, piece in enumerate(convex_pieces(obstacle)):
             name = f"obstacle{i}_{j}"
-            assets.append(_prism(name, piece, 0.0, WALL_HEIGHT))
+            assets.append(_prism(name, piece, 0.0, height))  # as tall as the scene has it: an arm may meet its top
             world.append(f'<geom name="{name}" type="mesh" mesh="{name}" rgba=".6 .3 .3 1"/>')
             blocks.append(name)
     return assets, world, blocks

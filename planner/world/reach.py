@@ -24,7 +24,7 @@ frame's table pose alone, so the planner checks them as it checks obstacles, by 
   lifts instead. The bound is the wrist's reach as the arm's inverse kinematics
   (:mod:`planner.arm.reach`) measures it, less :data:`WRIST_MARGIN`: its other joints take up
   some of the turn, more the nearer the pusher is to the base (:data:`WRIST`: 175 degrees up to
-  0.50 m from a Panda's base, 170.5 at 0.70 m, 163.5 at its outer rim). The UR5e's last joint turns two
+  0.50 m from a Panda's base, 174.5 at 0.70 m, 166.5 at its outer rim). The UR5e's last joint turns two
   whole turns: its bound is the cap, 180 degrees less the margin, which keeps its wrist within
   half a turn of where a path starts it.
 
@@ -38,12 +38,12 @@ bent until its two offset links line up (0.3266 m and 0.3928 m, 0.7194 m from th
 wrist's centre), the wrist's centre 0.096 m below the shoulder (0.333 - 0.01 - 0.12 - 0.107) and
 the flange 0.088 m beyond it: sqrt(0.7194^2 - 0.096^2) + 0.088 = 0.801 m, less the margin. Its
 wrist turns the pusher to 180 degrees from pushing straight away (its other joints help its last,
-which turns +-166 degrees) up to half a metre out, and 168.5 degrees at 0.78 m; less the margin:
+which turns +-166 degrees) up to half a metre out, and 171.5 degrees at 0.78 m; less the margin:
 
 >>> from planner.model.robot import Robot
 >>> zone = reach_zone(Robot("panda", np.array([0.0, 0.0, 0.0]), 0.12))
 >>> round(zone.outer + RING_MARGIN, 3), round(math.degrees(zone.bound(0.5)), 1), round(math.degrees(zone.bound(0.78)), 1)
-(0.801, 175.0, 163.5)
+(0.801, 175.0, 166.5)
 >>> zone.holds((0.5, 0.0, 0.0)), zone.holds((0.5, 0.0, math.pi)), zone.holds((0.1, 0.0, 0.0))
 (True, False, False)
 """
@@ -68,9 +68,9 @@ WRIST_MARGIN = math.radians(5.0)
 #: Per arm, how far ``|psi|`` turns from zero before
 #: the wrist comes within 0.05 rad of its stop, following the inverse kinematics from pushing
 #: straight away at ``(distance from the base (m), degrees)``, the lesser of the two ways (the
-#: Panda with a 0.12 m tool: 188.2 at 0.50 m, 175.5 at 0.70 m, 172.2 at 0.74 m, 168.5 at 0.78 m;
+#: Panda with a 0.12 m tool: 189.0 at 0.50 m, 179.5 at 0.70 m, 176.2 at 0.74 m, 171.5 at 0.78 m;
 #: docs/arm.md). Between these points it is interpolated, held at the ends, and never above 180.
-WRIST = {"panda": ((0.50, 188.2), (0.70, 175.5), (0.74, 172.2), (0.78, 168.5)),
+WRIST = {"panda": ((0.50, 189.0), (0.70, 179.5), (0.74, 176.2), (0.78, 171.5)),
          # The UR5e's last joint turns two whole turns: the cap. A random scene's plan that took
          # the pusher round the base near its inner rim turned it 270 degrees on one edge.
          "ur5e": ((0.0, 360.0),)}
