@@ -58,6 +58,13 @@ class JointTrajectory:
     speed: np.ndarray
     lowest: float
     part: np.ndarray | None = None
+    slowed: float = 1.0  # how many times slower than the pusher's own time law the trajectory was timed
+
+    @property
+    def too_fast(self) -> bool:
+        """Whether the arm holds every sample and stays above the table but some joint would
+        move faster than its limit: a trajectory timed slower is followed."""
+        return bool(self.miss.max(initial=0.0) <= HELD and self.lowest > 0.0 and self.speed.max(initial=0.0) > 1.0)
 
     @property
     def follows(self) -> bool:
@@ -83,7 +90,8 @@ class JointTrajectory:
 
     def summary(self) -> str:
         verdict = "follows" if self.follows else "CANNOT FOLLOW"
-        return (f"arm: {verdict}: {len(self.t)} samples, {self.robot.model} ({self.q.shape[1]} joints); worst "
+        slowed = f", the trajectory timed {self.slowed:.2f} times slower for its joints" if self.slowed > 1.0 else ""
+        return (f"arm: {verdict}: {len(self.t)} samples, {self.robot.model} ({self.q.shape[1]} joints){slowed}; worst "
                 f"{self.miss.max(initial=0.0) * 1e3:.3f} mm off, joints at most {self.speed.max(initial=0.0):.0%} "
                 f"of their speed limits, lowest joint frame {self.lowest:.3f} m above the table")
 

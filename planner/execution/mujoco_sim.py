@@ -938,7 +938,7 @@ def _lead_in(scene: Scene, plan: Plan, model: CollisionModel) -> Trajectory:
 
 def perturbations(scene: Scene, plan: Plan, model: CollisionModel | None = None,
                   start_error: ArrayLike = (0.0, 0.0, 0.0), bumps: ArrayLike = (),
-                  noise: ArrayLike = (0.0, 0.0)) -> Perturbed:
+                  noise: ArrayLike = (0.0, 0.0), motion: Trajectory | None = None) -> Perturbed:
     """Check a run's perturbations against ``plan`` and set the run up (:class:`Perturbed`).
 
     ``start_error`` ``(dx, dy, dtheta)`` (m, m, rad, world frame) moves the first part the plan
@@ -947,6 +947,8 @@ def perturbations(scene: Scene, plan: Plan, model: CollisionModel | None = None,
     transfer, the part it goes to) by that much; ``noise`` ``(sigma_m, sigma_rad)`` is on what a
     closed loop observes. ``model`` is the collision model of the first move's scene (the
     scene's own for a scene of one part; default: built here), which the lead-in avoids.
+    ``motion`` is the plan's trajectory (default: :func:`.trajectory.trajectory`'s; an arm's is
+    timed for its joints, :mod:`.arm_timing`).
 
     Raises
     ------
@@ -973,7 +975,7 @@ def perturbations(scene: Scene, plan: Plan, model: CollisionModel | None = None,
     if fault:
         raise SceneError("start_error", f"puts the part where it cannot be: {fault}")
     starts = {**{name: np.asarray(pose, dtype=float) for name, pose in plan.starts.items()}, lone.part: start}
-    motion = trajectory(scene, plan)
+    motion = trajectory(scene, plan) if motion is None else motion
     planned = {name: planned_part(scene, plan, motion, name) for name in scene.names}
     rows = np.asarray(bumps, dtype=float).reshape(-1, 4) if len(bumps) else np.zeros((0, 4))
     out = []
@@ -998,7 +1000,7 @@ def perturbations(scene: Scene, plan: Plan, model: CollisionModel | None = None,
 
 def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
              cf_offset: ArrayLike = (0.0, 0.0), start_error: ArrayLike = (0.0, 0.0, 0.0),
-             bumps: ArrayLike = (), joints: JointTrajectory | None = None) -> Simulation:
+             bumps: ArrayLike = (), arm: tuple[Trajectory, JointTrajectory] | None = None) -> Simulation:
     """Run ``plan``, of one part or several, open-loop in MuJoCo once per foot set: run ``k`` puts
     every part on the ``k``-th of its own :func:`feet` (module docstring).
 
@@ -1016,10 +1018,10 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
         Moves every support's centre of pressure from its part's CF, slider frame (m).
     start_error, bumps : array_like
         The first moved part's start off the plan's, and knocks during the run (:func:`perturbations`).
-    joints : JointTrajectory, optional
-        For a scene with a robot, whose arm holds the pusher (:mod:`.arm_sim`): the joint
-        trajectory its servos follow along the plan's trajectory; default
-        :func:`planner.arm.joints.joints_along` it.
+    arm : (Trajectory, JointTrajectory), optional
+        For a scene with a robot, whose arm holds the pusher (:mod:`.arm_sim`): the plan's
+        trajectory and the joint trajectory its servos follow along it; default
+        :func:`.arm_timing.arm_trajectory`'s (timed for the arm's joints).
 
     Every run begins with the pusher behind the first contact, moving in (:func:`.approach.lead_in_pose`).
 
@@ -1035,11 +1037,15 @@ def simulate(scene: Scene, plan: Plan, n: int = 3, seed: int = 1, mu: float | No
     """
     needs_mujoco()
     sets = foot_sets(scene, n, seed, cf_offset)
-    setup = perturbations(scene, plan, None, start_error, bumps)
-    arm = None
+    held = None
     if scene.robot is not None:
         from .arm_sim import sim_arm  # loads mink: only for an arm
+        from .arm_timing import arm_trajectory
 
-        arm = sim_arm(scene.robot, setup.lead, setup.motion, joints)
-    runs = tuple(_run(scene, plan, setup, supports, mu, arm) for supports in sets)
-    return Simulation(runs, scene.pusher.mu if mu is None else mu, setup.motion, setup.starts, setup.planned, arm)
+        motion, joints = arm_trajectory(scene, plan) if arm is None else arm
+        setup = perturbations(scene, plan, None, start_error, bumps, motion=motion)
+        held = sim_arm(scene.robot, setup.lead, setup.motion, joints)
+    else:
+        setup = perturbations(scene, plan, None, start_error, bumps)
+    runs = tuple(_run(scene, plan, setup, supports, mu, held) for supports in sets)
+    return Simulation(runs, scene.pusher.mu if mu is None else mu, setup.motion, setup.starts, setup.planned, held)

@@ -107,16 +107,17 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
                        regions=planner_options.regions)
     # The arm's joints are checked wherever they are used: written, or followed in the simulation.
     if result.solved and (options.trajectory or (options.simulate and scene.robot is not None)):
-        from ..execution.trajectory import trajectory  # loads ruckig, only for a trajectory
+        if scene.robot is None:
+            from ..execution.trajectory import trajectory  # loads ruckig, only for a trajectory
 
-        moved = trajectory(scene, result)
+            moved = trajectory(scene, result)
+        else:
+            from ..execution.arm_timing import arm_trajectory  # loads mink and MuJoCo, only for an arm
+
+            moved, arm = arm_trajectory(scene, result)
         motion = moved if options.trajectory else None
-        if scene.robot is not None:
-            from ..arm.joints import joints_along  # loads mink and MuJoCo, only for an arm
-
-            arm = joints_along(scene.robot, moved)
     if options.simulate and result.solved:
-        simulation = _simulated(scene, options, planner_options, result, session, arm)
+        simulation = _simulated(scene, options, planner_options, result, session, None if arm is None else (moved, arm))
     if options.reach:  # the map is about the start, whatever the plan
         mapped = scene if options.part is None else scene.move_scene(options.part, scene.starts)
         if reach_map is None:
@@ -128,17 +129,18 @@ def _checked(scene: Scene, options: RunOptions, planner_options: PlannerOptions,
 
 
 def _simulated(scene: Scene, options: RunOptions, planner_options: PlannerOptions, result: Plan,
-               session: Planner | None, joints=None):
+               session: Planner | None, arm=None):
     """The MuJoCo runs of ``result`` (MuJoCo is loaded only now): open loop, the scene's arm (if
-    any) following ``joints``, or closed loop on ``session`` (made now, with ``planner_options``,
-    for a plan read from a file), whose re-plans join ``result``."""
+    any) following ``arm`` (the trajectory and the joints along it), or closed loop on
+    ``session`` (made now, with ``planner_options``, for a plan read from a file), whose re-plans
+    join ``result``."""
     seed, cf_offset = planner_options.seed, options.sim_cf_offset or (0.0, 0.0)
     start_error = options.start_error or (0.0, 0.0, 0.0)
     if not options.closed_loop:
         from ..execution.mujoco_sim import simulate
 
         return simulate(scene, result, options.simulate, seed, options.sim_mu, cf_offset, start_error, options.bumps,
-                        joints)
+                        arm)
     from ..execution.closed_loop import closed_loop
 
     if session is None:

@@ -247,3 +247,23 @@ def test_a_bad_robot_block_is_one_line_exit_1(tmp_path, change, field):
     assert run.returncode == 1 and run.stdout == ""
     assert run.stderr.startswith(f"plan: error: {field}: ") and run.stderr.count("\n") == 1, run.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_trajectory_too_fast_for_a_joint_is_timed_slower_for_the_arm(tmp_path):
+    """A random scene's plan (test_unseen_scenes found it) passes the Panda's elbow near straight,
+    where the pusher's own time law asked joint 3 for 1.74 times its speed limit: the trajectory is
+    timed slower, the same path in more time, and its joints pass the independent check."""
+    spec = {"name": "elbow", "slider": {"vertices": [[-0.0304, -0.0351], [0.0304, -0.0351], [0.0304, 0.0351],
+                                                     [-0.0304, 0.0351]]},
+            "pusher": {"width": 0.03, "depth": 0.015, "mu": 0.6848},
+            "obstacles": [{"box": {"center": [0.3985, 0.5088], "size": [0.0996, 0.1079]}}],
+            "workspace": {"min": [-0.4752, -0.45], "max": [0.4752, 0.5148]},
+            "start": [-0.3726, -0.3650, 179.0], "goal": [0.3897, -0.2361, 165.8],
+            "robot": {"model": "panda", "base": [0.0, -0.45, 90.0], "tool_length": 0.1847, "push_height": 0.0178}}
+    path = tmp_path / "elbow.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    run = plan(str(path), "--trajectory", "--seed", "1", "--out", "out", cwd=tmp_path)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "arm: follows: " in run.stdout and " times slower for its joints; " in run.stdout, run.stdout
+    found = check_joints(path, tmp_path / "out")
+    assert found["speed"] <= 1.0

@@ -83,7 +83,7 @@ def test_a_joint_trajectory_5_cm_off_fails_the_run(around):
     motion = setup.motion
     off = joint_trajectory(scene.robot, motion.t, np.c_[motion.x, motion.y + 0.05, motion.theta], motion.z,
                            motion.segment)
-    doctored = mujoco_sim.simulate(scene, plan, 1, joints=off)
+    doctored = mujoco_sim.simulate(scene, plan, 1, arm=(motion, off))
     assert not doctored.passed and not doctored.runs[0].in_goal, doctored.lines()
     assert 0.045 < doctored.runs[0].tracking < 0.06
 
@@ -95,7 +95,7 @@ def test_a_link_on_the_table_is_reported_by_name(around):
     # The pusher frame 12 cm lower: the flange (13 cm over the table) and its link go into the table.
     low = joint_trajectory(scene.robot, motion.t, np.c_[motion.x, motion.y, motion.theta], motion.z - 0.12,
                            motion.segment)
-    run = mujoco_sim.simulate(scene, plan, 1, joints=low).runs[0]
+    run = mujoco_sim.simulate(scene, plan, 1, arm=(motion, low)).runs[0]
     assert not run.passed and any(what == "the arm's link7 touches the table" for _, what in run.faults), run.faults
 
 
