@@ -163,9 +163,12 @@ class ArmReach:
         dt, limits, tasks = ((_DT, self.limits, [self.task, self.posture]) if within is None
                              else (within, self.limits + [self.speeds], [self.task]))
         miss = math.inf
-        for _ in range(steps):
+        for step in range(steps):
             miss = float(np.linalg.norm(self.task.compute_error(self.configuration)))
-            if miss < REACHED and not settle:
+            # Along a path every sample takes its step, however near: a posture left where it
+            # was while the pose creeps until it is REACHED away, then caught up, would shake the
+            # arm's pusher by that much a sample (slip in the simulation).
+            if miss < REACHED and not settle and (within is None or step > 0):
                 break
             velocity = mink.solve_ik(self.configuration, tasks, dt, "daqp", damping=1e-6, limits=limits)
             if miss < REACHED and float(np.abs(velocity).max()) * dt < _SETTLED:
