@@ -125,7 +125,14 @@ class ArmReach:
         # The flange points down, so the last joint turns the pusher's heading the other way.
         at = self.pusher_frame(facing)[1]
         off = math.remainder(float(pose[2]) - self.mount - math.atan2(at[1, 0], at[0, 0]), 2 * math.pi)
-        facing[-1] = float(np.clip(facing[-1] - off, low[-1], high[-1]))
+        wrist = facing[-1] - off
+        # A last joint of more than a turn (the UR5e's) holds the heading on several branches: the
+        # one where pushing straight away from the base (psi = 0, planner.world.reach) would put
+        # it nearest the middle of its range, so that the psi the planner allows either way fits.
+        psi = math.remainder(float(pose[2]) - math.atan2(pose[1] - y, pose[0] - x), 2 * math.pi)
+        middle = (low[-1] + high[-1]) / 2
+        branches = [wrist + k * 2 * math.pi for k in (-1, 0, 1) if low[-1] <= wrist + k * 2 * math.pi <= high[-1]]
+        facing[-1] = min(branches, key=lambda q: abs(q + psi - middle)) if branches else float(np.clip(wrist, low[-1], high[-1]))
         q, miss = self.solve(pose, facing, height=height, settle=True)
         if miss < REACHED:
             return q, miss
