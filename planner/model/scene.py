@@ -45,6 +45,7 @@ from mechanics import Slider, pose_error
 from .bodies import slider_at
 from .fields import SceneError, shown
 from .options import PlannerOptions
+from .camera import Camera
 from .robot import Robot
 
 __all__ = ["ONE_PART", "Part", "Pusher", "Scene"]
@@ -94,6 +95,7 @@ class Scene:
     path: str | None = None  # the file it was read from
     notes: tuple[str, ...] = ()  # what was not read from the CAD files it names (text, open chains)
     robot: Robot | None = None  # the arm holding the pusher (None: a pusher that floats)
+    camera: Camera | None = None  # the overhead depth camera (None: the file has no camera block)
 
     @property
     def names(self) -> tuple[str, ...]:
