@@ -8,7 +8,6 @@ import numpy as np
 
 from planner.execution.depth_camera import DepthCamera
 from planner.execution.mujoco_sim import World, feet
-from planner.model.camera import read_camera
 from planner.model.scene import Scene
 from planner.model.scene_file import parse_scene
 
@@ -19,12 +18,14 @@ SQUARE = [[-0.03, -0.03], [0.03, -0.03], [0.03, 0.03], [-0.03, 0.03]]
 AWAY = (5.0, 5.0, 1.0, 0.0)
 
 
-def table(parts: dict[str, list], half: float = 0.5, camera: dict | None = None) -> Scene:
-    """A bare table ``2 half`` square with ``parts`` (name: vertices) and the ``camera`` block
-    (default: the default camera)."""
-    spec = {"parts": [{"name": name, "vertices": vertices, "start": [0.3 * k - 0.3, -0.3, 0], "goal": [0.3 * k - 0.3, 0.3, 0]}
+def table(parts: dict[str, list], half: float = 0.5, camera: dict | None = None,
+          pusher: tuple[float, float] = (0.05, 0.01)) -> Scene:
+    """A bare table ``2 half`` square with ``parts`` (name: vertices), the ``camera`` block
+    (default: the default camera) and a pusher ``(width, depth)``."""
+    spec = {"parts": [{"name": name, "vertices": vertices, "start": [0.6 * half * (k - 1), -0.6 * half, 0],
+                       "goal": [0.6 * half * (k - 1), 0.6 * half, 0]}
                       for k, (name, vertices) in enumerate(parts.items())],
-            "pusher": {"width": 0.05, "depth": 0.01, "mu": 0.5},
+            "pusher": {"width": pusher[0], "depth": pusher[1], "mu": 0.5},
             "workspace": {"min": [-half, -half], "max": [half, half]}, "camera": camera or {}}
     return parse_scene(spec)
 
@@ -36,7 +37,3 @@ def staged(scene: Scene, poses: dict[str, np.ndarray], pusher=AWAY) -> tuple[Wor
     world = World(scene, supports, None, {n: np.asarray(p, dtype=float) for n, p in poses.items()})
     world.data.qpos[world.qpos] = pusher
     return world, DepthCamera(world, scene.camera)
-
-
-def camera(spec: dict, half: float = 0.5):
-    return read_camera(spec, (-half, -half, half, half))
