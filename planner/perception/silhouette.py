@@ -2,9 +2,12 @@
 
 A part is a prism whose top is ``top`` over the table. A pixel is *part* if its smoothed height
 (:class:`~.table_view.TableView`) is at least half of ``top`` and at most :data:`ABOVE` over it,
-*table* if under half of ``top``, and *occluded* if higher (the pusher, a wall, an obstacle) or
-within :data:`GUARD` pixels of such: the smoothing spreads a tall thing's edge across the part's
-band, which must not be taken for a part. Specks of part pixels, fewer than :data:`SPECK`, are
+*table* if under half of ``top``, and *occluded* if higher (the pusher, a wall, an obstacle), within
+:data:`GUARD` pixels of such (the smoothing spreads a tall thing's edge across the part's band), or
+over the table within :data:`GUARD` pixels' footprint of where such stands (:func:`_beside_tall`):
+the camera sees the walls of tall things that face it, whose heights pass through the part's band
+over many pixels where the view slants (16 mm of the pusher's wall over 10 pixels), and a wall
+stands over its thing's outline, which its top shows. None of these must be taken for a part. Specks of part pixels, fewer than :data:`SPECK`, are
 noise. An *edge point* lies between a part pixel and a table pixel next to it (in a row or a
 column), where the smoothed height crosses half of ``top``; only those count: where a part meets
 something taller its outline is hidden, not seen.
@@ -65,7 +68,9 @@ def silhouette(view: TableView, top: float) -> Silhouette:
     """The edge points of the parts of height ``top`` (m) in ``view`` (module docstring)."""
     half = top / 2
     height = view.height
-    occluded = ndimage.binary_dilation(height > top + ABOVE, iterations=GUARD) | ~view.valid
+    tall = height > top + ABOVE
+    occluded = ndimage.binary_dilation(tall, iterations=GUARD) | ~view.valid
+    occluded |= _beside_tall(view, tall, (height >= ABOVE) & ~occluded)
     part = (height >= half) & ~occluded
     labels, count = ndimage.label(part)
     if count:
@@ -93,6 +98,33 @@ def silhouette(view: TableView, top: float) -> Silhouette:
     facing = np.einsum("ij,ij->i", outward, view.camera.position[:2] - at_top[:, :2]) > 0
     points = np.where(facing[:, None], view.on_plane(pixels, half)[:, :2], at_top[:, :2])
     return Silhouette(points, table, view)
+
+
+def _beside_tall(view: TableView, tall: np.ndarray, candidates: np.ndarray) -> np.ndarray:
+    """Which of the ``candidates`` pixels stand, over the table, within :data:`GUARD` pixels' footprint
+    of a ``tall`` pixel's point: the tall things' points and the candidates' are placed at their
+    smoothed heights over the table, and compared on a grid of that footprint."""
+    out = np.zeros_like(candidates)
+    if not tall.any() or not candidates.any():
+        return out
+    cell = view.camera.position[2] / view.camera.focal  # a pixel's footprint on the table, about
+
+    def cells(mask: np.ndarray) -> np.ndarray:
+        v, u = np.nonzero(mask)
+        xy = view.on_plane(np.column_stack([u, v]).astype(float), view.height[v, u])[:, :2]
+        return np.floor(xy / cell).astype(np.int64)
+
+    occupied, asked = cells(tall), cells(candidates)
+    low = occupied.min(axis=0) - GUARD
+    grid = np.zeros(tuple(occupied.max(axis=0) - low + GUARD + 1), dtype=bool)
+    grid[tuple((occupied - low).T)] = True
+    grid = ndimage.binary_dilation(grid, iterations=GUARD)
+    index = asked - low
+    inside = ((index >= 0) & (index < grid.shape)).all(axis=1)
+    hit = np.zeros(len(asked), dtype=bool)
+    hit[inside] = grid[tuple(index[inside].T)]
+    out[candidates] = hit
+    return out
 
 
 def _shifted(mask: np.ndarray, step: int, axis: int) -> np.ndarray:
