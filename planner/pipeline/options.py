@@ -87,6 +87,9 @@ class RunOptions:
                     raise SceneError(name, "only applies with simulate (a number of MuJoCo runs)")
         if self.observe is not None and not self.closed_loop:
             raise SceneError("observe", "only applies with closed_loop (the open loop observes nothing)")
+        if self.observe == "camera" and self.pose_noise is not None:
+            raise SceneError("pose_noise", "is the truth observer's noise; a camera has its own (the scene's camera: "
+                                           "block)")
         for name in ("start_error", "pose_noise", "sim_cf_offset"):
             if (values := getattr(self, name)) is not None and not all(abs(v) < math.inf for v in values):
                 raise SceneError(name, f"must be finite, got {' '.join(map(str, values))}")

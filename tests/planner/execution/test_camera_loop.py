@@ -100,7 +100,11 @@ def test_a_part_seen_again_is_observed_at_rest_and_re_planned_from():
     assert np.allclose(replan.start, moved) and replan.why == "lost track: too occluded"
 
 
-def test_observe_only_applies_to_a_closed_loop(tmp_path, capsys):
-    assert main(["scenes/battery.yaml", "--simulate", "1", "--observe", "camera", "--out", str(tmp_path / "o")]) == 1
-    assert capsys.readouterr().err == ("plan: error: --observe: only applies with closed_loop (the open loop observes "
-                                       "nothing)\n")
+@pytest.mark.parametrize("flags, line", [
+    (["--observe", "camera"], "--observe: only applies with closed_loop (the open loop observes nothing)"),
+    (["--closed-loop", "--observe", "camera", "--sim-pose-noise", "0.001", "0.5"],
+     "--sim-pose-noise: is the truth observer's noise; a camera has its own (the scene's camera: block)")])
+def test_observe_camera_is_refused_where_it_means_nothing(tmp_path, capsys, flags, line):
+    out = tmp_path / "o"
+    assert main(["scenes/battery.yaml", "--simulate", "1", *flags, "--out", str(out)]) == 1
+    assert capsys.readouterr().err == f"plan: error: {line}\n" and not out.exists()
