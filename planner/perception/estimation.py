@@ -98,19 +98,22 @@ def estimate_poses(depth: np.ndarray, camera: Camera, outlines: Mapping[str, Arr
     shapes = {name: np.asarray(outline, dtype=float) for name, outline in outlines.items()}
     priors = {name: np.asarray(priors[name], dtype=float) for name in shapes}
     pixels = {name: _footprint(camera, priors[name], top) for name in shapes}
-    # The deviation of the smoothed heights at each part, its depth being its pixel's footprint times the focal length.
-    noise = {name: smoothed_noise(camera.noise * (pixels[name] * camera.focal) ** 2) for name in shapes}
     first = {name: _fit(points, shapes[name], priors[name], pixels[name])
              for name, points in _shares(seen.points, shapes, priors, GATE).items()}
     # The points again, each to the part whose fitted outline it is nearest: the priors' outlines
     # may have handed a neighbour's edge to a part.
     found = {name: priors[name] if fit is None else fit.pose for name, fit in first.items()}
-    return {name: _judge(seen, shapes[name], priors[name], points, pixels[name],
-                         first[name] and _fit(points, shapes[name], found[name], pixels[name]))
-            if top / 2 >= CONTRAST * noise[name] else
-            Estimate(None, None, np.nan, 0.0, len(points), f"too thin for the camera here: {top * 1e3:.1f} mm high in "
-                                                           f"depth noise of {noise[name] * 1e3:.1f} mm (smoothed)")
-            for name, points in _shares(seen.points, shapes, found, GATE).items()}
+    estimates = {}
+    for name, points in _shares(seen.points, shapes, found, GATE).items():
+        # The deviation of the smoothed heights there: the depth is the pixel's footprint times the focal length.
+        noise = smoothed_noise(camera.noise * (pixels[name] * camera.focal) ** 2)
+        if top / 2 < CONTRAST * noise:
+            estimates[name] = Estimate(None, None, np.nan, 0.0, len(points), f"too thin for the camera here: "
+                                       f"{top * 1e3:.1f} mm high in depth noise of {noise * 1e3:.1f} mm (smoothed)")
+        else:
+            refit = None if first[name] is None else _fit(points, shapes[name], found[name], pixels[name])
+            estimates[name] = _judge(seen, shapes[name], priors[name], points, pixels[name], refit)
+    return estimates
 
 
 def _shares(points: np.ndarray, shapes: dict[str, np.ndarray], poses: dict[str, np.ndarray],
