@@ -400,9 +400,9 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
         return [pose[0], pose[1], height, pose[2]], [rate[0], rate[1], rate[3], rate[2]]
 
     eye = None if camera is None else CameraObserver(world, scene, camera, plan.starts, rng)
-    every = max(1, round(RATE / (OBSERVE_HZ if camera is None else camera.rate)))
+    every = max(1, round(RATE / OBSERVE_HZ))
     frames: deque = deque()  # the camera's images taken and not yet in hand: (in hand at, taken at, estimates, truth)
-    errors, lost_time = [], 0.0
+    shots, errors, lost_time = 0, [], 0.0  # images taken; the k-th at the first sample at or after k / rate
     rows, moving, collisions, faults, k = [], [], 0, {}, 0
     while True:
         u = k / RATE
@@ -418,17 +418,18 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
         if world.diverged:  # nothing real is left to observe: the run fails, saying why
             break
         ended = False
-        if k % every == 0:
-            if eye is None:
-                seen = {n: world.pose(n) + rng.normal(0.0, [noise[0], noise[0], noise[1]]) for n in scene.names}
-                ended = loop.observe(u, seen)
-            else:  # the truth is kept beside the estimates to judge them, never handed to the loop
-                frames.append((u + camera.latency, u, eye.look(), {n: world.pose(n) for n in scene.names}))
+        if eye is None and k % every == 0:
+            seen = {n: world.pose(n) + rng.normal(0.0, [noise[0], noise[0], noise[1]]) for n in scene.names}
+            ended = loop.observe(u, seen)
+        if eye is not None and u >= shots / camera.rate - 1e-9:
+            # The truth is kept beside the estimates to judge them, never handed to the loop.
+            frames.append((u + camera.latency, u, eye.look(), {n: world.pose(n) for n in scene.names}))
+            shots += 1
         while frames and frames[0][0] <= u + 1e-9 and not ended:
             _, taken, found, truth = frames.popleft()
             errors += [pose_error(e.pose, truth[n]) for n, e in found.items() if e.tracked]
             lost = {n: e.lost for n, e in found.items() if not e.tracked}
-            lost_time += every / RATE if lost else 0.0
+            lost_time += 1 / camera.rate if lost else 0.0
             ended = loop.observe(u, {n: e.pose for n, e in found.items() if e.tracked}, taken, lost)
         if ended or u > limit:
             break
