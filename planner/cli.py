@@ -103,7 +103,8 @@ def read_inputs(argv: Sequence[str] | None = None) -> Inputs:
         start_error=None if args.sim_start_error is None else _radians(args.sim_start_error),
         bumps=tuple(_radians(b) for b in args.sim_bump or ()),
         pose_noise=None if args.sim_pose_noise is None else _radians(args.sim_pose_noise),
-        closed_loop=args.closed_loop, mjcf=None if args.mjcf is None else Path(args.mjcf), reach=args.reach,
+        closed_loop=args.closed_loop, observe=args.observe,
+        mjcf=None if args.mjcf is None else Path(args.mjcf), reach=args.reach,
         part=args.part, out=out, export_scene=None if args.export_scene is None else Path(args.export_scene))
     try:
         return Inputs(scene, options.checked(scene), planner_options)

@@ -25,7 +25,7 @@ ARGUMENTS = {"seed": "--seed", "cf_offset": "--sim-cf-offset", "sim_cf_offset": 
              "pose_noise": "--sim-pose-noise", "plan_file": "--plan",
              **{name: f"--{name.replace('_', '-')}" for name in
                 ("engine", "jobs", "address", "out", "seeds", "resume", "simulate", "verify", "reach", "part",
-                 "trajectory", "sim_mu", "mjcf", "closed_loop", "export_scene")}}
+                 "trajectory", "sim_mu", "mjcf", "closed_loop", "observe", "export_scene")}}
 
 
 #: A negative number as float() reads it: -1, -.5, -1e-3, -2.5E+4, -inf, -nan.
@@ -134,6 +134,11 @@ $STABLEPUSH_CACHE, else $XDG_CACHE_HOME/stablepush or ~/.cache/stablepush (here:
                         "move ends); the summary counts the re-plans; with --trajectory "
                         "each run's executed pusher path is written as <name>.executed.csv (the first run), "
                         "<name>.executed-<k>.csv (run k)")
+    p.add_argument("--observe", choices=("truth", "camera"),
+                   help="with --closed-loop: what the loop sees the parts with: truth, MuJoCo's poses with "
+                        "--sim-pose-noise (the default), or camera, the scene's depth camera (its camera: block, or "
+                        "the default camera of the workspace) and the pose estimator (planner.perception); each "
+                        "run's line then gives the estimates' errors against MuJoCo's poses and the time lost")
     p.add_argument("--mjcf", metavar="FILE", help="with --simulate: write the first run's MuJoCo model (MJCF XML)")
     p.add_argument("--export-scene", metavar="FILE",
                    help="also write the scene as planned to FILE (YAML, the plain schema: CAD files and boxes "

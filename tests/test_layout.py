@@ -10,7 +10,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 #: The subpackages of planner, lowest first: each may import only from itself and those before it.
-ORDER = ["model", "world", "arm", "actions", "search", "queries", "execution", "outputs", "pipeline", "batch", "bench"]
+ORDER = ["model", "world", "arm", "perception", "actions", "search", "queries", "execution", "outputs", "pipeline", "batch", "bench"]
 
 
 def _module_name(path: Path) -> str:

@@ -16,7 +16,13 @@ open loop and once closed loop on the grid foot set; a row per case, then the to
 goal without touching a wall or obstacle (open loop: slip is not counted, a part met off its
 planned contact slides along the face by design), re-plans and their latency (median, max), and
 how often the loop went on with its plan for want of a re-plan.
-Needs the mujoco extra.
+
+``--observe camera`` runs each case closed loop a second time, seeing the parts through the
+scene's depth camera (its ``camera:`` block, or the default camera of its workspace;
+``plan --closed-loop --observe camera``), and prints it beside the truth observer's run: whether
+it passed, its estimates' error against MuJoCo's poses (median, 95th percentile and worst, over
+the run's images) and the time it lost the part. The ``noisy`` kind's noise is the truth
+observer's; the camera has its own. Needs the mujoco extra.
 """
 
 from __future__ import annotations
@@ -38,6 +44,8 @@ __all__ = ["KINDS", "draw", "main"]
 KINDS = ("start", "knock", "noisy", "cf", "slippery")
 HEADER = ("| scene | case | open loop | closed loop | re-plans | latency (median, max) |\n"
           "|---|---|---|---|---|---|")
+#: The columns ``--observe camera`` adds.
+CAMERA_HEADER = (" closed loop, camera | camera error (median/p95/worst) | lost |", "---|---|---|")
 
 
 def draw(kind: str, rng: np.random.Generator, duration: float, mu: float) -> dict:
@@ -71,15 +79,31 @@ def _shown(case: dict) -> str:
     return ", ".join(parts)
 
 
+def _camera(run) -> str:
+    """The columns of a camera run (:data:`CAMERA_HEADER`)."""
+    errors = run.seen.errors
+    error = (f"{np.median(errors[:, 0]) * 1e3:.2f}/{np.percentile(errors[:, 0], 95) * 1e3:.2f}/"
+             f"{errors[:, 0].max() * 1e3:.2f} mm, {np.degrees(np.median(errors[:, 1])):.2f}/"
+             f"{np.degrees(np.percentile(errors[:, 1], 95)):.2f}/{np.degrees(errors[:, 1].max()):.2f} deg"
+             if len(errors) else "no estimate")
+    return (f" {'ok' if run.passed else 'FAIL'} ({run.goal_error[0] * 1e3:.1f} mm"
+            f"{'; ' + run.reason if run.reason else ''}) | {error} | {run.seen.lost:.1f} s |")
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m planner.bench.closed_loop", description=__doc__.splitlines()[0])
     p.add_argument("scenes", nargs="+", help="scene files (YAML)")
     p.add_argument("--cases", type=int, default=5, help="perturbations per scene (default 5, one of each kind)")
     p.add_argument("--seed", type=int, default=1, help="seed of the draws (default 1)")
+    p.add_argument("--observe", choices=("truth", "camera"), default="truth",
+                   help="camera: also run each case closed loop through the scene's depth camera, beside the truth "
+                        "observer (module docstring)")
     args = p.parse_args(argv)
     rng = np.random.default_rng(args.seed)
-    print(HEADER, flush=True)
-    opened = closed = total = 0
+    looks = args.observe == "camera"
+    top, rule = HEADER.split("\n")
+    print(f"{top}{CAMERA_HEADER[0]}\n{rule}{CAMERA_HEADER[1]}" if looks else HEADER, flush=True)
+    opened = closed = seen = total = 0
     latencies: list[float] = []
     for path in args.scenes:
         session = Planner(load_scene(path))
@@ -111,19 +135,25 @@ def main(argv: list[str] | None = None) -> int:
             latencies += closed_run.latencies
             timing = (f"{np.median(closed_run.latencies) * 1e3:.0f} ms, {max(closed_run.latencies) * 1e3:.0f} ms"
                       if closed_run.latencies else "")
+            if looks:
+                case.pop("noise")
+                camera_run = closed_loop(session, result, 1, observe="camera", **case).runs[0]
+                case["noise"] = noise if noise != (0.0, 0.0) else None
+                seen += camera_run.passed
             print(f"| {scene.name} | {kind}: {_shown({k: v for k, v in case.items() if v is not None})} "
                   f"| {'ok' if open_ok else 'FAIL'} ({open_run.goal_error[0] * 1e3:.1f} mm"
                   f"{', collides' if open_run.collisions else ''}) "
                   f"| {'ok' if closed_run.passed else 'FAIL'} ({closed_run.goal_error[0] * 1e3:.1f} mm"
                   f"{', collides' if closed_run.collisions else ''}{'; ' + closed_run.reason if closed_run.reason else ''}"
                   f"{f'; went on {len(closed_run.carried)} times' if closed_run.carried else ''}) "
-                  f"| {len(closed_run.replans)} | {timing} |",
+                  f"| {len(closed_run.replans)} | {timing} |{_camera(camera_run) if looks else ''}",
                   flush=True)
     if total:
         timing = (f"re-plans {len(latencies)}, latency median {np.median(latencies) * 1e3:.0f} ms, "
                   f"max {max(latencies) * 1e3:.0f} ms" if latencies else "no re-plans")
+        camera = f", closed loop with the camera {seen}/{total} ({100 * seen / total:.1f} %)" if looks else ""
         print(f"\nopen loop {opened}/{total} ({100 * opened / total:.1f} %), closed loop {closed}/{total} "
-              f"({100 * closed / total:.1f} %); {timing}")
+              f"({100 * closed / total:.1f} %){camera}; {timing}")
     return 0
 
 

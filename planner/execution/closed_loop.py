@@ -27,6 +27,16 @@ from another part by a transfer as the planner makes them
 same part (or where no transfer is found) by the tracker's approach. Re-plans a move's end did
 not ask for count against the tracker's :data:`~.tracker.BUDGET`.
 
+**Observers.** The truth observer hands the loop MuJoCo's pose of every part with Gaussian noise,
+:data:`OBSERVE_HZ` times a second. The camera observer (``observe='camera'``) never reads them: it
+takes depth images with the scene's camera (its ``camera:`` block, or the default camera of the
+workspace) at the camera's frame rate, finds the parts in them
+(:class:`.camera_observer.CameraObserver`) and hands each image's estimates to the loop the
+camera's latency after the image was taken, to be compared with the plan at the time it was
+taken. A part not seen (a lost track) stops the pusher while the camera looks again
+(:meth:`.tracker.Tracker.unseen`). MuJoCo's poses at the images' times are kept beside the
+estimates, only to say how far off they were (:class:`Seen`).
+
 A run ends when every part is observed at rest in its goal (one part: the tracker is done), when
 it gives up (the tracker, for one part; no plan of the moves left, or the budget spent, for
 several), or after :data:`PATIENCE` times the first plan's duration plus :data:`GRACE` seconds.
@@ -40,6 +50,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections import deque
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -49,22 +61,26 @@ from numpy.typing import ArrayLike
 from mechanics import pose_error, wrap_angle
 
 from ..actions.transit import edge_contact_pose
+from ..model.camera import Camera, read_camera
 from ..model.fields import SceneError, counted
 from ..model.plan import Plan
 from ..model.scene import Scene
 from ..model.segments import Transit
 from ..queries.session import Planner
 from .approach import first_edge, lead_in_pose
+from .camera_observer import CameraObserver
 from .mujoco_sim import (SETTLE, TABLE_MU, ByPart, Feet, Runs, World, _one, _worst, foot_sets, needs_mujoco,
                          perturbations, write_mjcf)
 from .tracker import BUDGET, CONFIRM, Replan, Tracker, mean_pose
 from .tracker import SETTLE as AT_REST  # observations of the parts at rest (mujoco_sim's SETTLE is seconds)
 from .trajectory import RATE, Trajectory
 
-__all__ = ["GRACE", "OBSERVE_HZ", "PATIENCE", "ClosedLoop", "ClosedRun", "closed_loop"]
+__all__ = ["GRACE", "OBSERVERS", "OBSERVE_HZ", "PATIENCE", "ClosedLoop", "ClosedRun", "Seen", "closed_loop"]
 
-#: Observations per second of simulated time.
+#: Observations per second of simulated time (the truth observer; a camera has its own rate).
 OBSERVE_HZ = 20.0
+#: What observes the parts: MuJoCo's poses with Gaussian noise, or the scene's camera.
+OBSERVERS = ("truth", "camera")
 #: A run is stopped after this many times the first plan's duration plus this many seconds.
 PATIENCE, GRACE = 3.0, 20.0
 
@@ -96,6 +112,7 @@ class ClosedRun(ByPart):
     tracks: dict[str, np.ndarray]
     carried: tuple[tuple[float, str], ...] = ()
     faults: tuple[tuple[float, str], ...] = ()
+    seen: "Seen | None" = None  # how well the camera saw the parts (None: the truth observer)
 
     @property
     def part(self) -> np.ndarray:
@@ -126,7 +143,27 @@ class ClosedRun(ByPart):
         return (f"closed loop {k}/{n} ({kinds}, {'+'.join(str(len(f.points)) for f in self.supports.values())} feet): "
                 f"goal error {self.goal_error[0]:.2e} m, {self.goal_error[1]:.2e} rad{worst}; "
                 f"{counted(len(self.replans), 're-plan')}{latency}; {_carried(self.carried)}"
+                f"{'' if self.seen is None else self.seen.text() + '; '}"
                 f"{self.seconds:.1f} s for {self.simulated:.1f} s: {', '.join(faults) if faults else 'ok'}")
+
+
+@dataclass(frozen=True)
+class Seen:
+    """How well a camera saw the parts in a run: each estimate's distance (m) and heading difference
+    (rad) from MuJoCo's pose at the time its image was taken (``errors``, ``(n, 2)``), and the
+    seconds of images in which some part was lost (``lost``)."""
+
+    errors: np.ndarray
+    lost: float
+
+    def text(self) -> str:
+        """The camera's part of a run's line: the errors' median, 95th percentile and worst."""
+        if not len(self.errors):
+            return f"camera: no estimate, lost {self.lost:.1f} s"
+        mm, deg = self.errors[:, 0] * 1e3, np.degrees(self.errors[:, 1])
+        return (f"camera: {len(self.errors)} estimates off by {np.median(mm):.2f}/{np.percentile(mm, 95):.2f}/"
+                f"{mm.max():.2f} mm, {np.median(deg):.2f}/{np.percentile(deg, 95):.2f}/{deg.max():.2f} deg "
+                f"(median/p95/worst), lost {self.lost:.1f} s")
 
 
 def _carried(carried: tuple[tuple[float, str], ...]) -> str:
@@ -204,6 +241,7 @@ class _Loop:
         self._strikes: dict[str, int] = {}
         self._left: str | None = None  # the part the pusher leaves for this move's, until it pushes
         session, lone, goal = self._move()
+        self._seen = lone.start  # the moving part's last observed pose
         self.tracker = Tracker(session, lone, pusher=lead_in_pose(session.scene, session.model, lone), noise=noise,
                                seed=seed, goal=goal)
 
@@ -242,14 +280,24 @@ class _Loop:
             return pose.copy(), height, np.zeros(4), False
         return self.tracker.pusher_at(now)
 
-    def observe(self, now: float, seen: dict[str, np.ndarray]) -> bool:
-        """Take every part's observed pose at ``now``; whether the run has ended."""
+    def observe(self, now: float, seen: dict[str, np.ndarray], taken: float | None = None,
+                lost: Mapping[str, str] | None = None) -> bool:
+        """Take every part's observed pose at ``now``, of the parts as they were at ``taken``
+        (default: ``now``; a camera's latency before), and the parts not seen with why (``lost``:
+        the moving part's tracker stops the pusher and looks again; a part not seen is not
+        judged); whether the run has ended."""
+        lost = lost or {}
         if self._held is not None:
-            self._window.append(seen)
+            if not lost:  # the mean of the parts at rest needs every part seen
+                self._window.append(seen)
             if len(self._window) >= AT_REST:
                 self._replan(now)
             return self.done or bool(self.reason)
-        command = self.tracker.observe(now, seen[self.moving])
+        if self.moving in lost:
+            command = self.tracker.unseen(now, lost[self.moving])
+        else:
+            command = self.tracker.observe(now, seen[self.moving], taken)
+            self._seen = seen[self.moving]
         if command.contact:
             self._left = None
         if command.kind.ended:
@@ -258,7 +306,7 @@ class _Loop:
                 return True
             done = self.tracker.done
             why = f"{self.moving}'s move is done" if done else f"gave up on {self.moving}: {self.tracker.reason}"
-            self._hold(now, self.moving, seen[self.moving], command.error, why, not done)
+            self._hold(now, self.moving, self._seen, command.error, why, not done)
             return False
         for name, pose in seen.items():
             if name == self.moving:
@@ -322,7 +370,7 @@ class _Loop:
         self._past += [*self.tracker.replans, Replan(now, means[name], trigger, error, why, latency, found,
                                                      observed.pusher.mu)]
         self._carried += self.tracker.carried
-        self.tracker, self._held, self._strikes = tracker, None, {}
+        self.tracker, self._held, self._strikes, self._seen = tracker, None, {}, lone.start
         self._left = left if lone.part != left else None
 
 
@@ -334,9 +382,13 @@ def _after_first_move(plan: Plan, motion: Trajectory) -> float:
 
 
 def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | None, starts: dict[str, np.ndarray],
-         bumps: tuple, noise: np.ndarray, rng: np.random.Generator, seed: int | None, later: float) -> ClosedRun:
+         bumps: tuple, noise: np.ndarray, rng: np.random.Generator, seed: int | None, later: float,
+         camera: Camera | None = None) -> ClosedRun:
     """One run of :func:`closed_loop`, each part on its ``supports`` and placed at ``starts``;
-    ``later`` is how long the plan runs after its first move (:func:`_after_first_move`)."""
+    ``later`` is how long the plan runs after its first move (:func:`_after_first_move`). With
+    ``camera``, the parts are observed through it (:class:`.camera_observer.CameraObserver`, at
+    its frame rate, each image in hand its latency after it was taken); else as MuJoCo has them,
+    with Gaussian ``noise``."""
     scene = session.scene
     clock = time.perf_counter()
     world = World(scene, supports, mu, starts, bumps)
@@ -347,7 +399,10 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
         pose, height, rate, _ = loop.pusher_at(u)
         return [pose[0], pose[1], height, pose[2]], [rate[0], rate[1], rate[3], rate[2]]
 
+    eye = None if camera is None else CameraObserver(world, scene, camera, plan.starts, rng)
     every = max(1, round(RATE / OBSERVE_HZ))
+    frames: deque = deque()  # the camera's images taken and not yet in hand: (in hand at, taken at, estimates, truth)
+    shots, errors, lost_time = 0, [], 0.0  # images taken; the k-th at the first sample at or after k / rate
     rows, moving, collisions, faults, k = [], [], 0, {}, 0
     while True:
         u = k / RATE
@@ -362,10 +417,22 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
             faults.setdefault(fault, u)
         if world.diverged:  # nothing real is left to observe: the run fails, saying why
             break
-        if k % every == 0:
+        ended = False
+        if eye is None and k % every == 0:
             seen = {n: world.pose(n) + rng.normal(0.0, [noise[0], noise[0], noise[1]]) for n in scene.names}
-            if loop.observe(u, seen) or u > limit:
-                break
+            ended = loop.observe(u, seen)
+        if eye is not None and u >= shots / camera.rate - 1e-9:
+            # The truth is kept beside the estimates to judge them, never handed to the loop.
+            frames.append((u + camera.latency, u, eye.look(), {n: world.pose(n) for n in scene.names}))
+            shots += 1
+        while frames and frames[0][0] <= u + 1e-9 and not ended:
+            _, taken, found, truth = frames.popleft()
+            errors += [pose_error(e.pose, truth[n]) for n, e in found.items() if e.tracked]
+            lost = {n: e.lost for n, e in found.items() if not e.tracked}
+            lost_time += 1 / camera.rate if lost else 0.0
+            ended = loop.observe(u, {n: e.pose for n, e in found.items() if e.tracked}, taken, lost)
+        if ended or u > limit:
+            break
         k += 1
     table = np.array(rows)
     table[:, 3] = wrap_angle(table[:, 3])
@@ -374,34 +441,40 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
     tracks = {n: table[:, 10 + 3 * j:13 + 3 * j] for j, n in enumerate(scene.names)}
     ends = {n: world.pose(n) for n in scene.names}
     reason = world.diverged or loop.reason or ("" if loop.done else f"not done after {limit:.0f} s")
+    seen = None if camera is None else Seen(np.array(errors).reshape(-1, 2), lost_time)
     return ClosedRun(dict(supports), {n: pose_error(end, scene.part(n).goal) for n, end in ends.items()},
                      {n: scene.delivered(n, end) for n, end in ends.items()}, tuple(loop.replans), reason, collisions,
                      time.perf_counter() - clock, float(table[-1, 0]), executed, tracks, tuple(loop.carried),
-                     tuple((t, what) for what, t in faults.items()))
+                     tuple((t, what) for what, t in faults.items()), seen)
 
 
 def closed_loop(session: Planner, plan: Plan, n: int = 3, seed: int = 1, mu: float | None = None,
                 cf_offset: ArrayLike = (0.0, 0.0), start_error: ArrayLike = (0.0, 0.0, 0.0), bumps: ArrayLike = (),
-                noise: ArrayLike = (0.0, 0.0)) -> ClosedLoop:
+                noise: ArrayLike = (0.0, 0.0), observe: str = "truth") -> ClosedLoop:
     """Run ``plan``, of one part or several, closed-loop in MuJoCo once per foot set: run ``k``
     puts every part on the ``k``-th of its own :func:`.mujoco_sim.feet` (module docstring),
     re-planning with ``session`` (its scene is the one run; for several parts, its move sessions
     track the first plan's first move).
 
     ``seed`` draws the foot sets, the observation noise and the re-plans; the perturbations are
-    :func:`.mujoco_sim.perturbations`' (``noise``: ``(sigma_m, sigma_rad)``).
+    :func:`.mujoco_sim.perturbations`' (``noise``: ``(sigma_m, sigma_rad)``). ``observe`` is
+    ``'truth'`` (MuJoCo's poses with that noise) or ``'camera'`` (the scene's camera, or the
+    default camera of its workspace, and the pose estimator: module docstring, "Observers").
 
     Raises
     ------
     SceneError
-        As :func:`.mujoco_sim.simulate`, and naming ``pose_noise``.
+        As :func:`.mujoco_sim.simulate`, and naming ``pose_noise`` or ``observe``.
     """
     needs_mujoco()
     scene = session.scene
+    if observe not in OBSERVERS:
+        raise SceneError("observe", f"must be one of {', '.join(OBSERVERS)}, got {observe!r}")
+    camera = None if observe == "truth" else scene.camera or read_camera(None, scene.workspace)
     sets = foot_sets(scene, n, seed, cf_offset)
     setup = perturbations(scene, plan, session.model, start_error, bumps, noise)
     rng = np.random.default_rng(seed)
     sigma = np.asarray(noise, dtype=float)
     later = _after_first_move(plan, setup.motion)
-    runs = tuple(_run(session, plan, s, mu, setup.starts, setup.bumps, sigma, rng, seed, later) for s in sets)
+    runs = tuple(_run(session, plan, s, mu, setup.starts, setup.bumps, sigma, rng, seed, later, camera) for s in sets)
     return ClosedLoop(runs, scene.pusher.mu if mu is None else mu, setup.starts)

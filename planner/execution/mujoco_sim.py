@@ -666,7 +666,9 @@ class World:
                                           mujoco.mjtWarning.mjWARN_BADQACC)]
         self.mujoco = mujoco
         self.scene, self.arm = scene, arm
-        self.model = mujoco.MjModel.from_xml_string(mjcf(scene, supports, mu, starts, arm=arm))
+        #: The model as MJCF (a renderer's copy of it adds a camera: :mod:`.depth_camera`).
+        self.xml = mjcf(scene, supports, mu, starts, arm=arm)
+        self.model = mujoco.MjModel.from_xml_string(self.xml)
         self.data = mujoco.MjData(self.model)
         mujoco.mj_resetDataKeyframe(self.model, self.data, self.model.key("start").id)
         names = list(zip(_names(scene), scene.parts))

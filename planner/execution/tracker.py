@@ -50,6 +50,12 @@ meets a part askew turns it flush and funnels its error (open loop in MuJoCo), a
 may exist. Deviations are not looked at until the pusher has moved the part's radius on along the
 plan (or the plan ends); then the loop looks again. Each time counts against the budget.
 
+**Lost track.** A camera may not see the part (the pusher hides it, or it left the view): the
+perception then says so (:meth:`Tracker.unseen`) instead of giving a pose. The pusher stops
+where it is and the tracker looks again; once the part is seen again it is observed at rest as
+after a deviation and re-planned from, since it may have moved while unseen. Seen by no
+observation for :data:`LOST_PATIENCE` seconds, the tracker gives up.
+
 **Giving up.** When the goal is certified unreachable from the observed pose
 (:meth:`planner.Planner.certify_unreachable`), when no plan is found from where the plan has
 ended, or when the re-plans and the goings-on exceed the budget, the tracker gives up with the
@@ -79,7 +85,8 @@ from ..queries.session import Planner
 from .approach import approach, first_edge
 from .trajectory import Trajectory, planned_part, trajectory
 
-__all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "REPLAN_LIMIT", "FRACTION", "SETTLE", "SIGMAS",
+__all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "LOST_PATIENCE", "REPLAN_LIMIT", "FRACTION", "SETTLE",
+           "SIGMAS",
            "Action", "Command", "Replan", "Tracker", "mean_pose"]
 
 #: Thresholds: this fraction of the goal tolerance, and at least this many noise deviations.
@@ -88,6 +95,8 @@ FRACTION, SIGMAS = 0.5, 5.0
 CONFIRM = 3
 #: Observations of the part at rest averaged before a re-plan or the final check.
 SETTLE = 5
+#: Longest time, s, the part may go unseen before the tracker gives up (module docstring, "Lost track").
+LOST_PATIENCE = 3.0
 #: Re-plans allowed in one run.
 BUDGET = 8
 #: Default time limit of a re-plan's search, s: a robot waits that long at most (a join to the
@@ -231,6 +240,7 @@ class Tracker:
         self.reason = ""  # why the tracker gave up
         self.done = False
         self._strikes, self._jump, self._last = 0, 0.0, None
+        self._unseen: float | None = None  # since when the part has not been seen
         self._body = shapely.Polygon(pusher_frame_body(scene.pusher.width, scene.pusher.depth))
         self._trigger: tuple[np.ndarray, tuple[float, float], str, bool] | None = None
         self._window: list[np.ndarray] = []  # the observations since the pusher stopped
@@ -310,8 +320,10 @@ class Tracker:
         planned = self.expected[k]
         return pose_error(pose, planned)
 
-    def observe(self, now: float, pose: ArrayLike) -> Command:
+    def observe(self, now: float, pose: ArrayLike, seen_at: float | None = None) -> Command:
         """Take the part's observed pose at ``now`` and say what the pusher does (module docstring).
+        ``seen_at`` is when the part was where ``pose`` says (default: ``now``): a camera's image
+        is in hand its latency after it was taken, and it is compared with the plan at that time.
 
         Raises
         ------
@@ -320,7 +332,8 @@ class Tracker:
         """
         pose = self._pose(pose, "pose")
         now = float(now)
-        error = self.error(now, pose)
+        self._unseen = None
+        error = self.error(now if seen_at is None else float(seen_at), pose)
         if self.done or self.reason:
             return self._command(Action.DONE if self.done else Action.GIVE_UP, now, error)
         if self._held is not None:
@@ -340,6 +353,22 @@ class Tracker:
             self._stop(now)
             return self._command(Action.STOP, now, error)
         return self._command(Action.FOLLOW, now, error)
+
+    def unseen(self, now: float, why: str) -> Command:
+        """The part was not seen at ``now`` (``why``): the pusher stops where it is and the tracker
+        looks again, giving up after :data:`LOST_PATIENCE` s unseen (module docstring, "Lost track")."""
+        now, error = float(now), (math.nan, math.nan)
+        if self.done or self.reason:
+            return self._command(Action.DONE if self.done else Action.GIVE_UP, now, error)
+        self._unseen = now if self._unseen is None else self._unseen
+        if now - self._unseen >= LOST_PATIENCE:
+            return self._give_up(now, error, f"lost track of the part for {now - self._unseen:.1f} s: {why}")
+        if self._held is None:
+            k = min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
+            self._trigger = (self.expected[k], error, f"lost track: {why}", False)
+            self._stop(now)
+        self._window = []  # the part at rest is observed anew once seen
+        return self._command(Action.STOP, now, error)
 
     def _slid(self, now: float, pose: np.ndarray) -> bool:
         """Whether the part, observed at ``pose``, strayed as a push that does not stick makes it:

@@ -45,6 +45,7 @@ from mechanics import Slider, pose_error
 from .bodies import slider_at
 from .fields import SceneError, shown
 from .options import PlannerOptions
+from .camera import Camera
 from .robot import Robot
 
 __all__ = ["OBSTACLE_HEIGHT", "ONE_PART", "PART_HEIGHT", "Part", "Pusher", "Scene"]
@@ -99,6 +100,7 @@ class Scene:
     path: str | None = None  # the file it was read from
     notes: tuple[str, ...] = ()  # what was not read from the CAD files it names (text, open chains)
     robot: Robot | None = None  # the arm holding the pusher (None: a pusher that floats)
+    camera: Camera | None = None  # the overhead depth camera (None: the file has no camera block)
     #: The first obstacles' heights above the table (m); those after them, the other parts that
     #: :meth:`move_scene` and the transfers stand in the way, are as high as a part
     #: (:data:`PART_HEIGHT`). Only an arm's links can meet an obstacle's top (planner.world.reach).

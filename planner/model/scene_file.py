@@ -31,6 +31,7 @@ from .bodies import slider_at
 from .files import write_atomic
 from .fields import ANGLE, LENGTH, SceneError, integer, keys, number, shown, vector
 from .options import DEFAULT_TRANSIT, PlannerOptions, check_transit
+from .camera import Camera, read_camera
 from .robot import Robot, read_robot
 from .scale import check_scale
 from .scene import OBSTACLE_HEIGHT, ONE_PART, Part, Pusher, Scene
@@ -100,7 +101,8 @@ def plain_scene(scene: Scene, options: PlannerOptions | None = None) -> dict[str
              "workspace": {"min": list(scene.workspace[:2]), "max": list(scene.workspace[2:])},
              "tolerance": {"position": scene.tolerance_position, "angle": _degrees(scene.tolerance_angle)},
              "planner": {key: getattr(options, key) for key in PLANNER_KEYS} | {"margin": options.margin.to_dict()},
-             **({"robot": scene.robot.to_dict()} if scene.robot is not None else {})}
+             **({"robot": scene.robot.to_dict()} if scene.robot is not None else {}),
+             **({"camera": scene.camera.to_dict()} if scene.camera is not None else {})}
     if scene.names == (ONE_PART,):
         part = scene.part()
         return {"name": scene.name, "slider": _plain_part(part), "pusher": {**pusher_data, "edges": list(part.edges)},
@@ -351,7 +353,8 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     """
     if isinstance(data, dict) and "parts" in data:
         return _parse_parts(data, default_name, path)
-    required, optional = ("slider", "pusher", "workspace", "start", "goal"), ("name", "obstacles", "tolerance", "planner", "robot")
+    required = ("slider", "pusher", "workspace", "start", "goal")
+    optional = ("name", "obstacles", "tolerance", "planner", "robot", "camera")
     keys(data, "scene", (), required + optional, suggest=("parts",))  # a tray's "part:" is a typo of parts:
     if not any(key in data for key in ONE_PART_KEYS):  # neither form: say both, not what one part misses
         raise SceneError("parts", "missing: a scene has parts: (each with its own start and goal) or slider, start "
@@ -368,7 +371,8 @@ def parse_scene(data: Any, default_name: str = "scene", path: str | None = None)
     goal = read_pose(spec["goal"], "goal", slider, table.obstacles, table.workspace)
     part = Part(ONE_PART, slider, start, goal, edges, cf_uncertainty)
     return Scene(name, (part,), pusher, table.obstacles, table.workspace, table.tolerance_position,
-                 table.tolerance_angle, table.options, path, tuple(notes), table.robot, table.heights)
+                 table.tolerance_angle, table.options, path, tuple(notes), table.robot, table.camera,
+                 table.heights)
 
 
 @dataclass(frozen=True)
@@ -382,6 +386,7 @@ class Table:
     tolerance_angle: float
     options: PlannerOptions
     robot: Robot | None = None
+    camera: Camera | None = None
     heights: tuple[float, ...] = ()  # the obstacles' (Scene.heights)
 
 
@@ -416,7 +421,8 @@ def read_table(spec: dict, folder: Path, notes: list[str], transit: str) -> Tabl
     opts = keys(spec.get("planner", {}), "planner", (), PLANNER_KEYS)
     return Table(obstacles, workspace, tol_pos, tol_ang,
                  PlannerOptions().merged({**opts, "transit": transit}, prefix="planner."),
-                 None if spec.get("robot") is None else read_robot(spec["robot"], workspace), heights)
+                 None if spec.get("robot") is None else read_robot(spec["robot"], workspace),
+                 read_camera(spec["camera"], workspace) if "camera" in spec else None, heights)
 
 
 def read_cf_uncertainty(spec: dict, slider: Slider, name: str) -> float:
@@ -444,7 +450,8 @@ def _parse_parts(data: dict, default_name: str, path: str | None) -> Scene:
         if key in data:
             raise SceneError(key, "a scene has parts: (each with its own start and goal) or slider, start and goal, "
                                   "not both")
-    spec = keys(data, "scene", ("parts", "pusher", "workspace"), ("name", "obstacles", "tolerance", "planner", "robot"))
+    spec = keys(data, "scene", ("parts", "pusher", "workspace"),
+                ("name", "obstacles", "tolerance", "planner", "robot", "camera"))
     name = read_name(spec.get("name", default_name))
     folder, notes = Path(path).parent if path else Path(), []
     pusher, _, transit = read_pusher(spec["pusher"], False)
@@ -468,7 +475,8 @@ def _parse_parts(data: dict, default_name: str, path: str | None) -> Scene:
     for which in ("start", "goal"):
         _apart(parts, which)
     return Scene(name, tuple(parts), pusher, table.obstacles, table.workspace, table.tolerance_position,
-                 table.tolerance_angle, table.options, path, tuple(notes), table.robot, table.heights)
+                 table.tolerance_angle, table.options, path, tuple(notes), table.robot, table.camera,
+                 table.heights)
 
 
 def _part_name(value: Any, field_name: str) -> str:

@@ -30,7 +30,7 @@ __all__ = ["MAX_NOISE", "RunOptions"]
 MAX_NOISE = (0.1, math.pi / 4)
 
 #: The options that only apply to a simulation.
-_SIMULATION = ("sim_mu", "sim_cf_offset", "start_error", "bumps", "pose_noise", "closed_loop", "mjcf")
+_SIMULATION = ("sim_mu", "sim_cf_offset", "start_error", "bumps", "pose_noise", "closed_loop", "observe", "mjcf")
 
 
 @dataclass(frozen=True)
@@ -52,6 +52,7 @@ class RunOptions:
     bumps: tuple[tuple[float, float, float, float], ...] = ()  # (t s, dx m, dy m, dtheta rad): knocks
     pose_noise: tuple[float, float] | None = None  # the closed loop's observation noise (m, rad)
     closed_loop: bool = False  # observe the part and re-plan when it strays (planner.execution.tracker)
+    observe: str | None = None  # the closed loop's observer: "truth" (the default) or "camera"
     mjcf: Path | None = None  # write the first run's MuJoCo model here
     #: Map the goal positions reachable in at most this many (1 or 2) stable pushes.
     reach: int | None = None
@@ -84,6 +85,11 @@ class RunOptions:
             for name in _SIMULATION:
                 if getattr(self, name) not in (None, False, ()):
                     raise SceneError(name, "only applies with simulate (a number of MuJoCo runs)")
+        if self.observe is not None and not self.closed_loop:
+            raise SceneError("observe", "only applies with closed_loop (the open loop observes nothing)")
+        if self.observe == "camera" and self.pose_noise is not None:
+            raise SceneError("pose_noise", "is the truth observer's noise; a camera has its own (the scene's camera: "
+                                           "block)")
         for name in ("start_error", "pose_noise", "sim_cf_offset"):
             if (values := getattr(self, name)) is not None and not all(abs(v) < math.inf for v in values):
                 raise SceneError(name, f"must be finite, got {' '.join(map(str, values))}")

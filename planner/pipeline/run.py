@@ -149,7 +149,7 @@ def _simulated(scene: Scene, options: RunOptions, planner_options: PlannerOption
         if len(scene.parts) == 1:
             session.plan(start=result.start)
     return closed_loop(session, result, options.simulate, seed, options.sim_mu, cf_offset, start_error,
-                       options.bumps, options.pose_noise or (0.0, 0.0))
+                       options.bumps, options.pose_noise or (0.0, 0.0), options.observe or "truth")
 
 
 def check_outputs(options: RunOptions) -> None:

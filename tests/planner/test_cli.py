@@ -591,7 +591,7 @@ def test_a_mistyped_key_gets_a_did_you_mean(tmp_path, capsys):
      "(one part)"),
     # A scene's field named as a flag is (--seed) is the file's, not the flag's.
     (lambda text: text + "\nseed: 3\n", "plan: error: seed: unknown key (known: parts, pusher, workspace, name, "
-                                         "obstacles, tolerance, planner, robot)")])
+                                         "obstacles, tolerance, planner, robot, camera)")])
 def test_a_tray_file_with_a_wrong_key_is_told_about_the_tray_form(change, line, tmp_path, capsys):
     """Issue 41: "part:" for "parts:" suggested "start", and a scene field named like a flag was
     printed as the flag (--part)."""

@@ -1,0 +1,67 @@
+"""Registration of a known outline to edge points: the pose that puts the outline through them.
+
+The points are the edge points a depth image gives of one part (:mod:`.silhouette`), world
+``(x, y)``; the outline is the part's polygon in its own frame. The pose minimises the sum of a
+robust function (scipy's ``soft_l1``, linear beyond ``scale``) of each point's distance to the
+outline placed there, so that a few points of something else (a corner rounded by the smoothing,
+a speck) pull it little. Distances to the nearest edge are those to the nearest point of any
+segment, so the fit is 2-D ICP with the matching done exactly at every step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from mechanics import transform_points, wrap_angle
+from mechanics.se2 import inverse
+
+__all__ = ["Fit", "distances", "register"]
+
+
+@dataclass(frozen=True)
+class Fit:
+    """A registration: the ``pose`` (world ``(x, y, theta)``), each point's distance to the outline
+    there (``distance``, m) and the Jacobian of those distances in the pose (``jacobian``, ``(n, 3)``)."""
+
+    pose: np.ndarray
+    distance: np.ndarray
+    jacobian: np.ndarray
+
+    def cost(self, scale: float) -> float:
+        """The robust cost minimised (``soft_l1`` at ``scale``), per point."""
+        return float(np.mean(2 * scale ** 2 * (np.sqrt(1 + (self.distance / scale) ** 2) - 1)))
+
+
+def distances(points: np.ndarray, outline: np.ndarray, pose: np.ndarray) -> np.ndarray:
+    """The distance of each world point of ``points`` (``(n, 2)``) to the closed polygon ``outline``
+    (``(m, 2)``, its own frame) placed at ``pose``.
+
+    >>> square = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float)
+    >>> distances(np.array([[0.5, -0.25], [1.5, 1.5], [0.5, 0.5]]), square, np.zeros(3)).round(6).tolist()
+    [0.25, 0.707107, 0.5]
+    """
+    local = transform_points(points, inverse(pose))
+    a, b = outline, np.roll(outline, -1, axis=0)
+    edge = b - a
+    along = np.einsum("nmk,mk->nm", local[:, None, :] - a, edge) / np.einsum("mk,mk->m", edge, edge)
+    nearest = a + np.clip(along, 0.0, 1.0)[..., None] * edge
+    return np.linalg.norm(local[:, None, :] - nearest, axis=-1).min(axis=1)
+
+
+def register(points: np.ndarray, outline: np.ndarray, start: np.ndarray, scale: float) -> Fit:
+    """The pose of ``outline`` nearest ``start`` through ``points`` (module docstring); ``scale``
+    (m) is the distance beyond which a point counts as an outlier, about a pixel's footprint."""
+    def residuals(pose: np.ndarray) -> np.ndarray:
+        return distances(points, outline, pose)
+
+    found = least_squares(residuals, np.asarray(start, dtype=float), loss="soft_l1", f_scale=scale,
+                          x_scale=np.array([scale, scale, scale / max(float(np.abs(outline).max()), scale)]),
+                          diff_step=1e-6, max_nfev=200)
+    pose = np.array([*found.x[:2], float(wrap_angle(found.x[2]))])
+    step = np.diag([1e-6, 1e-6, 1e-6])
+    here = residuals(pose)
+    jacobian = np.column_stack([(residuals(pose + d) - here) / 1e-6 for d in step])
+    return Fit(pose, here, jacobian)
