@@ -6,9 +6,10 @@ planner), and a scene not solved must say why.
 A scene: a table 0.9-1.3 m by 0.8-1.0 m; a Panda or a UR5e at the middle of its near edge, facing
 across it, with a tool 0.08-0.2 m long pushing 5-30 mm above the table; a rectangular part
 4-12 cm by 3-8 cm, its start and goal 0.35-0.65 m from the base (inside either arm's reach
-zone) and at least 5 cm apart, anywhere round it on the table; up to two box obstacles clear of both. The examples are a
-hundredth of the Hypothesis profile's (8 in CI): each plans and follows a trajectory of thousands
-of samples. A start the arm cannot serve may be refused (one line, exit 1) and a goal not reached
+zone) and at least 5 cm apart, anywhere round it on the table; up to two box obstacles clear of
+both. The examples are a two-hundredth of the Hypothesis profile's (4 in CI; `--hypothesis-profile
+long` runs 100, as the runs reported on issue 39 did): each plans and follows a trajectory of
+thousands of samples. A start the arm cannot serve may be refused (one line, exit 1) and a goal not reached
 said so (exit 2).
 """
 
@@ -31,7 +32,7 @@ from test_joints import check_joints  # noqa: E402
 
 pytestmark = pytest.mark.slow
 # Not shrunk: an example costs seconds, and the one found is printed whole.
-FEW = settings(max_examples=max(4, settings().max_examples // 100), deadline=None,
+FEW = settings(max_examples=max(4, settings().max_examples // 200), deadline=None,
                phases=[Phase.explicit, Phase.reuse, Phase.generate],
                suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 
