@@ -110,7 +110,6 @@ def check_joints(scene_file: Path, out: Path) -> dict:
 
 
 CASES = {
-    "swap (a tray), ur5e": ("parts/swap.yaml", {"model": "ur5e", "base": [0.0, -0.4, 90], "tool_length": 0.12}),
     "arm/tray (shipped, a tray), ur5e": ("arm/tray.yaml", None),
 }
 

@@ -124,12 +124,13 @@ def test_simulate_with_the_arm_from_the_command_line(tmp_path):
 @pytest.mark.slow
 @pytest.mark.parametrize("scene, robot", [
     ("parts/swap.yaml", {"model": "ur5e", "base": [0.0, -0.4, 90], "tool_length": 0.12}),
-    ("junction.yaml", {"model": "panda", "base": [0.0, 0.4, -90], "tool_length": 0.1, "push_height": 0.02}),
-], ids=["swap (a tray), ur5e", "junction, panda"])
+    ("arm/wrist.yaml", None),
+], ids=["swap (a tray), ur5e", "arm/wrist (shipped), panda"])
 def test_the_arm_delivers_other_scenes(tmp_path, scene, robot):
-    run = plan(str(with_robot(tmp_path, scene, robot)), "--simulate", "2", cwd=tmp_path)
+    path = ROOT / "scenes" / scene if robot is None else with_robot(tmp_path, scene, robot)
+    run = plan(str(path), "--simulate", "2", cwd=tmp_path)
     assert run.returncode == 0, run.stdout + run.stderr
-    assert f"pusher held by the {robot['model']} arm" in run.stdout
+    assert f"pusher held by the {yaml.safe_load(path.read_text())['robot']['model']} arm" in run.stdout
 
 
 @pytest.mark.slow
