@@ -117,8 +117,9 @@ class ArmReach:
         wrist leaves joints near their stops, where the path soon cannot be followed."""
         x, y, _ = (float(v) for v in self.robot.base)
         low, high = self.arm.lower, self.arm.upper
+        middle = (low[-1] + high[-1]) / 2
         facing = family_posture(self.robot, math.hypot(pose[0] - x, pose[1] - y))
-        facing[-1] = (low[-1] + high[-1]) / 2
+        facing[-1] = middle
         at, _ = self.pusher_frame(facing)
         turn = math.atan2(pose[1] - y, pose[0] - x) - math.atan2(at[1] - y, at[0] - x)
         facing[0] = float(np.clip(facing[0] + math.remainder(turn, 2 * math.pi), low[0], high[0]))
@@ -130,7 +131,6 @@ class ArmReach:
         # one where pushing straight away from the base (psi = 0, planner.world.reach) would put
         # it nearest the middle of its range, so that the psi the planner allows either way fits.
         psi = math.remainder(float(pose[2]) - math.atan2(pose[1] - y, pose[0] - x), 2 * math.pi)
-        middle = (low[-1] + high[-1]) / 2
         branches = [wrist + k * 2 * math.pi for k in (-1, 0, 1) if low[-1] <= wrist + k * 2 * math.pi <= high[-1]]
         facing[-1] = min(branches, key=lambda q: abs(q + psi - middle)) if branches else float(np.clip(wrist, low[-1], high[-1]))
         q, miss = self.solve(pose, facing, height=height, settle=True)

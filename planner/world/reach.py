@@ -156,7 +156,7 @@ class ReachZone:
         # metre); the bound changes with rho at most at its steepest slope per metre.
         return min(ring, (self.bound(rho) - abs(psi)) / (turn + 1.0 / self.inner + self._slope))
 
-    @property
+    @functools.cached_property
     def _slope(self) -> float:
         rho, bound = self.wrist
         return float(np.abs(np.diff(bound) / np.diff(rho)).max(initial=0.0))
