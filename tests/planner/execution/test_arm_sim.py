@@ -76,16 +76,32 @@ def test_the_pusher_prism_sits_on_the_flange_where_the_arm_holds_the_pusher(mode
             assert np.linalg.norm(corners[:, :2] - point, axis=1).min() < 1e-3, (point, corners)
 
 
-def test_a_joint_trajectory_5_cm_off_fails_the_run(around):
-    """(That the arm's own joints deliver the part: test_simulate_with_the_arm_from_the_command_line.)"""
-    scene, plan, setup, joints = around
-    # Doctored: the arm's joints solved for the pusher's targets moved 5 cm along y, across the pushes.
-    motion = setup.motion
-    off = joint_trajectory(scene.robot, motion.t, np.c_[motion.x, motion.y + 0.05, motion.theta], motion.z,
-                           motion.segment)
-    doctored = mujoco_sim.simulate(scene, plan, 1, arm=(motion, off))
-    assert not doctored.passed and not doctored.runs[0].in_goal, doctored.lines()
-    assert 0.045 < doctored.runs[0].tracking < 0.06
+def test_a_joint_trajectory_5_cm_off_fails_the_run_and_the_command_exits_3(tmp_path, monkeypatch, capsys):
+    """(That the arm's own joints deliver the part: test_simulate_with_the_arm_from_the_command_line.)
+    The command given, in place of the arm's joints, ones solved for the pusher's targets moved 5 cm
+    along y, across the pushes: the run fails, and the command exits 3."""
+    import planner.execution.arm_timing
+    from planner.cli import main
+
+    honest = planner.execution.arm_timing.arm_trajectory
+    runs = []
+
+    def doctored(scene, plan):
+        motion, _ = honest(scene, plan)
+        off = joint_trajectory(scene.robot, motion.t, np.c_[motion.x, motion.y + 0.05, motion.theta], motion.z,
+                               motion.segment)
+        return motion, off
+
+    real = mujoco_sim.simulate
+    monkeypatch.setattr(planner.execution.arm_timing, "arm_trajectory", doctored)
+    monkeypatch.setattr(mujoco_sim, "simulate", lambda *a, **k: runs.append(real(*a, **k)) or runs[-1])
+    code = main([str(AROUND), "--simulate", "1", "--seed", "1", "--out", str(tmp_path / "out")])
+    out = capsys.readouterr().out
+    assert code == 3, out
+    (simulation,) = runs
+    assert not simulation.passed and not simulation.runs[0].in_goal, out  # the run itself fails, not only the check
+    assert 0.045 < simulation.runs[0].tracking < 0.06
+    assert "simulate: FAILED" in out
 
 
 @pytest.mark.slow
