@@ -51,9 +51,10 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -74,6 +75,10 @@ from .mujoco_sim import (SETTLE, TABLE_MU, ByPart, Feet, Runs, World, _one, _wor
 from .tracker import BUDGET, CONFIRM, Replan, Tracker, mean_pose
 from .tracker import SETTLE as AT_REST  # observations of the parts at rest (mujoco_sim's SETTLE is seconds)
 from .trajectory import RATE, Trajectory
+
+if TYPE_CHECKING:  # mink is loaded only for an arm
+    from ..arm.reach import ArmReach
+    from .arm_sim import SimArm
 
 __all__ = ["GRACE", "OBSERVERS", "OBSERVE_HZ", "PATIENCE", "ClosedLoop", "ClosedRun", "Seen", "closed_loop"]
 
@@ -185,6 +190,7 @@ class ClosedLoop(Runs):
     runs: tuple[ClosedRun, ...]
     mu: float
     starts: dict[str, np.ndarray]  # where the parts were placed: the first moved by any start error
+    arm: "SimArm | None" = None  # the arm that held the pusher (arm_sim), for a scene with a robot
 
     @property
     def start(self) -> np.ndarray:
@@ -206,7 +212,7 @@ class ClosedLoop(Runs):
 
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:
         """Write the first run's model, the parts where they were placed (:func:`.mujoco_sim.mjcf`)."""
-        write_mjcf(path, scene, self.runs[0].supports, self.mu, self.starts)
+        write_mjcf(path, scene, self.runs[0].supports, self.mu, self.starts, arm=self.arm)
 
     def executed_files(self, name: str) -> list[str]:
         """The executed paths' file names, one per run: ``<name>.executed.csv`` for the first (the
@@ -281,11 +287,11 @@ class _Loop:
         return self.tracker.pusher_at(now)
 
     def observe(self, now: float, seen: dict[str, np.ndarray], taken: float | None = None,
-                lost: Mapping[str, str] | None = None) -> bool:
+                lost: Mapping[str, str] | None = None, hidden: Collection[str] = ()) -> bool:
         """Take every part's observed pose at ``now``, of the parts as they were at ``taken``
-        (default: ``now``; a camera's latency before), and the parts not seen with why (``lost``:
-        the moving part's tracker stops the pusher and looks again; a part not seen is not
-        judged); whether the run has ended."""
+        (default: ``now``; a camera's latency before), and the parts not seen with why (``lost``,
+        those of them ``hidden`` partly seen: :meth:`.tracker.Tracker.unseen`; a part not seen is
+        not judged); whether the run has ended."""
         lost = lost or {}
         if self._held is not None:
             if not lost:  # the mean of the parts at rest needs every part seen
@@ -294,7 +300,7 @@ class _Loop:
                 self._replan(now)
             return self.done or bool(self.reason)
         if self.moving in lost:
-            command = self.tracker.unseen(now, lost[self.moving])
+            command = self.tracker.unseen(now, lost[self.moving], self.moving in hidden)
         else:
             command = self.tracker.observe(now, seen[self.moving], taken)
             self._seen = seen[self.moving]
@@ -374,6 +380,29 @@ class _Loop:
         self._left = left if lone.part != left else None
 
 
+class _ArmDriver:
+    """The arm's servos' reference in a closed loop (module docstring, "With a robot"): at each
+    sample, the pose the loop asks of the pusher, reached from the posture of the sample before
+    (:meth:`planner.arm.reach.ArmReach.follow`, as the joints file's samples are); linear in between,
+    at the rate that gets it there."""
+
+    def __init__(self, reach: "ArmReach", start: np.ndarray):
+        self.reach = reach
+        self.times, self.postures = (0.0, 0.0), (start, start)
+        self.rate = np.zeros_like(start)
+
+    def advance(self, u: float, pose: np.ndarray, height: float) -> None:
+        """Reach the pusher's pose ``pose`` at ``height`` for time ``u``, the next sample's."""
+        before, now = self.postures[1], self.times[1]
+        posture, _ = self.reach.follow(pose, before, height, u - now)
+        self.times, self.postures, self.rate = (now, u), (before, posture), (posture - before) / (u - now)
+
+    def __call__(self, u: float) -> tuple[np.ndarray, np.ndarray]:
+        (t0, t1), (q0, q1) = self.times, self.postures
+        share = 1.0 if t1 <= t0 else min(max((u - t0) / (t1 - t0), 0.0), 1.0)
+        return q0 + share * (q1 - q0), self.rate
+
+
 def _after_first_move(plan: Plan, motion: Trajectory) -> float:
     """Seconds of ``motion``, the trajectory of ``plan``, after its first move (the later moves,
     with their transfers): 0 for a plan of one move."""
@@ -383,21 +412,29 @@ def _after_first_move(plan: Plan, motion: Trajectory) -> float:
 
 def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | None, starts: dict[str, np.ndarray],
          bumps: tuple, noise: np.ndarray, rng: np.random.Generator, seed: int | None, later: float,
-         camera: Camera | None = None) -> ClosedRun:
+         camera: Camera | None = None, arm: "SimArm | None" = None) -> ClosedRun:
     """One run of :func:`closed_loop`, each part on its ``supports`` and placed at ``starts``;
     ``later`` is how long the plan runs after its first move (:func:`_after_first_move`). With
     ``camera``, the parts are observed through it (:class:`.camera_observer.CameraObserver`, at
     its frame rate, each image in hand its latency after it was taken); else as MuJoCo has them,
-    with Gaussian ``noise``."""
+    with Gaussian ``noise``. With ``arm`` (a scene with a robot), the arm holds the pusher and
+    follows the loop's pusher (:class:`_ArmDriver`)."""
     scene = session.scene
     clock = time.perf_counter()
-    world = World(scene, supports, mu, starts, bumps)
+    world = World(scene, supports, mu, starts, bumps, arm)
     loop = _Loop(session, plan, (float(noise[0]), float(noise[1])), seed)
     limit = PATIENCE * (loop.tracker.motion.duration + later) + GRACE
 
-    def pusher(u: float) -> tuple[list[float], list[float]]:
+    def free(u: float) -> tuple[list[float], list[float]]:
         pose, height, rate, _ = loop.pusher_at(u)
         return [pose[0], pose[1], height, pose[2]], [rate[0], rate[1], rate[3], rate[2]]
+
+    if arm is None:
+        pusher, joints = free, None
+    else:
+        from ..arm.reach import ArmReach  # loads mink: only for an arm
+
+        pusher = joints = _ArmDriver(ArmReach(scene.robot), arm.q[0])
 
     eye = None if camera is None else CameraObserver(world, scene, camera, plan.starts, rng)
     every = max(1, round(RATE / OBSERVE_HZ))
@@ -406,6 +443,9 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
     rows, moving, collisions, faults, k = [], [], 0, {}, 0
     while True:
         u = k / RATE
+        if joints is not None and k > 0:
+            pose, height, _, _ = loop.pusher_at(u)
+            joints.advance(u, pose, height)
         world.step_to(SETTLE + u, pusher)
         pose, height, rate, contact = loop.pusher_at(u)
         parts = np.ravel([world.pose(n) for n in scene.names])
@@ -430,7 +470,10 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
             errors += [pose_error(e.pose, truth[n]) for n, e in found.items() if e.tracked]
             lost = {n: e.lost for n, e in found.items() if not e.tracked}
             lost_time += 1 / camera.rate if lost else 0.0
-            ended = loop.observe(u, {n: e.pose for n, e in found.items() if e.tracked}, taken, lost)
+            hidden = {n for n, e in found.items() if e.hidden}
+            ended = loop.observe(u, {n: e.pose for n, e in found.items() if e.tracked}, taken, lost, hidden)
+            if loop.moving in hidden:  # pushed blind: it is looked for where the plan has it next
+                eye.priors[loop.moving] = loop.tracker.planned(u)
         if ended or u > limit:
             break
         k += 1
@@ -472,9 +515,19 @@ def closed_loop(session: Planner, plan: Plan, n: int = 3, seed: int = 1, mu: flo
         raise SceneError("observe", f"must be one of {', '.join(OBSERVERS)}, got {observe!r}")
     camera = None if observe == "truth" else scene.camera or read_camera(None, scene.workspace)
     sets = foot_sets(scene, n, seed, cf_offset)
-    setup = perturbations(scene, plan, session.model, start_error, bumps, noise)
+    held = None
+    if scene.robot is None:
+        setup = perturbations(scene, plan, session.model, start_error, bumps, noise)
+    else:
+        from .arm_sim import sim_arm  # loads mink: only for an arm
+        from .arm_timing import arm_trajectory
+
+        motion, joints = arm_trajectory(scene, plan)
+        setup = perturbations(scene, plan, session.model, start_error, bumps, noise, motion=motion)
+        held = sim_arm(scene.robot, setup.lead, setup.motion, joints)
     rng = np.random.default_rng(seed)
     sigma = np.asarray(noise, dtype=float)
     later = _after_first_move(plan, setup.motion)
-    runs = tuple(_run(session, plan, s, mu, setup.starts, setup.bumps, sigma, rng, seed, later, camera) for s in sets)
-    return ClosedLoop(runs, scene.pusher.mu if mu is None else mu, setup.starts)
+    runs = tuple(_run(session, plan, s, mu, setup.starts, setup.bumps, sigma, rng, seed, later, camera, held)
+                 for s in sets)
+    return ClosedLoop(runs, scene.pusher.mu if mu is None else mu, setup.starts, held)

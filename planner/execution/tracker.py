@@ -50,11 +50,19 @@ meets a part askew turns it flush and funnels its error (open loop in MuJoCo), a
 may exist. Deviations are not looked at until the pusher has moved the part's radius on along the
 plan (or the plan ends); then the loop looks again. Each time counts against the budget.
 
-**Lost track.** A camera may not see the part (the pusher hides it, or it left the view): the
-perception then says so (:meth:`Tracker.unseen`) instead of giving a pose. The pusher stops
-where it is and the tracker looks again; once the part is seen again it is observed at rest as
-after a deviation and re-planned from, since it may have moved while unseen. Seen by no
-observation for :data:`LOST_PATIENCE` seconds, the tracker gives up.
+**Lost track.** A camera may not see the part (the pusher or the arm hides it, or it left the
+view): the perception then says so (:meth:`Tracker.unseen`) instead of giving a pose. Where the
+part is *hidden* (some of its outline is seen where it was expected, too little to fix its pose)
+and was last seen on the plan (within the thresholds), the pusher goes on blind: a stable push
+carries the part whatever its support and friction (that is what the plan was chosen for), a part
+waiting for the pusher stays where it is, and the part is judged again at the next observation,
+or when the plan ends (whether it is in its goal needs it seen).
+Otherwise (not seen at all, or last seen off the plan) the pusher stops where it is and the
+tracker looks again; once the part is seen again it is observed at rest as after a deviation and
+re-planned from, since it may have moved while unseen. Seen by no observation for
+:data:`LOST_PATIENCE` seconds while stopped, the tracker gives up. (An arm between an overhead
+camera and the part hides it for most of a push and of the approach to it: holding still does
+not help there, going on does.)
 
 **Giving up.** When the goal is certified unreachable from the observed pose
 (:meth:`planner.Planner.certify_unreachable`), when no plan is found from where the plan has
@@ -313,12 +321,14 @@ class Tracker:
         self._edge = self._segments[int(self.motion.segment[k])].edge
         self._held, self._window = (pose, height), []
 
+    def planned(self, now: float) -> np.ndarray:
+        """The part's planned pose at ``now``."""
+        k = min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
+        return self.expected[k].copy()
+
     def error(self, now: float, pose: np.ndarray) -> tuple[float, float]:
         """The distance (m) and heading difference (rad) of ``pose`` from the part's planned pose at ``now``."""
-        u = now - self._since
-        k = min(int(np.searchsorted(self.motion.t, u)), len(self.motion.t) - 1)
-        planned = self.expected[k]
-        return pose_error(pose, planned)
+        return pose_error(pose, self.planned(now))
 
     def observe(self, now: float, pose: ArrayLike, seen_at: float | None = None) -> Command:
         """Take the part's observed pose at ``now`` and say what the pusher does (module docstring).
@@ -354,12 +364,17 @@ class Tracker:
             return self._command(Action.STOP, now, error)
         return self._command(Action.FOLLOW, now, error)
 
-    def unseen(self, now: float, why: str) -> Command:
-        """The part was not seen at ``now`` (``why``): the pusher stops where it is and the tracker
-        looks again, giving up after :data:`LOST_PATIENCE` s unseen (module docstring, "Lost track")."""
+    def unseen(self, now: float, why: str, hidden: bool = False) -> Command:
+        """The part was not seen at ``now`` (``why``; ``hidden``: partly seen where it was expected):
+        a hidden part last seen on the plan is followed blind; else the pusher stops where it is
+        and the tracker looks again, giving up after :data:`LOST_PATIENCE` s unseen (module
+        docstring, "Lost track")."""
         now, error = float(now), (math.nan, math.nan)
         if self.done or self.reason:
             return self._command(Action.DONE if self.done else Action.GIVE_UP, now, error)
+        if (hidden and self._held is None and self._last is not None and not self._strikes
+                and now - self._since < self.motion.duration):  # the plan's end needs the part seen
+            return self._command(Action.FOLLOW, now, error)  # blind (module docstring, "Lost track")
         self._unseen = now if self._unseen is None else self._unseen
         if now - self._unseen >= LOST_PATIENCE:
             return self._give_up(now, error, f"lost track of the part for {now - self._unseen:.1f} s: {why}")

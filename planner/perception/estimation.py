@@ -20,6 +20,13 @@ footprint), if the pose is poorly fixed (its deviation beyond :data:`MAX_SIGMA`,
 straight side is seen), or if the camera sees the table inside the outline at the pose found
 (beyond :data:`TABLE_INSIDE` of its pixels): then the part is not where the fit put it.
 
+A lost track is *hidden* (:attr:`Estimate.hidden`) when it is lost for want of sight alone: too
+little of the outline seen (under :data:`MIN_VISIBLE`) where the points fit it, or too few points
+where something taller than the parts (the pusher, the arm) stands over at least :data:`HIDDEN`
+of the area where the part was. The part is then likely still there, under it; a part out of view,
+or gone from where the table now shows, is not hidden. The closed loop goes on blind through a
+hidden part's push (:mod:`planner.execution.tracker`, "Lost track").
+
 The covariance has two terms. The noise's is the Gauss-Newton one, the inverse of ``J^T J`` (``J``
 the distances' Jacobian at the inlying points) times their mean square distance, times
 :data:`CORRELATED`: the smoothing of the heights makes neighbouring edge points share their
@@ -47,7 +54,7 @@ from .registration import Fit, distances, register
 from .silhouette import Silhouette, silhouette
 from .table_view import smoothed_noise, table_view
 
-__all__ = ["CONTRAST", "CORRELATED", "GATE", "MAX_SIGMA", "MIN_POINTS", "MIN_VISIBLE", "SYSTEMATIC", "TABLE_INSIDE", "Estimate", "estimate_poses"]
+__all__ = ["CONTRAST", "CORRELATED", "GATE", "MAX_SIGMA", "HIDDEN", "MIN_POINTS", "MIN_VISIBLE", "SYSTEMATIC", "TABLE_INSIDE", "Estimate", "estimate_poses"]
 
 #: Farthest an edge point may be from a part's outline at its prior and still be the part's, m:
 #: how far a part may move between two images (a knock of 2.5 cm and 12 degrees moves a 5 cm
@@ -59,6 +66,9 @@ CONTRAST = 3.0
 MIN_POINTS = 20
 #: Least fraction of the outline seen (within two pixels' footprint of an inlying edge point).
 MIN_VISIBLE = 0.3
+#: Least share of where a part was, by area, that something taller must stand over for a part not
+#: seen at all to be hidden rather than gone (:class:`Estimate`).
+HIDDEN = 0.5
 #: Largest deviation of a good estimate's noise: m in position, radians in heading.
 MAX_SIGMA = (0.002, np.radians(2.0))
 #: Largest fraction of the pixels inside a part's outline (shrunk by two pixels) that may be table.
@@ -75,7 +85,9 @@ class Estimate:
     ``covariance`` (m, m, rad), the median distance of its points to the outline there
     (``residual``, m), the fraction of the outline seen (``visible``) and the number of edge points
     (``points``); ``lost`` says why the track is lost (then ``pose`` and ``covariance`` are None),
-    empty if it is not."""
+    empty if it is not, and ``hidden`` whether it is lost for want of sight alone: something taller
+    stands between the camera and where the part was, and what is seen of it does not say it left
+    (module docstring)."""
 
     pose: np.ndarray | None
     covariance: np.ndarray | None
@@ -83,6 +95,7 @@ class Estimate:
     visible: float
     points: int
     lost: str = ""
+    hidden: bool = False
 
     @property
     def tracked(self) -> bool:
@@ -150,6 +163,11 @@ def _judge(seen: Silhouette, outline: np.ndarray, prior: np.ndarray, points: np.
     """The estimate of ``fit`` of ``points`` (a part of ``outline`` last at ``prior``), or a lost
     track if it fails a check (module docstring); ``pixel`` is a pixel's footprint there (m)."""
     if fit is None or len(points) < MIN_POINTS:
+        where = slider_at(shapely.Polygon(outline), prior)
+        covered = seen.occluded_inside(where) / max(where.area / pixel ** 2, 1.0)
+        if covered >= HIDDEN:
+            return Estimate(None, None, np.nan, 0.0, len(points),
+                            f"hidden: something taller stands over {min(covered, 1.0):.0%} of where it was", hidden=True)
         return Estimate(None, None, np.nan, 0.0, len(points), "not seen: the part is out of view or hidden")
     fit = _nearest_alike(fit, outline, prior)
     inlying = fit.distance <= 2 * pixel
@@ -164,7 +182,7 @@ def _judge(seen: Silhouette, outline: np.ndarray, prior: np.ndarray, points: np.
            "ambiguous: the points do not fix the pose" if max(sigma[:2]) > MAX_SIGMA[0] or sigma[2] > MAX_SIGMA[1] else
            f"the table is seen where the part would be ({table:.0%} of it)" if table > TABLE_INSIDE else "")
     if why:
-        return Estimate(None, None, residual, visible, len(points), why)
+        return Estimate(None, None, residual, visible, len(points), why, hidden=visible < MIN_VISIBLE)
     floor = SYSTEMATIC * pixel
     covariance = noise + np.diag([floor ** 2, floor ** 2, (floor / Slider(outline).radius) ** 2])
     return Estimate(fit.pose, covariance, residual, visible, len(points))

@@ -108,3 +108,27 @@ def test_observe_camera_is_refused_where_it_means_nothing(tmp_path, capsys, flag
     out = tmp_path / "o"
     assert main(["scenes/battery.yaml", "--simulate", "1", *flags, "--out", str(out)]) == 1
     assert capsys.readouterr().err == f"plan: error: {line}\n" and not out.exists()
+
+
+def test_a_hidden_part_last_seen_on_the_plan_is_pushed_blind_and_one_not_seen_at_all_stops_the_pusher():
+    """Hidden (partly seen where it was, or covered by something taller): a stable push carries the
+    part, so the pusher goes on along the plan; a part not seen at all, or last seen off the plan,
+    stops it; and the plan's end is not passed blind."""
+    session = Planner(load_scene("scenes/battery.yaml"))
+    plan = session.plan(seed=1)
+    tracker = Tracker(session, plan)
+    start = session.scene.start
+    assert tracker.observe(0.0, start).kind == Action.FOLLOW
+    blind = [tracker.unseen(t, "too occluded", hidden=True) for t in (0.5, 1.0)]
+    assert [c.kind for c in blind] == [Action.FOLLOW] * 2
+    assert np.allclose(blind[1].pusher, tracker.pusher_at(1.0)[0]) and not np.allclose(blind[0].pusher, blind[1].pusher)
+    assert tracker.unseen(1.1, "not seen").kind == Action.STOP
+
+    off = Tracker(session, plan)
+    off.observe(0.0, start + [0.01, 0.0, 0.0])  # beyond the thresholds: a strike
+    assert off.unseen(0.05, "too occluded", hidden=True).kind == Action.STOP
+
+    late = Tracker(session, plan)
+    late.observe(0.0, start)
+    end = late.motion.duration + 0.1
+    assert late.unseen(end, "too occluded", hidden=True).kind == Action.STOP

@@ -119,13 +119,21 @@ def test_a_part_under_a_wide_cover_is_lost_not_guessed(face):
     scene = table({"a": BOX}, pusher=(0.1, 0.1))
     found = estimate(scene, {"a": [0.0, 0.0, 0.0]}, pusher=(face, 0.0, 0.007, 0.0))["a"]
     assert not found.tracked and found.pose is None and found.covariance is None, found
+    # Hidden, not gone: the cover stands over where the box was (the loop may push it blind).
+    assert found.hidden, found.lost
+
+
+def test_a_part_gone_from_where_it_was_is_not_hidden():
+    """The prior says (0, 0), the box is 20 cm away, nothing over (0, 0): the table shows there."""
+    found = estimate(table({"a": BOX}), {"a": [0.2, 0.0, 0.0]}, {"a": [0.0, 0.0, 0.0]})["a"]
+    assert not found.tracked and not found.hidden, found
 
 
 def test_a_part_out_of_view_is_lost():
     scene = table({"a": BOX, "b": BOX})
     found = estimate(scene, {"a": [0.2, 0.2, 0.0], "b": [5.0, 0.0, 0.0]}, {"a": [0.2, 0.2, 0.0], "b": [0.3, 0.0, 0.0]})
     assert found["a"].tracked and not found["b"].tracked
-    assert found["b"].lost == "not seen: the part is out of view or hidden"
+    assert found["b"].lost == "not seen: the part is out of view or hidden" and not found["b"].hidden
 
 
 def test_two_parts_side_by_side_are_each_found():
