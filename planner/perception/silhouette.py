@@ -52,7 +52,7 @@ class Silhouette:
     def table_inside(self, outline: shapely.Polygon) -> int:
         """How many table pixels, on the table plane, fall inside ``outline`` (world frame)."""
         ring = np.asarray(outline.exterior.coords)
-        corners = self.view.camera.pixels(np.column_stack([ring, np.zeros(len(ring))]))
+        corners = self.view.camera.pixels(np.column_stack([ring, np.zeros(len(ring))])) - self.view.corner
         (u0, v0), (u1, v1) = corners.min(axis=0), corners.max(axis=0)
         height, width = self.table.shape
         rows = slice(max(int(np.floor(v0)), 0), max(min(int(np.ceil(v1)) + 1, height), 0))

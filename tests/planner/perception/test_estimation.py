@@ -14,7 +14,7 @@ import pytest
 
 from mechanics import pose_error, transform_points
 from planner.execution.depth_camera import PART_TOP
-from planner.perception.estimation import estimate_poses
+from planner.perception.estimation import estimate_poses, sight
 from staged import BOX, SQUARE, staged, table
 
 
@@ -192,3 +192,26 @@ def test_the_pushers_wall_seen_aslant_is_not_taken_for_the_part():
     assert found.tracked, found
     distance, turn = errors(found, truth)
     assert distance < 0.001 and turn < 1.0, (distance, turn)
+
+
+def test_an_image_cast_only_where_the_estimator_reads_gives_the_same_estimates():
+    """Two parts, one beside the table's wall (a third of the pixels round it are the part's or the
+    wall's): the sight round their priors is a small part of the image; the camera casts rays there
+    only, with the same depths as the whole image's; the estimates from that image are those from
+    the whole image (noise-free, so pixel for pixel the same where they are read)."""
+    scene = table({"a": BOX, "b": SQUARE})
+    truth = {"a": np.array([0.44, 0.0, 1.5]), "b": np.array([-0.1, 0.2, 0.3])}
+    world, eye = staged(scene, truth)
+    outlines = {p.name: p.slider.vertices for p in scene.parts}
+    priors = {n: p + [0.003, -0.002, 0.03] for n, p in truth.items()}
+    looked = sight(scene.camera, outlines, PART_TOP, priors)
+    assert looked.mean() < 0.15
+    whole, seen = eye.exact(), eye.exact(looked)
+    assert np.array_equal(seen[looked], whole[looked]) and not seen[~looked].any()
+    full = estimate_poses(eye.image(None), scene.camera, outlines, PART_TOP, priors)
+    part = estimate_poses(eye.image(None, looked), scene.camera, outlines, PART_TOP, priors)
+    for name, pose in truth.items():
+        assert full[name].tracked and part[name].tracked
+        assert np.allclose(full[name].pose, part[name].pose, atol=1e-9), name
+        distance, turn = errors(part[name], pose)
+        assert distance < 0.001 and turn < 1.0, (name, distance, turn)
