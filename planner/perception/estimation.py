@@ -27,7 +27,8 @@ straight side is seen), or if the camera sees the table inside the outline at th
 (beyond :data:`TABLE_INSIDE` of its pixels): then the part is not where the fit put it.
 
 The covariance has two terms. The noise's is the Gauss-Newton one, the inverse of ``J^T J`` (``J``
-the distances' Jacobian at the inlying points) times their mean square distance, times
+the Jacobian of the inlying points' distances across their edges, the points at corners left out:
+:class:`.registration.Fit`) times their mean square distance, times
 :data:`CORRELATED`: the smoothing of the heights makes neighbouring edge points share their
 noise, so they are worth fewer independent measurements than their count; the pose is poorly
 fixed if this term's deviations pass :data:`MAX_SIGMA`. The other is what is left when the noise

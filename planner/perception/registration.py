@@ -24,7 +24,11 @@ __all__ = ["Fit", "distances", "register"]
 @dataclass(frozen=True)
 class Fit:
     """A registration: the ``pose`` (world ``(x, y, theta)``), each point's distance to the outline
-    there (``distance``, m) and the Jacobian of those distances in the pose (``jacobian``, ``(n, 3)``)."""
+    there (``distance``, m) and the Jacobian in the pose of each point's distance to the line of its
+    nearest edge (``jacobian``, ``(n, 3)``): what an edge point measures is how far the edge is
+    across it, not where the edge ends, since an edge may end in the image where something hides
+    the rest of it (the pusher, the image's border). With only parallel edges seen, the pose along
+    them is not fixed, and the Jacobian says so."""
 
     pose: np.ndarray
     distance: np.ndarray
@@ -43,12 +47,28 @@ def distances(points: np.ndarray, outline: np.ndarray, pose: np.ndarray) -> np.n
     >>> distances(np.array([[0.5, -0.25], [1.5, 1.5], [0.5, 0.5]]), square, np.zeros(3)).round(6).tolist()
     [0.25, 0.707107, 0.5]
     """
+    return _to_edges(points, outline, pose)[0].min(axis=1)
+
+
+def _to_edges(points: np.ndarray, outline: np.ndarray, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distance of each world point of ``points`` to each edge of ``outline`` at ``pose``, and
+    where along the edge's line (0 to 1 from its first vertex to its second) it is nearest, ``(n, m)`` each."""
     local = transform_points(points, inverse(pose))
     a, b = outline, np.roll(outline, -1, axis=0)
     edge = b - a
     along = np.einsum("nmk,mk->nm", local[:, None, :] - a, edge) / np.einsum("mk,mk->m", edge, edge)
     nearest = a + np.clip(along, 0.0, 1.0)[..., None] * edge
-    return np.linalg.norm(local[:, None, :] - nearest, axis=-1).min(axis=1)
+    return np.linalg.norm(local[:, None, :] - nearest, axis=-1), along
+
+
+def _across(points: np.ndarray, outline: np.ndarray, pose: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """The signed distance of each world point of ``points`` to the line of its edge of ``outline``
+    (``edges``, an index per point) at ``pose``."""
+    local = transform_points(points, inverse(pose))
+    a = outline[edges]
+    edge = np.roll(outline, -1, axis=0)[edges] - a
+    off = local - a
+    return (edge[:, 0] * off[:, 1] - edge[:, 1] * off[:, 0]) / np.linalg.norm(edge, axis=1)
 
 
 def register(points: np.ndarray, outline: np.ndarray, start: np.ndarray, scale: float) -> Fit:
@@ -61,7 +81,14 @@ def register(points: np.ndarray, outline: np.ndarray, start: np.ndarray, scale: 
                           x_scale=np.array([scale, scale, scale / max(float(np.abs(outline).max()), scale)]),
                           diff_step=1e-6, max_nfev=200)
     pose = np.array([*found.x[:2], float(wrap_angle(found.x[2]))])
-    step = np.diag([1e-6, 1e-6, 1e-6])
-    here = residuals(pose)
-    jacobian = np.column_stack([(residuals(pose + d) - here) / 1e-6 for d in step])
-    return Fit(pose, here, jacobian)
+    near, along = _to_edges(points, outline, pose)
+    edges = near.argmin(axis=1)
+    across = _across(points, outline, pose, edges)
+    jacobian = np.column_stack([(_across(points, outline, pose + d, edges) - across) / 1e-6
+                                for d in np.diag([1e-6, 1e-6, 1e-6])])
+    # A point at a corner (within two scales of its edge's ends, or beyond them) says where the edge
+    # ends, which may be where the rest of it is hidden: it measures nothing (Fit).
+    length = np.linalg.norm(np.roll(outline, -1, axis=0) - outline, axis=1)[edges]
+    at = np.take_along_axis(along, edges[:, None], axis=1)[:, 0] * length
+    jacobian[(at < 2 * scale) | (at > length - 2 * scale)] = 0.0
+    return Fit(pose, near.min(axis=1), jacobian)

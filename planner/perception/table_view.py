@@ -89,8 +89,11 @@ def table_view(depth: np.ndarray, camera: Camera, window: tuple[slice, slice] | 
     v, u = np.nonzero(plane_pixels(depth.shape) & (depth > 0))
     points = camera.position + depth[v, u][:, None] * camera.rays(np.column_stack([u, v]))
     xy, z = points[:, :2], points[:, 2]
+    # The lattice's heights are not smoothed (its pixels are far apart): the bands round the plane are
+    # at least three deviations of a pixel's own noise wide, so that they cut its noise evenly.
+    spread = 3 * camera.noise * depth[v, u] ** 2
     plane = np.zeros(3)
-    for band in PLANE_BAND:
+    for band in (PLANE_BAND[0], *[np.maximum(PLANE_BAND[1], spread)] * 2):
         use = np.abs(z - xy @ plane[:2] - plane[2]) < band
         if use.sum() < 3:
             break
