@@ -119,7 +119,8 @@ taken:
   where no ray was cast (the estimator reads only round the parts); coloured over the table's
   depths and twice a part's height either side, so the table is mid-range, a part darker and the
   pixels not cast the light end. The default blueprint shows run 1's in a 2-D view of its own
-  (in the world's view they would be a cloud of points hiding the outlines);
+  and leaves the cameras out of the world's view (there the images would be clouds of points
+  hiding the outlines, and the frustum lines across the view);
 * ``/world/closed_loop/<k>/seen/estimate`` -- each image's estimated outlines (none for a part
   lost), orange, labelled ``camera``, over ``/world/closed_loop/<k>/seen/truth``, the outlines
   where MuJoCo had the parts when the image was taken, drawn red and labelled ``lost track:
@@ -597,9 +598,10 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
     name, edge = _analysed(scene, plan)
     first = scene.part(name).slider
     # A camera run's depth images in a view of their own: in the world's, the viewer draws each as a
-    # cloud of fat points over the table, which hides the outlines.
+    # cloud of fat points over the table, which hides the outlines, and the camera's frustum, near
+    # the view's eye, as lines across it.
     cameras = closed_loop is not None and len(scene.parts) == 1 and closed_loop.runs[0].seen is not None
-    depths = tuple(f"/world/closed_loop/{k}/camera/depth" for k in range(1, len(closed_loop.runs) + 1)) if cameras else ()
+    depths = tuple(f"/world/closed_loop/{k}/camera/**" for k in range(1, len(closed_loop.runs) + 1)) if cameras else ()
     views = [_top_view("/world", scene.name, (xmin + xmax) / 2, (ymin + ymax) / 2, max(xmax - xmin, ymax - ymin) / 2,
                        depths),
              _top_view("/analysis", f"{look[name].label('pushed edge')} (slider frame)", *first.cf, 6 * first.radius)]
