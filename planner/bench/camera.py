@@ -9,8 +9,9 @@ starts, the pusher off the table, ``--frames`` times through
 --closed-loop --observe camera``); a row gives the median seconds per frame of the depth image,
 of the estimate and of both.
 
-*Accuracy*: a box of 8 x 5 cm and a square of 6 cm, each alone on a bare 1 m table under its
-default camera (0.947 m high), at ``--poses`` random poses anywhere on the table, the priors
+*Accuracy*: a box of 8 x 5 cm and a square of 6 cm, each alone on a bare square table
+``--table`` m across (default 1 m: its default camera hangs 0.947 m high) under its default
+camera, at ``--poses`` random poses anywhere on it (up to 8 cm from its walls), the priors
 3 mm and 2 degrees off (1-sigma); a row gives the estimates' error against the pose MuJoCo holds
 the part at (median, 95th percentile and worst), how many were lost and the mean squared
 Mahalanobis distance of the errors under the estimates' covariances (3 for a covariance exactly
@@ -83,16 +84,18 @@ def timed(observer: CameraObserver, frames: int) -> tuple[float, float, float]:
     return tuple(statistics.median(column) for column in zip(*rows))
 
 
-def accuracy(vertices: list, poses: int, seed: int) -> str:
-    """The accuracy table's row of the part ``vertices`` (module docstring)."""
-    scene = parse_scene({"parts": [{"name": "a", "vertices": vertices, "start": [0, -0.3, 0], "goal": [0, 0.3, 0]}],
+def accuracy(vertices: list, side: float, poses: int, seed: int) -> str:
+    """The accuracy table's row of the part ``vertices`` on a table ``side`` m across (module docstring)."""
+    half = side / 2
+    scene = parse_scene({"parts": [{"name": "a", "vertices": vertices, "start": [0, -0.3 * half, 0],
+                                    "goal": [0, 0.3 * half, 0]}],
                          "pusher": {"width": 0.05, "depth": 0.01, "mu": 0.5},
-                         "workspace": {"min": [-0.5, -0.5], "max": [0.5, 0.5]}})
+                         "workspace": {"min": [-half, -half], "max": [half, half]}})
     world, observer = watching(scene, seed)
     rng = np.random.default_rng(seed)
     errors, mahalanobis, lost = [], [], 0
     for _ in range(poses):
-        truth = np.array([*rng.uniform(-0.42, 0.42, 2), rng.uniform(-math.pi, math.pi)])
+        truth = np.array([*rng.uniform(0.08 - half, half - 0.08, 2), rng.uniform(-math.pi, math.pi)])
         world.data.qpos[world.slots["a"]] = truth
         observer.priors["a"] = truth + rng.normal(0.0, [PRIOR[0], PRIOR[0], PRIOR[1]])
         found = observer.look()["a"]
@@ -110,12 +113,14 @@ def accuracy(vertices: list, poses: int, seed: int) -> str:
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(prog="python -m planner.bench.camera", description=__doc__.splitlines()[0])
     p.add_argument("scenes", nargs="*", default=list(SCENES))
-    p.add_argument("--frames", type=int, default=10, help="looks timed per scene")
+    p.add_argument("--frames", type=int, default=10, help="looks timed per scene (0: no time table)")
     p.add_argument("--poses", type=int, default=40, help="random poses per part of the accuracy table (0: none)")
+    p.add_argument("--table", type=float, default=1.0, help="the accuracy table's table, m across")
     p.add_argument("--seed", type=int, default=1)
     args = p.parse_args(argv)
-    print("| scene | camera | image s | estimate s | frame s |\n|---|---|---|---|---|")
-    for path in args.scenes:
+    if args.frames:
+        print("| scene | camera | image s | estimate s | frame s |\n|---|---|---|---|---|")
+    for path in args.scenes if args.frames else ():
         scene = load_scene(path)
         _, observer = watching(scene, args.seed)
         width, height = observer.camera.resolution
@@ -126,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
         print("\n| part | position error median / p95 / worst | heading error median / p95 / worst | lost | "
               "mean squared Mahalanobis |\n|---|---|---|---|---|")
         for name, vertices in PARTS.items():
-            print(f"| {name} | {accuracy(vertices, args.poses, args.seed)} |", flush=True)
+            print(f"| {name} | {accuracy(vertices, args.table, args.poses, args.seed)} |", flush=True)
     return 0
 
 
