@@ -86,9 +86,9 @@ OBSERVE_HZ = 20.0
 OBSERVERS = ("truth", "camera")
 #: A run is stopped after this many times the first plan's duration plus this many seconds.
 PATIENCE, GRACE = 3.0, 20.0
-#: The camera's depth images kept for the recording: about this many a second, and of each every
-#: this many-th pixel along its rows and columns (a sixteenth of the pixels, in whole millimetres:
-#: 51 kB an image at 848 x 480), so that a run's images take a few megabytes.
+#: The camera's depth images kept for the recording: about this many a second, and of each the
+#: middle pixel of every square this many pixels a side (a sixteenth of the pixels, in whole
+#: millimetres: 51 kB an image at 848 x 480), so that a minute's images take a few megabytes.
 DEPTH_HZ, DEPTH_STEP = 2.0, 4
 
 
