@@ -15,6 +15,7 @@ import pytest
 from mechanics import pose_error, transform_points
 from planner.execution.depth_camera import PART_TOP
 from planner.perception.estimation import estimate_poses, sight
+from planner.perception.registration import distances, register
 from staged import BOX, SQUARE, staged, table
 
 
@@ -231,3 +232,26 @@ def test_a_part_whose_ends_are_hidden_is_lost_not_slid_along_its_sides():
         found = estimate(scene, {"a": truth}, {"a": truth + [-0.002, 0.0, 0.01]}, pusher=(0.0134, -0.0024, 0.0, 0.4149),
                          seed=seed)["a"]
         assert not found.tracked and found.lost.startswith("ambiguous"), (seed, found)
+
+
+def test_the_fits_jacobian_is_the_distances_change_across_the_edges_and_nothing_at_corners():
+    """Points scattered a millimetre round a box's outline at a known pose: the fit finds the pose;
+    its Jacobian is the distances' change with the pose (numerical differences) for the points along
+    the edges, and zero for those within two scales of a corner."""
+    box = np.array(BOX, dtype=float)
+    pose = np.array([0.1, -0.2, 0.7])
+    rng = np.random.default_rng(3)
+    ring = np.vstack([box, box[:1]])
+    steps = rng.uniform(0.0, 1.0, 200)
+    side = rng.integers(0, 4, 200)
+    local = ring[side] + steps[:, None] * (ring[side + 1] - ring[side]) + rng.normal(0.0, 0.0005, (200, 2))
+    points = transform_points(local, pose)
+    fit = register(points, box, pose + [0.002, -0.001, 0.02], 0.001)
+    assert np.abs(fit.pose - pose).max() < 5e-4
+    numerical = np.column_stack([(distances(points, box, fit.pose + h) - fit.distance) / 1e-7
+                                 for h in np.diag([1e-7] * 3)])
+    length = np.linalg.norm(ring[side + 1] - ring[side], axis=1)
+    inner = (steps * length > 0.003) & ((1 - steps) * length > 0.003)  # clear of the corners' two scales
+    corner = (steps * length < 0.001) | ((1 - steps) * length < 0.001)
+    assert np.allclose(fit.jacobian[inner], numerical[inner], atol=1e-4)
+    assert not fit.jacobian[corner].any()
