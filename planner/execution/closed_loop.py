@@ -35,7 +35,8 @@ workspace) at the camera's frame rate, finds the parts in them
 camera's latency after the image was taken, to be compared with the plan at the time it was
 taken. A part not seen (a lost track) stops the pusher while the camera looks again
 (:meth:`.tracker.Tracker.unseen`). MuJoCo's poses at the images' times are kept beside the
-estimates, only to say how far off they were (:class:`Seen`).
+estimates, only to say how far off they were (:class:`Seen`) and to draw them in the recording
+(:class:`Image`, with some of the depth images, downsampled).
 
 A run ends when every part is observed at rest in its goal (one part: the tracker is done), when
 it gives up (the tracker, for one part; no plan of the moves left, or the budget spent, for
@@ -67,6 +68,7 @@ from ..model.fields import SceneError, counted
 from ..model.plan import Plan
 from ..model.scene import Scene
 from ..model.segments import Transit
+from ..perception.estimation import Estimate
 from ..queries.session import Planner
 from .approach import first_edge, lead_in_pose
 from .camera_observer import CameraObserver
@@ -80,7 +82,8 @@ if TYPE_CHECKING:  # mink is loaded only for an arm
     from ..arm.reach import ArmReach
     from .arm_sim import SimArm
 
-__all__ = ["GRACE", "OBSERVERS", "OBSERVE_HZ", "PATIENCE", "ClosedLoop", "ClosedRun", "Seen", "closed_loop"]
+__all__ = ["DEPTH_HZ", "DEPTH_STEP", "GRACE", "OBSERVERS", "OBSERVE_HZ", "PATIENCE", "ClosedLoop", "ClosedRun", "Image",
+           "Seen", "closed_loop"]
 
 #: Observations per second of simulated time (the truth observer; a camera has its own rate).
 OBSERVE_HZ = 20.0
@@ -88,6 +91,10 @@ OBSERVE_HZ = 20.0
 OBSERVERS = ("truth", "camera")
 #: A run is stopped after this many times the first plan's duration plus this many seconds.
 PATIENCE, GRACE = 3.0, 20.0
+#: The camera's depth images kept for the recording: about this many a second, and of each the
+#: middle pixel of every square this many pixels a side (a sixteenth of the pixels, in whole
+#: millimetres: 51 kB an image at 848 x 480), so that a minute's images take a few megabytes.
+DEPTH_HZ, DEPTH_STEP = 2.0, 4
 
 
 @dataclass(frozen=True)
@@ -153,13 +160,30 @@ class ClosedRun(ByPart):
 
 
 @dataclass(frozen=True)
+class Image:
+    """One image of a run's camera, as the recording shows it: when it was taken (``taken``, s on
+    the run's clock), each part's estimate from it and MuJoCo's pose of the part then (``truth``),
+    and, for about :data:`DEPTH_HZ` images a second, the depth image at the middle pixel of each
+    square of :data:`DEPTH_STEP` pixels, in mm (``depth``; 0: no return or no ray cast; None for the
+    other images)."""
+
+    taken: float
+    estimates: dict[str, Estimate]
+    truth: dict[str, np.ndarray]
+    depth: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
 class Seen:
     """How well a camera saw the parts in a run: each estimate's distance (m) and heading difference
-    (rad) from MuJoCo's pose at the time its image was taken (``errors``, ``(n, 2)``), and the
-    seconds of images in which some part was lost (``lost``)."""
+    (rad) from MuJoCo's pose at the time its image was taken (``errors``, ``(n, 2)``), the seconds
+    of images in which some part was lost (``lost``), and every image taken (``images``), with
+    the ``camera`` that took them."""
 
     errors: np.ndarray
     lost: float
+    camera: Camera | None = None
+    images: tuple[Image, ...] = ()
 
     def text(self) -> str:
         """The camera's part of a run's line: the errors' median, 95th percentile and worst."""
@@ -438,7 +462,9 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
 
     eye = None if camera is None else CameraObserver(world, scene, camera, plan.starts, rng)
     every = max(1, round(RATE / OBSERVE_HZ))
-    frames: deque = deque()  # the camera's images taken and not yet in hand: (in hand at, taken at, estimates, truth)
+    frames: deque[tuple[float, Image]] = deque()  # the camera's images taken and not yet in hand, and when they will be
+    images: list[Image] = []
+    keep = max(1, round(camera.rate / DEPTH_HZ)) if camera is not None else 1  # the images whose depth is kept
     shots, errors, lost_time = 0, [], 0.0  # images taken; the k-th at the first sample at or after k / rate
     rows, moving, collisions, faults, k = [], [], 0, {}, 0
     while True:
@@ -462,16 +488,23 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
             seen = {n: world.pose(n) + rng.normal(0.0, [noise[0], noise[0], noise[1]]) for n in scene.names}
             ended = loop.observe(u, seen)
         if eye is not None and u >= shots / camera.rate - 1e-9:
+            found = eye.look()
+            # The middle pixel of each square of DEPTH_STEP: never one of the table plane's lattice, which would
+            # speckle the picture.
+            middle = slice(DEPTH_STEP // 2, None, DEPTH_STEP)
+            depth = np.round(eye.image[middle, middle] * 1e3).astype(np.uint16) if shots % keep == 0 else None
             # The truth is kept beside the estimates to judge them, never handed to the loop.
-            frames.append((u + camera.latency, u, eye.look(), {n: world.pose(n) for n in scene.names}))
+            images.append(Image(u, found, {n: world.pose(n) for n in scene.names}, depth))
+            frames.append((u + camera.latency, images[-1]))
             shots += 1
         while frames and frames[0][0] <= u + 1e-9 and not ended:
-            _, taken, found, truth = frames.popleft()
-            errors += [pose_error(e.pose, truth[n]) for n, e in found.items() if e.tracked]
+            _, image = frames.popleft()
+            found = image.estimates
+            errors += [pose_error(e.pose, image.truth[n]) for n, e in found.items() if e.tracked]
             lost = {n: e.lost for n, e in found.items() if not e.tracked}
             lost_time += 1 / camera.rate if lost else 0.0
             hidden = {n for n, e in found.items() if e.hidden}
-            ended = loop.observe(u, {n: e.pose for n, e in found.items() if e.tracked}, taken, lost, hidden)
+            ended = loop.observe(u, {n: e.pose for n, e in found.items() if e.tracked}, image.taken, lost, hidden)
             if loop.moving in hidden:  # pushed blind: it is looked for where the plan has it next
                 eye.priors[loop.moving] = loop.tracker.planned(u)
         if ended or u > limit:
@@ -484,7 +517,7 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
     tracks = {n: table[:, 10 + 3 * j:13 + 3 * j] for j, n in enumerate(scene.names)}
     ends = {n: world.pose(n) for n in scene.names}
     reason = world.diverged or loop.reason or ("" if loop.done else f"not done after {limit:.0f} s")
-    seen = None if camera is None else Seen(np.array(errors).reshape(-1, 2), lost_time)
+    seen = None if camera is None else Seen(np.array(errors).reshape(-1, 2), lost_time, camera, tuple(images))
     return ClosedRun(dict(supports), {n: pose_error(end, scene.part(n).goal) for n, end in ends.items()},
                      {n: scene.delivered(n, end) for n, end in ends.items()}, tuple(loop.replans), reason, collisions,
                      time.perf_counter() - clock, float(table[-1, 0]), executed, tracks, tuple(loop.carried),

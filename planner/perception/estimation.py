@@ -10,6 +10,12 @@ prior a few millimetres off can hand a neighbour's edge to a part, a fit cannot.
 four poses alike, :attr:`mechanics.Slider.turns` about its centroid) is then given the look-alike
 pose nearest the prior: continuity decides what the image cannot.
 
+Only the pixels round the parts' priors are read: for each part, the image's rectangle round its
+outline at the prior widened by :data:`GATE`, so every edge point the gate lets through is in it,
+with the pixels its smoothed height depends on (:data:`PAD`); and a sparse lattice over the whole
+image that fits the table plane (:mod:`.table_view`). :func:`sight` says which pixels these are:
+a camera need cast no ray elsewhere, since what it would see there is never used.
+
 The estimate is checked before it is given (:class:`Estimate`): the track is *lost* if the part
 stands too little out of the depth noise where it is (half its height less than :data:`CONTRAST`
 deviations of the smoothed heights: then enough pixels of the table pass for the part, and of
@@ -28,7 +34,8 @@ or gone from where the table now shows, is not hidden. The closed loop goes on b
 hidden part's push (:mod:`planner.execution.tracker`, "Lost track").
 
 The covariance has two terms. The noise's is the Gauss-Newton one, the inverse of ``J^T J`` (``J``
-the distances' Jacobian at the inlying points) times their mean square distance, times
+the Jacobian of the inlying points' distances across their edges, the points at corners left out:
+:class:`.registration.Fit`) times their mean square distance, times
 :data:`CORRELATED`: the smoothing of the heights makes neighbouring edge points share their
 noise, so they are worth fewer independent measurements than their count; the pose is poorly
 fixed if this term's deviations pass :data:`MAX_SIGMA`. The other is what is left when the noise
@@ -51,15 +58,19 @@ from mechanics import Slider, transform_points, wrap_angle
 from ..model.bodies import slider_at
 from ..model.camera import Camera
 from .registration import Fit, distances, register
-from .silhouette import Silhouette, silhouette
-from .table_view import smoothed_noise, table_view
+from .silhouette import GUARD, Silhouette, silhouette
+from .table_view import SMOOTHING, plane_pixels, smoothed_noise, table_view
 
-__all__ = ["CONTRAST", "CORRELATED", "GATE", "MAX_SIGMA", "HIDDEN", "MIN_POINTS", "MIN_VISIBLE", "SYSTEMATIC", "TABLE_INSIDE", "Estimate", "estimate_poses"]
+__all__ = ["CONTRAST", "CORRELATED", "GATE", "HIDDEN", "MAX_SIGMA", "MIN_POINTS", "MIN_VISIBLE", "PAD", "SYSTEMATIC",
+           "TABLE_INSIDE", "Estimate", "estimate_poses", "sight"]
 
 #: Farthest an edge point may be from a part's outline at its prior and still be the part's, m:
 #: how far a part may move between two images (a knock of 2.5 cm and 12 degrees moves a 5 cm
 #: part's far corner by about 3 cm).
 GATE = 0.04
+#: Pixels round each part's rectangle of :func:`sight`: the smoothing's reach (three deviations), the
+#: guard round tall things (:data:`.silhouette.GUARD`), and the table pixel next to an edge's part pixel.
+PAD = 3 * round(SMOOTHING) + GUARD + 1
 #: Least ratio of half a part's height to the deviation of the smoothed heights there.
 CONTRAST = 3.0
 #: Fewest edge points of a part seen.
@@ -107,7 +118,7 @@ def estimate_poses(depth: np.ndarray, camera: Camera, outlines: Mapping[str, Arr
     """Each part's :class:`Estimate` from ``depth`` (z-depths, m; 0: no return) taken by ``camera``
     (its calibration): ``outlines`` are the parts' polygons (their own frames), ``top`` the height
     of their tops over the table (m), ``priors`` their last known poses (module docstring)."""
-    seen = silhouette(table_view(depth, camera), top)
+    seen = silhouette(table_view(depth, camera, _window(_rectangles(camera, outlines, top, priors))), top)
     shapes = {name: np.asarray(outline, dtype=float) for name, outline in outlines.items()}
     priors = {name: np.asarray(priors[name], dtype=float) for name in shapes}
     pixels = {name: _footprint(camera, priors[name], top) for name in shapes}
@@ -127,6 +138,48 @@ def estimate_poses(depth: np.ndarray, camera: Camera, outlines: Mapping[str, Arr
             refit = None if first[name] is None else _fit(points, shapes[name], found[name], pixels[name])
             estimates[name] = _judge(seen, shapes[name], priors[name], points, pixels[name], refit)
     return estimates
+
+
+def sight(camera: Camera, outlines: Mapping[str, ArrayLike], top: float, priors: Mapping[str, ArrayLike]) -> np.ndarray:
+    """The pixels :func:`estimate_poses` reads of ``camera``'s images, a mask of the image, for parts of
+    ``outlines`` at ``priors`` whose tops are ``top`` over the table (module docstring): the
+    rectangles round the parts (:func:`_rectangles`) and the lattice that fits the table plane
+    (:func:`.table_view.plane_pixels`)."""
+    width, height = camera.resolution
+    mask = plane_pixels((height, width))
+    for rows, columns in _rectangles(camera, outlines, top, priors):
+        mask[rows, columns] = True
+    return mask
+
+
+def _rectangles(camera: Camera, outlines: Mapping[str, ArrayLike], top: float,
+                priors: Mapping[str, ArrayLike]) -> list[tuple[slice, slice]]:
+    """For each part (``outlines`` at ``priors``, their tops ``top`` over the table), the rectangle
+    of the image (rows, columns) round its outline widened by :data:`GATE`, on the table and at
+    ``top``, and :data:`PAD` pixels more (empty where it is out of view); the whole image if some of
+    that is behind the camera."""
+    width, height = camera.resolution
+    found = []
+    for name, outline in outlines.items():
+        ring = np.asarray(slider_at(shapely.Polygon(outline), np.asarray(priors[name], dtype=float)).buffer(GATE)
+                          .exterior.coords)
+        points = np.vstack([np.column_stack([ring, np.full(len(ring), z)]) for z in (0.0, top)])
+        if ((points - camera.position) @ camera.T_world_camera[:3, 2] <= 0).any():
+            return [(slice(0, height), slice(0, width))]
+        pixels = camera.pixels(points)
+        (u0, v0), (u1, v1) = np.floor(pixels.min(axis=0)) - PAD, np.ceil(pixels.max(axis=0)) + PAD + 1
+        found.append((slice(int(np.clip(v0, 0, height)), int(np.clip(v1, 0, height))),
+                      slice(int(np.clip(u0, 0, width)), int(np.clip(u1, 0, width)))))
+    return found
+
+
+def _window(rectangles: list[tuple[slice, slice]]) -> tuple[slice, slice]:
+    """The smallest rectangle of the image holding all of ``rectangles`` (those not empty)."""
+    full = [(r, c) for r, c in rectangles if r.stop > r.start and c.stop > c.start]
+    if not full:
+        return slice(0, 0), slice(0, 0)
+    return (slice(min(r.start for r, _ in full), max(r.stop for r, _ in full)),
+            slice(min(c.start for _, c in full), max(c.stop for _, c in full)))
 
 
 def _shares(points: np.ndarray, shapes: dict[str, np.ndarray], poses: dict[str, np.ndarray],

@@ -62,7 +62,7 @@ class Silhouette:
     def _inside(self, mask: np.ndarray, outline: shapely.Polygon) -> int:
         """How many pixels of ``mask`` see the table plane inside ``outline``."""
         ring = np.asarray(outline.exterior.coords)
-        corners = self.view.camera.pixels(np.column_stack([ring, np.zeros(len(ring))]))
+        corners = self.view.camera.pixels(np.column_stack([ring, np.zeros(len(ring))])) - self.view.corner
         (u0, v0), (u1, v1) = corners.min(axis=0), corners.max(axis=0)
         height, width = self.table.shape
         rows = slice(max(int(np.floor(v0)), 0), max(min(int(np.ceil(v1)) + 1, height), 0))
