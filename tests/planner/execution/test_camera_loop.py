@@ -14,7 +14,7 @@ from planner.cli import main
 from planner.execution import camera_observer
 from planner.execution.closed_loop import DEPTH_HZ, closed_loop
 from planner.execution.mujoco_sim import World
-from planner.execution.tracker import LOST_PATIENCE, SETTLE, Action, Tracker
+from planner.execution.tracker import CONFIRM, LOOK_BACK, LOST_PATIENCE, SETTLE, Action, Tracker
 from planner.model.camera import read_camera
 from planner.outputs.recording import write_recording
 from test_recording import entities, rrd_rows
@@ -152,8 +152,9 @@ def test_observe_camera_is_refused_where_it_means_nothing(tmp_path, capsys, flag
 
 def test_a_hidden_part_last_seen_on_the_plan_is_pushed_blind_and_one_not_seen_at_all_stops_the_pusher():
     """Hidden (partly seen where it was, or covered by something taller): a stable push carries the
-    part, so the pusher goes on along the plan; a part not seen at all, or last seen off the plan,
-    stops it; and the plan's end is not passed blind."""
+    part, so the pusher goes on along the plan; a part not seen at all stops it; a hidden part after
+    a confirmed deviation, or at the plan's end (never passed blind), has the pusher stop and back
+    off along its own -x to look."""
     session = Planner(load_scene("scenes/battery.yaml"))
     plan = session.plan(seed=1)
     tracker = Tracker(session, plan)
@@ -165,10 +166,21 @@ def test_a_hidden_part_last_seen_on_the_plan_is_pushed_blind_and_one_not_seen_at
     assert tracker.unseen(1.1, "not seen").kind == Action.STOP
 
     off = Tracker(session, plan)
-    off.observe(0.0, start + [0.01, 0.0, 0.0])  # beyond the thresholds: a strike
-    assert off.unseen(0.05, "too occluded", hidden=True).kind == Action.STOP
+    kinds = [off.observe(0.05 * k, start + [0.01, 0.0, 0.0]).kind for k in range(CONFIRM)]
+    assert kinds[-1] == Action.STOP  # a deviation confirmed: held where it stopped
+    held = off.pusher_at(0.1)[0]
+    assert off.unseen(0.2, "too occluded", hidden=True).kind == Action.STOP
+    assert off.pusher_at(60.0)[0][0] < held[0] - 0.01  # backed off along -x (battery pushes along +x) to look
 
-    late = Tracker(session, plan)
-    late.observe(0.0, start)
-    end = late.motion.duration + 0.1
-    assert late.unseen(end, "too occluded", hidden=True).kind == Action.STOP
+    hidden = Tracker(session, plan)
+    hidden.observe(0.0, start)
+    end = hidden.motion.duration + 0.1
+    stop = hidden.unseen(end, "too occluded", hidden=True)
+    assert stop.kind == Action.STOP  # the plan's end is not passed blind: it backs off to look
+    there = hidden.pusher_at(end)[0]
+    back = hidden.pusher_at(end + 60.0)[0]
+    way = back[:2] - there[:2]
+    heading = np.array([math.cos(there[2]), math.sin(there[2])])
+    assert 0.0 < np.linalg.norm(way) <= LOOK_BACK + 1e-9 and np.dot(way, heading) < -0.99 * np.linalg.norm(way)
+    # Looking begins once it has backed off: no patience spent on the way.
+    assert hidden.unseen(end + 1.0, "too occluded", hidden=True).kind == Action.STOP
