@@ -14,7 +14,9 @@ to 10 degrees from straight down, its image turned by any yaw, from the least he
 5 % from the default camera's) at which that image holds the whole table, raised by 0-20 %; at
 one of the resolutions of the default
 sensor's modes (848 x 480, 640 x 360, 424 x 240), a field of view of 50-65 degrees, the default
-sensor's noise times 0.5-1.5, at 15 or 30 frames a second. A draw whose scene file is refused
+sensor's noise times 0.5-1.5 (lowered by fifths where a part at the table's farthest corner would
+not stand :data:`MARGIN` times the estimator's least contrast out of it: a cell's designer picks a
+sensor that sees its parts), at 15 or 30 frames a second. A draw whose scene file is refused
 (:func:`planner.model.scene_file.load_scene`: the part on an obstacle, say) is drawn again.
 """
 
@@ -29,16 +31,21 @@ import numpy as np
 import shapely
 import yaml
 
+from ..execution.depth_camera import PART_TOP
 from ..model.camera import DEFAULTS, read_camera
 from ..model.fields import SceneError
 from ..model.scene_file import load_scene
+from ..perception.estimation import CONTRAST
+from ..perception.table_view import smoothed_noise
 
-__all__ = ["MODES", "draw_scene", "main", "write_scenes"]
+__all__ = ["MARGIN", "MODES", "draw_scene", "main", "write_scenes"]
 
 #: The resolutions the cameras are drawn from (width, height): the default sensor's depth modes.
 MODES = ((848, 480), (640, 360), (424, 240))
 #: Clearance of the part from the table's edges, and of the obstacles from the start and goal, m.
 EDGE, CLEAR = 0.03, 0.06
+#: How far above the estimator's least contrast the parts stand out of the depth noise everywhere.
+MARGIN = 1.5
 
 
 def _outline(rng: np.random.Generator) -> tuple[str, list[list[float]]]:
@@ -101,7 +108,13 @@ def draw_scene(rng: np.random.Generator, name: str) -> dict:
         if (u > 0).all() and (u < resolution[0]).all() and (v > 0).all() and (v < resolution[1]).all():
             break
         height *= 1.05
-    camera.update(noise=round(DEFAULTS["noise"] * rng.uniform(0.5, 1.5), 6), rate=int(rng.choice([15, 30])))
+    # A cell's designer picks a sensor that sees its parts: the noise, where it would hide a part at the
+    # table's farthest corner from the camera (the estimator's test, planner.perception.estimation), lowered.
+    noise, seen = DEFAULTS["noise"] * rng.uniform(0.5, 1.5), read_camera(camera, (*low, *high))
+    farthest = float(np.max((corners + [0.0, 0.0, PART_TOP] - seen.position) @ seen.T_world_camera[:3, 2]))
+    while PART_TOP / 2 < MARGIN * CONTRAST * smoothed_noise(noise * farthest ** 2):
+        noise *= 0.8
+    camera.update(noise=round(noise, 6), rate=int(rng.choice([15, 30])))
     return {"name": f"{name}-{kind}", "slider": {"vertices": vertices, "cf": cf},
             "pusher": {"width": round(rng.uniform(0.03, 0.06), 4), "depth": 0.01, "mu": round(rng.uniform(0.4, 1.0), 2)},
             "obstacles": obstacles, "workspace": {"min": low, "max": high}, "start": start, "goal": goal,
