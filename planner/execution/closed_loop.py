@@ -281,9 +281,10 @@ class _Loop:
         return self.tracker.pusher_at(now)
 
     def observe(self, now: float, seen: dict[str, np.ndarray], taken: float | None = None,
-                lost: Mapping[str, str] | None = None) -> bool:
+                lost: Mapping[str, str] | None = None, covariances: Mapping[str, np.ndarray] | None = None) -> bool:
         """Take every part's observed pose at ``now``, of the parts as they were at ``taken``
-        (default: ``now``; a camera's latency before), and the parts not seen with why (``lost``:
+        (default: ``now``; a camera's latency before), with their ``covariances`` (a camera's
+        estimates'; default: the configured noise's), and the parts not seen with why (``lost``:
         the moving part's tracker stops the pusher and looks again; a part not seen is not
         judged); whether the run has ended."""
         lost = lost or {}
@@ -296,7 +297,7 @@ class _Loop:
         if self.moving in lost:
             command = self.tracker.unseen(now, lost[self.moving])
         else:
-            command = self.tracker.observe(now, seen[self.moving], taken)
+            command = self.tracker.observe(now, seen[self.moving], taken, (covariances or {}).get(self.moving))
             self._seen = seen[self.moving]
         if command.contact:
             self._left = None
@@ -427,10 +428,12 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
             shots += 1
         while frames and frames[0][0] <= u + 1e-9 and not ended:
             _, taken, found, truth = frames.popleft()
-            errors += [pose_error(e.pose, truth[n]) for n, e in found.items() if e.tracked]
+            tracked = {n: e for n, e in found.items() if e.tracked}
+            errors += [pose_error(e.pose, truth[n]) for n, e in tracked.items()]
             lost = {n: e.lost for n, e in found.items() if not e.tracked}
             lost_time += 1 / camera.rate if lost else 0.0
-            ended = loop.observe(u, {n: e.pose for n, e in found.items() if e.tracked}, taken, lost)
+            ended = loop.observe(u, {n: e.pose for n, e in tracked.items()}, taken, lost,
+                                 {n: e.covariance for n, e in tracked.items()})
         if ended or u > limit:
             break
         k += 1
