@@ -24,14 +24,17 @@ from planner.model.scene_file import parse_scene
 GAP = 0.003  # between the box's long sides and the slot's walls, m
 
 
-def pushed(walls: bool) -> Tracker:
-    """A tracker of the straight push, along the slot or in the open."""
-    obstacles = [{"box": {"center": [0.0, side * (0.03 + GAP + 0.01)], "size": [0.5, 0.02]}} for side in (1, -1)]
+def pushed(slot: float | None) -> Tracker:
+    """A tracker of the straight push, in the open (``slot`` None) or into a slot whose walls begin
+    at x = ``slot`` (and end at 0.25 m, beyond the push's end)."""
+    obstacles = [] if slot is None else [
+        {"box": {"center": [(slot + 0.25) / 2, side * (0.03 + GAP + 0.01)], "size": [0.25 - slot, 0.02]}}
+        for side in (1, -1)]
     scene = parse_scene({
         "name": "slot",
         "slider": {"vertices": [[-0.04, -0.03], [0.04, -0.03], [0.04, 0.03], [-0.04, 0.03]]},
         "pusher": {"width": 0.05, "depth": 0.015, "mu": 0.5, "transit": "none", "edges": [3]},
-        "obstacles": obstacles if walls else [],
+        "obstacles": obstacles,
         "workspace": {"min": [-0.4, -0.2], "max": [0.4, 0.2]},
         "start": [-0.1, 0.0, 0.0], "goal": [0.1, 0.0, 0.0]})
     session = Planner(scene)
@@ -40,12 +43,12 @@ def pushed(walls: bool) -> Tracker:
 
 @pytest.fixture(scope="module")
 def slot() -> Tracker:
-    return pushed(walls=True)
+    return pushed(-0.25)  # the box starts inside it
 
 
 @pytest.fixture(scope="module")
 def open_table() -> Tracker:
-    return pushed(walls=False)
+    return pushed(None)
 
 
 def along(tracker: Tracker) -> np.ndarray:
@@ -61,6 +64,20 @@ def test_in_the_open_the_thresholds_are_half_the_goal_tolerance(open_table):
 
 def test_in_a_slot_the_sweep_may_take_half_the_clearance(slot):
     assert np.allclose(along(slot), [0.005, math.radians(1.0), 0.0015], rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("ahead, sweep", [(0.03, 0.0015), (0.08, None)])
+def test_the_room_is_the_least_the_plan_keeps_over_the_part_s_half_diagonal_ahead(ahead, sweep):
+    """The box starts outside the slot, its front ``ahead`` short of the walls. 3 cm short, it is in
+    the slot before it has moved its 5 cm half-diagonal on: at the start the sweep's threshold is
+    already the slot's. 8 cm short, the walls are farther than that, and the room there (3 cm to the
+    walls' ends at least) leaves the position's and the heading's thresholds the stricter."""
+    tracker = pushed(-0.06 + ahead)  # the box's front starts at x = -6 cm
+    first = tracker.threshold_at(0.0)[2]
+    if sweep is None:
+        assert first >= 0.005 + 0.05 * math.radians(1.0) - 1e-12
+    else:
+        assert first == pytest.approx(sweep)
 
 
 def test_a_noisy_observation_raises_them_to_three_sigma(slot, open_table):
