@@ -285,7 +285,7 @@ class Tracker:
         self._segments: list = []
         self.motion: Trajectory | None = None
         self.expected = np.zeros((0, 3))
-        self.clearance = np.zeros(0)  # the room ahead of each sample, m (_room_ahead)
+        self.ahead = np.zeros(0)  # the room ahead of each sample, m (_room_ahead)
         self._theta = np.zeros(0)
         self._since, self._quiet = float(time), 0.0
         start = self._pose(plan.start, "plan.start")
@@ -313,7 +313,7 @@ class Tracker:
         led = plan.with_segments(segments)
         self.motion = trajectory(self.scene, led)
         self.expected = planned_part(self.scene, led, self.motion)
-        self.clearance = self._room_ahead()
+        self.ahead = self._room_ahead()
         self._theta = np.unwrap(self.motion.theta)
         self._since, self._quiet = now, 0.0
         self._strikes, self._held, self._last = 0, None, None
@@ -373,7 +373,7 @@ class Tracker:
         else:
             c = np.asarray(covariance, dtype=float)
             sigma = (math.sqrt(max(float(np.linalg.eigvalsh(c[:2, :2])[-1]), 0.0)), math.sqrt(max(float(c[2, 2]), 0.0)))
-        room = ROOM * float(self.clearance[self._sample(now)])
+        room = ROOM * float(self.ahead[self._sample(now)])
         return (*self._raised(sigma), max(room, SIGMAS * (sigma[0] + self._reach * sigma[1])))
 
     def _raised(self, sigma: tuple[float, float]) -> tuple[float, float]:
