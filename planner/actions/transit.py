@@ -31,9 +31,9 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import Slider, transform_points, wrap_angle
+from mechanics import Slider, compose, transform_points, wrap_angle
 
-from ..model.bodies import pusher_frame_body
+from ..model.bodies import edge_frame, pusher_frame_body
 from ..model.segments import Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
@@ -110,8 +110,7 @@ def edge_contact_pose(slider: Slider, edge: int, part_pose: ArrayLike) -> np.nda
     >>> edge_contact_pose(block, 0, [0.0, 0.0, 0.0]).round(12).tolist()
     [0.0, 0.0, 1.570796326795]
     """
-    a, b = slider.edge(edge)
-    return contact_pose(part_pose, (a + b) / 2, -slider.inward_normal(edge))
+    return compose(part_pose, edge_frame(slider, edge))
 
 
 def transit_pieces(transit: Transit) -> list[tuple[np.ndarray, bool]]:

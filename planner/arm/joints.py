@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 
 from ..model.files import write_atomic
 from ..model.robot import Robot
-from .reach import FOLLOW_STEPS, ArmReach
+from .reach import ArmReach
 
 __all__ = ["HELD", "JointTrajectory", "joint_trajectory", "joints_along"]
 
@@ -129,9 +129,7 @@ def joint_trajectory(robot: Robot, t: ArrayLike, poses: ArrayLike, heights: Arra
             posture, _ = reach.solve(poses[k], start, height=float(heights[k]))
         else:
             # Within the samples' interval, as the arm would move (the speed check then has the rest).
-            gap = float(t[k] - t[k - 1])
-            posture, _ = reach.solve(poses[k], posture, steps=FOLLOW_STEPS, height=float(heights[k]),
-                                     within=gap if gap > 0 else None)
+            posture, _ = reach.follow(poses[k], posture, float(heights[k]), float(t[k] - t[k - 1]))
         q[k] = posture
         miss[k] = reach.pose_error(poses[k], posture, float(heights[k]))
     dt = np.diff(t)

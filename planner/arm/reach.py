@@ -149,6 +149,11 @@ class ArmReach:
         self.configuration.update(np.asarray(q, dtype=float))
         return float(self.configuration.data.xpos[self._links, 2].min())
 
+    def follow(self, pose: ArrayLike, q: ArrayLike, height: float, gap: float) -> tuple[np.ndarray, float]:
+        """A path's next pose, ``gap`` seconds after the one the arm holds at ``q``: :meth:`solve`
+        within that time (the joints file's rule, :mod:`planner.arm.joints`, and the closed loop's)."""
+        return self.solve(pose, q, steps=FOLLOW_STEPS, height=height, within=gap if gap > 0 else None)
+
     def solve(self, pose: ArrayLike, q: ArrayLike, steps: int = _STEPS, height: float = 0.0,
               settle: bool = False, within: float | None = None) -> tuple[np.ndarray, float]:
         """Joint angles holding the pusher at ``pose`` (``height`` above where it pushes), reached

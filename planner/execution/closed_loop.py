@@ -35,7 +35,8 @@ workspace) at the camera's frame rate, finds the parts in them
 camera's latency after the image was taken, to be compared with the plan at the time it was
 taken. A part not seen (a lost track) stops the pusher while the camera looks again
 (:meth:`.tracker.Tracker.unseen`). MuJoCo's poses at the images' times are kept beside the
-estimates, only to say how far off they were (:class:`Seen`).
+estimates, only to say how far off they were (:class:`Seen`) and to draw them in the recording
+(:class:`Image`, with some of the depth images, downsampled).
 
 A run ends when every part is observed at rest in its goal (one part: the tracker is done), when
 it gives up (the tracker, for one part; no plan of the moves left, or the budget spent, for
@@ -51,9 +52,10 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -66,6 +68,7 @@ from ..model.fields import SceneError, counted
 from ..model.plan import Plan
 from ..model.scene import Scene
 from ..model.segments import Transit
+from ..perception.estimation import Estimate
 from ..queries.session import Planner
 from .approach import first_edge, lead_in_pose
 from .camera_observer import CameraObserver
@@ -75,7 +78,12 @@ from .tracker import BUDGET, CONFIRM, Replan, Tracker, mean_pose
 from .tracker import SETTLE as AT_REST  # observations of the parts at rest (mujoco_sim's SETTLE is seconds)
 from .trajectory import RATE, Trajectory
 
-__all__ = ["GRACE", "OBSERVERS", "OBSERVE_HZ", "PATIENCE", "ClosedLoop", "ClosedRun", "Seen", "closed_loop"]
+if TYPE_CHECKING:  # mink is loaded only for an arm
+    from ..arm.reach import ArmReach
+    from .arm_sim import SimArm
+
+__all__ = ["DEPTH_HZ", "DEPTH_STEP", "GRACE", "OBSERVERS", "OBSERVE_HZ", "PATIENCE", "ClosedLoop", "ClosedRun", "Image",
+           "Seen", "closed_loop"]
 
 #: Observations per second of simulated time (the truth observer; a camera has its own rate).
 OBSERVE_HZ = 20.0
@@ -83,6 +91,10 @@ OBSERVE_HZ = 20.0
 OBSERVERS = ("truth", "camera")
 #: A run is stopped after this many times the first plan's duration plus this many seconds.
 PATIENCE, GRACE = 3.0, 20.0
+#: The camera's depth images kept for the recording: about this many a second, and of each the
+#: middle pixel of every square this many pixels a side (a sixteenth of the pixels, in whole
+#: millimetres: 51 kB an image at 848 x 480), so that a minute's images take a few megabytes.
+DEPTH_HZ, DEPTH_STEP = 2.0, 4
 
 
 @dataclass(frozen=True)
@@ -148,13 +160,30 @@ class ClosedRun(ByPart):
 
 
 @dataclass(frozen=True)
+class Image:
+    """One image of a run's camera, as the recording shows it: when it was taken (``taken``, s on
+    the run's clock), each part's estimate from it and MuJoCo's pose of the part then (``truth``),
+    and, for about :data:`DEPTH_HZ` images a second, the depth image at the middle pixel of each
+    square of :data:`DEPTH_STEP` pixels, in mm (``depth``; 0: no return or no ray cast; None for the
+    other images)."""
+
+    taken: float
+    estimates: dict[str, Estimate]
+    truth: dict[str, np.ndarray]
+    depth: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
 class Seen:
     """How well a camera saw the parts in a run: each estimate's distance (m) and heading difference
-    (rad) from MuJoCo's pose at the time its image was taken (``errors``, ``(n, 2)``), and the
-    seconds of images in which some part was lost (``lost``)."""
+    (rad) from MuJoCo's pose at the time its image was taken (``errors``, ``(n, 2)``), the seconds
+    of images in which some part was lost (``lost``), and every image taken (``images``), with
+    the ``camera`` that took them."""
 
     errors: np.ndarray
     lost: float
+    camera: Camera | None = None
+    images: tuple[Image, ...] = ()
 
     def text(self) -> str:
         """The camera's part of a run's line: the errors' median, 95th percentile and worst."""
@@ -185,6 +214,7 @@ class ClosedLoop(Runs):
     runs: tuple[ClosedRun, ...]
     mu: float
     starts: dict[str, np.ndarray]  # where the parts were placed: the first moved by any start error
+    arm: "SimArm | None" = None  # the arm that held the pusher (arm_sim), for a scene with a robot
 
     @property
     def start(self) -> np.ndarray:
@@ -206,7 +236,7 @@ class ClosedLoop(Runs):
 
     def write_mjcf(self, path: str | Path, scene: Scene) -> None:
         """Write the first run's model, the parts where they were placed (:func:`.mujoco_sim.mjcf`)."""
-        write_mjcf(path, scene, self.runs[0].supports, self.mu, self.starts)
+        write_mjcf(path, scene, self.runs[0].supports, self.mu, self.starts, arm=self.arm)
 
     def executed_files(self, name: str) -> list[str]:
         """The executed paths' file names, one per run: ``<name>.executed.csv`` for the first (the
@@ -281,12 +311,13 @@ class _Loop:
         return self.tracker.pusher_at(now)
 
     def observe(self, now: float, seen: dict[str, np.ndarray], taken: float | None = None,
-                lost: Mapping[str, str] | None = None, covariances: Mapping[str, np.ndarray] | None = None) -> bool:
+                lost: Mapping[str, str] | None = None, hidden: Collection[str] = (),
+                covariances: Mapping[str, np.ndarray] | None = None) -> bool:
         """Take every part's observed pose at ``now``, of the parts as they were at ``taken``
         (default: ``now``; a camera's latency before), with their ``covariances`` (a camera's
-        estimates'; default: the configured noise's), and the parts not seen with why (``lost``:
-        the moving part's tracker stops the pusher and looks again; a part not seen is not
-        judged); whether the run has ended."""
+        estimates'; default: the configured noise's), and the parts not seen with why (``lost``,
+        those of them ``hidden`` partly seen: :meth:`.tracker.Tracker.unseen`; a part not seen is
+        not judged); whether the run has ended."""
         lost = lost or {}
         if self._held is not None:
             if not lost:  # the mean of the parts at rest needs every part seen
@@ -295,7 +326,7 @@ class _Loop:
                 self._replan(now)
             return self.done or bool(self.reason)
         if self.moving in lost:
-            command = self.tracker.unseen(now, lost[self.moving])
+            command = self.tracker.unseen(now, lost[self.moving], self.moving in hidden)
         else:
             command = self.tracker.observe(now, seen[self.moving], taken, (covariances or {}).get(self.moving))
             self._seen = seen[self.moving]
@@ -375,6 +406,29 @@ class _Loop:
         self._left = left if lone.part != left else None
 
 
+class _ArmDriver:
+    """The arm's servos' reference in a closed loop (module docstring, "With a robot"): at each
+    sample, the pose the loop asks of the pusher, reached from the posture of the sample before
+    (:meth:`planner.arm.reach.ArmReach.follow`, as the joints file's samples are); linear in between,
+    at the rate that gets it there."""
+
+    def __init__(self, reach: "ArmReach", start: np.ndarray):
+        self.reach = reach
+        self.times, self.postures = (0.0, 0.0), (start, start)
+        self.rate = np.zeros_like(start)
+
+    def advance(self, u: float, pose: np.ndarray, height: float) -> None:
+        """Reach the pusher's pose ``pose`` at ``height`` for time ``u``, the next sample's."""
+        before, now = self.postures[1], self.times[1]
+        posture, _ = self.reach.follow(pose, before, height, u - now)
+        self.times, self.postures, self.rate = (now, u), (before, posture), (posture - before) / (u - now)
+
+    def __call__(self, u: float) -> tuple[np.ndarray, np.ndarray]:
+        (t0, t1), (q0, q1) = self.times, self.postures
+        share = 1.0 if t1 <= t0 else min(max((u - t0) / (t1 - t0), 0.0), 1.0)
+        return q0 + share * (q1 - q0), self.rate
+
+
 def _after_first_move(plan: Plan, motion: Trajectory) -> float:
     """Seconds of ``motion``, the trajectory of ``plan``, after its first move (the later moves,
     with their transfers): 0 for a plan of one move."""
@@ -384,29 +438,42 @@ def _after_first_move(plan: Plan, motion: Trajectory) -> float:
 
 def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | None, starts: dict[str, np.ndarray],
          bumps: tuple, noise: np.ndarray, rng: np.random.Generator, seed: int | None, later: float,
-         camera: Camera | None = None) -> ClosedRun:
+         camera: Camera | None = None, arm: "SimArm | None" = None) -> ClosedRun:
     """One run of :func:`closed_loop`, each part on its ``supports`` and placed at ``starts``;
     ``later`` is how long the plan runs after its first move (:func:`_after_first_move`). With
     ``camera``, the parts are observed through it (:class:`.camera_observer.CameraObserver`, at
     its frame rate, each image in hand its latency after it was taken); else as MuJoCo has them,
-    with Gaussian ``noise``."""
+    with Gaussian ``noise``. With ``arm`` (a scene with a robot), the arm holds the pusher and
+    follows the loop's pusher (:class:`_ArmDriver`)."""
     scene = session.scene
     clock = time.perf_counter()
-    world = World(scene, supports, mu, starts, bumps)
+    world = World(scene, supports, mu, starts, bumps, arm)
     loop = _Loop(session, plan, (float(noise[0]), float(noise[1])), seed)
     limit = PATIENCE * (loop.tracker.motion.duration + later) + GRACE
 
-    def pusher(u: float) -> tuple[list[float], list[float]]:
+    def free(u: float) -> tuple[list[float], list[float]]:
         pose, height, rate, _ = loop.pusher_at(u)
         return [pose[0], pose[1], height, pose[2]], [rate[0], rate[1], rate[3], rate[2]]
 
+    if arm is None:
+        pusher, joints = free, None
+    else:
+        from ..arm.reach import ArmReach  # loads mink: only for an arm
+
+        pusher = joints = _ArmDriver(ArmReach(scene.robot), arm.q[0])
+
     eye = None if camera is None else CameraObserver(world, scene, camera, plan.starts, rng)
     every = max(1, round(RATE / OBSERVE_HZ))
-    frames: deque = deque()  # the camera's images taken and not yet in hand: (in hand at, taken at, estimates, truth)
+    frames: deque[tuple[float, Image]] = deque()  # the camera's images taken and not yet in hand, and when they will be
+    images: list[Image] = []
+    keep = max(1, round(camera.rate / DEPTH_HZ)) if camera is not None else 1  # the images whose depth is kept
     shots, errors, lost_time = 0, [], 0.0  # images taken; the k-th at the first sample at or after k / rate
     rows, moving, collisions, faults, k = [], [], 0, {}, 0
     while True:
         u = k / RATE
+        if joints is not None and k > 0:
+            pose, height, _, _ = loop.pusher_at(u)
+            joints.advance(u, pose, height)
         world.step_to(SETTLE + u, pusher)
         pose, height, rate, contact = loop.pusher_at(u)
         parts = np.ravel([world.pose(n) for n in scene.names])
@@ -423,17 +490,27 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
             seen = {n: world.pose(n) + rng.normal(0.0, [noise[0], noise[0], noise[1]]) for n in scene.names}
             ended = loop.observe(u, seen)
         if eye is not None and u >= shots / camera.rate - 1e-9:
+            found = eye.look()
+            # The middle pixel of each square of DEPTH_STEP: never one of the table plane's lattice, which would
+            # speckle the picture.
+            middle = slice(DEPTH_STEP // 2, None, DEPTH_STEP)
+            depth = np.round(eye.image[middle, middle] * 1e3).astype(np.uint16) if shots % keep == 0 else None
             # The truth is kept beside the estimates to judge them, never handed to the loop.
-            frames.append((u + camera.latency, u, eye.look(), {n: world.pose(n) for n in scene.names}))
+            images.append(Image(u, found, {n: world.pose(n) for n in scene.names}, depth))
+            frames.append((u + camera.latency, images[-1]))
             shots += 1
         while frames and frames[0][0] <= u + 1e-9 and not ended:
-            _, taken, found, truth = frames.popleft()
+            _, image = frames.popleft()
+            found = image.estimates
             tracked = {n: e for n, e in found.items() if e.tracked}
-            errors += [pose_error(e.pose, truth[n]) for n, e in tracked.items()]
+            errors += [pose_error(e.pose, image.truth[n]) for n, e in tracked.items()]
             lost = {n: e.lost for n, e in found.items() if not e.tracked}
             lost_time += 1 / camera.rate if lost else 0.0
-            ended = loop.observe(u, {n: e.pose for n, e in tracked.items()}, taken, lost,
+            hidden = {n for n, e in found.items() if e.hidden}
+            ended = loop.observe(u, {n: e.pose for n, e in tracked.items()}, image.taken, lost, hidden,
                                  {n: e.covariance for n, e in tracked.items()})
+            if loop.moving in hidden:  # pushed blind: it is looked for where the plan has it next
+                eye.priors[loop.moving] = loop.tracker.planned(u)
         if ended or u > limit:
             break
         k += 1
@@ -444,7 +521,7 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
     tracks = {n: table[:, 10 + 3 * j:13 + 3 * j] for j, n in enumerate(scene.names)}
     ends = {n: world.pose(n) for n in scene.names}
     reason = world.diverged or loop.reason or ("" if loop.done else f"not done after {limit:.0f} s")
-    seen = None if camera is None else Seen(np.array(errors).reshape(-1, 2), lost_time)
+    seen = None if camera is None else Seen(np.array(errors).reshape(-1, 2), lost_time, camera, tuple(images))
     return ClosedRun(dict(supports), {n: pose_error(end, scene.part(n).goal) for n, end in ends.items()},
                      {n: scene.delivered(n, end) for n, end in ends.items()}, tuple(loop.replans), reason, collisions,
                      time.perf_counter() - clock, float(table[-1, 0]), executed, tracks, tuple(loop.carried),
@@ -475,9 +552,19 @@ def closed_loop(session: Planner, plan: Plan, n: int = 3, seed: int = 1, mu: flo
         raise SceneError("observe", f"must be one of {', '.join(OBSERVERS)}, got {observe!r}")
     camera = None if observe == "truth" else scene.camera or read_camera(None, scene.workspace)
     sets = foot_sets(scene, n, seed, cf_offset)
-    setup = perturbations(scene, plan, session.model, start_error, bumps, noise)
+    held = None
+    if scene.robot is None:
+        setup = perturbations(scene, plan, session.model, start_error, bumps, noise)
+    else:
+        from .arm_sim import sim_arm  # loads mink: only for an arm
+        from .arm_timing import arm_trajectory
+
+        motion, joints = arm_trajectory(scene, plan)
+        setup = perturbations(scene, plan, session.model, start_error, bumps, noise, motion=motion)
+        held = sim_arm(scene.robot, setup.lead, setup.motion, joints)
     rng = np.random.default_rng(seed)
     sigma = np.asarray(noise, dtype=float)
     later = _after_first_move(plan, setup.motion)
-    runs = tuple(_run(session, plan, s, mu, setup.starts, setup.bumps, sigma, rng, seed, later, camera) for s in sets)
-    return ClosedLoop(runs, scene.pusher.mu if mu is None else mu, setup.starts)
+    runs = tuple(_run(session, plan, s, mu, setup.starts, setup.bumps, sigma, rng, seed, later, camera, held)
+                 for s in sets)
+    return ClosedLoop(runs, scene.pusher.mu if mu is None else mu, setup.starts, held)

@@ -6,7 +6,9 @@ camera's centre through the pixel's centre with MuJoCo's ray caster (``mj_multiR
 no OpenGL, so it runs on a bare machine and in CI. MuJoCo tests every ray against every geom, so
 only the rays that may meet something standing on the table are cast: those through the image
 of a geom's bounding box; every other ray meets the table plane, where its depth is the camera's
-height over the ray's fall per unit of depth. A ray stops at the first body it meets: the
+height over the ray's fall per unit of depth. Given a *sight* (a mask of the image: the pixels the
+pose estimator reads, :func:`planner.perception.estimation.sight`), only its pixels are worked
+out, the others left 0, since nothing reads them. A ray stops at the first body it meets: the
 pusher, the walls and the obstacles hide what is under them, as they would from a real camera.
 The exact depths are then read as the sensor reads them (:meth:`~planner.model.camera.Camera.measured`:
 noise growing with the square of the depth, quantisation), from a seeded generator, so a run's
@@ -46,12 +48,16 @@ class DepthCamera:
         # A box's corners, as signs of its half sizes.
         self._corners = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)], dtype=float)
 
-    def exact(self) -> np.ndarray:
-        """The true z-depth at every pixel, ``(height, width)``, m (0: the ray meets nothing)."""
+    def exact(self, sight: np.ndarray | None = None) -> np.ndarray:
+        """The true z-depth at every pixel, ``(height, width)``, m (0: the ray meets nothing); with
+        ``sight`` (a mask of the image), only at its pixels, the others 0 (no ray cast there)."""
         mujoco, model, data = self.world.mujoco, self.world.model, self.world.data
         mujoco.mj_kinematics(model, data)  # the bodies where the last step left them
-        depth = self._on_table(model, data)
-        cast = self._near_geoms(data)
+        width, height = self.camera.resolution
+        sight = np.ones((height, width), dtype=bool) if sight is None else sight
+        depth = np.zeros((height, width))
+        depth[sight] = self._on_table(model, data, self._rays[sight])
+        cast = self._near_geoms(data) & sight
         rays = self._rays[cast]
         length = self._length[cast]
         geom, distance = np.empty(len(rays), dtype=np.int32), np.empty(len(rays))
@@ -61,15 +67,15 @@ class DepthCamera:
         depth[cast] = np.where(geom >= 0, distance / length, 0.0)
         return depth
 
-    def _on_table(self, model, data) -> np.ndarray:
-        """Every pixel's depth if its ray met nothing but the table plane (0 where it passes
+    def _on_table(self, model, data, rays: np.ndarray) -> np.ndarray:
+        """The depth of each of ``rays`` if it met nothing but the table plane (0 where it passes
         beyond the plane's extent)."""
         origin, axes = data.geom_xpos[self._table], data.geom_xmat[self._table].reshape(3, 3)
         normal = axes[:, 2]
-        fall = self._rays @ normal
+        fall = rays @ normal
         with np.errstate(divide="ignore", invalid="ignore"):
             depth = (origin - self.camera.position) @ normal / fall
-        local = (self.camera.position + depth[..., None] * self._rays - origin) @ axes[:, :2]
+        local = (self.camera.position + depth[..., None] * rays - origin) @ axes[:, :2]
         inside = (depth > 0) & (np.abs(local) <= model.geom_size[self._table, :2]).all(axis=-1)
         return np.where(inside, depth, 0.0)
 
@@ -95,10 +101,10 @@ class DepthCamera:
             near[int(max(v0, 0)):int(min(v1, height - 1)) + 1, int(max(u0, 0)):int(min(u1, width - 1)) + 1] = True
         return near
 
-    def image(self, rng: np.random.Generator | None) -> np.ndarray:
-        """The depth image the sensor reports now: :meth:`exact` with its noise (from ``rng``;
-        None: none) and quantisation."""
-        return self.camera.measured(self.exact(), rng)
+    def image(self, rng: np.random.Generator | None, sight: np.ndarray | None = None) -> np.ndarray:
+        """The depth image the sensor reports now: :meth:`exact` (at the pixels of ``sight``) with
+        its noise (from ``rng``; None: none) and quantisation."""
+        return self.camera.measured(self.exact(sight), rng)
 
 
 class RenderedDepthCamera(DepthCamera):
@@ -122,12 +128,13 @@ class RenderedDepthCamera(DepthCamera):
         # What the renderer draws where nothing is: its far clipping plane (a shade nearer, as a float32).
         self._far = 0.999 * self._model.vis.map.zfar * self._model.stat.extent
 
-    def exact(self) -> np.ndarray:
+    def exact(self, sight: np.ndarray | None = None) -> np.ndarray:
         """The z-depth at every pixel as the renderer draws it, ``(height, width)``, m (0: nothing
-        before the far clipping plane)."""
+        before the far clipping plane); with ``sight``, 0 outside it, as :meth:`DepthCamera.exact`
+        (the renderer draws every pixel anyway)."""
         self._data.qpos[:] = self.world.data.qpos
         self.world.mujoco.mj_kinematics(self._model, self._data)
         self.world.mujoco.mj_camlight(self._model, self._data)  # the camera's pose
         self._renderer.update_scene(self._data, camera="depth")
         depth = np.asarray(self._renderer.render(), dtype=float)
-        return np.where(depth < self._far, depth, 0.0)  # the far plane: nothing there
+        return np.where((depth < self._far) & (True if sight is None else sight), depth, 0.0)  # the far plane: nothing there

@@ -300,11 +300,10 @@ def _document(scene: Scene, assets: list[str], world: list[str], bodies: list[st
     span = max(xmax - xmin, ymax - ymin)
     assets = assets + [_prism("pusher", pusher_frame_body(scene.pusher.width, scene.pusher.depth), 0.0, PUSHER_TOP)]
     pusher = _free_pusher() if arm is None else arm.body(PUSHER_TOP)
-    # The arm's servos are stiff dampers: integrated implicitly (arm_sim's docstring).
-    integrator = "" if arm is None else ' integrator="implicitfast"'
+    step = TIMESTEP if arm is None else arm.timestep
     actuators = "" if arm is None else f"<actuator>{''.join(arm.actuators())}</actuator>"
     return f"""<mujoco model={quoteattr(scene.name)}>{"" if arm is None else '<compiler angle="radian"/>'}
-  <option timestep="{TIMESTEP}" gravity="0 0 {-GRAVITY:g}" cone="elliptic" impratio="10" solver="Newton" iterations="50" tolerance="1e-10" noslip_iterations="{NOSLIP_ITERATIONS}"{integrator}/>
+  <option timestep="{step}" gravity="0 0 {-GRAVITY:g}" cone="elliptic" impratio="10" solver="Newton" iterations="50" tolerance="1e-10" noslip_iterations="{NOSLIP_ITERATIONS}"/>
   <default>
     <geom contype="0" conaffinity="0"/>{"" if arm is None else arm.defaults()}
   </default>
@@ -398,6 +397,8 @@ def mjcf(scene: Scene, supports: Mapping[str, Feet], mu: float | None = None,
     starts = scene.starts if starts is None else starts
     assets, world, blocks = _table(scene)
     tail, rest = (4, np.zeros(4)) if arm is None else (arm.count, arm.q[0])
+    # The arm's tool slide (arm_sim) is the model's last joint, at rest.
+    slide = () if arm is None else (0.0,)
     bodies, pairs, geoms = [], [], []
     for (name, prefix), part in zip(_names(scene), scene.parts):
         more, body, own, feet_pairs = _part_body(name, prefix, part.slider, supports[part.name])
@@ -414,10 +415,10 @@ def mjcf(scene: Scene, supports: Mapping[str, Feet], mu: float | None = None,
         pairs += arm.pairs(["table", *blocks, *(g for own in geoms for g in own)])
     feet_counts = [len(supports[name].points) for name in scene.names]
     if keys is None:
-        frames = [f'<key name="start" qpos="{_qpos([starts[n] for n in scene.names], feet_counts, rest)}"/>']
+        frames = [f'<key name="start" qpos="{_qpos([starts[n] for n in scene.names], feet_counts, [*rest, *slide])}"/>']
     else:
         frames = [f'<key name="{"start" if k == 0 else f"t={row[0]:.2f}"}" time="{row[0]:.17g}" '
-                  f'qpos="{_qpos(np.reshape(row[1:-tail], (-1, 3)), feet_counts, row[-tail:])}"/>'
+                  f'qpos="{_qpos(np.reshape(row[1:-tail], (-1, 3)), feet_counts, [*row[-tail:], *slide])}"/>'
                   for k, row in enumerate(np.asarray(keys))]
     return _document(scene, assets, world, bodies, pairs, frames, arm)
 
@@ -692,8 +693,9 @@ class World:
             self.site, self.flange = model.site("pusher").id, model.site("flange").id
             self.link_ids = {model.geom(name).id: link for name, link in arm.links.items()}
             self.table = model.geom("table").id
-            # The arm's bodies, last in the model and a chain: in order from its base to its flange.
-            self.bodies = list(range(model.body("base").id, model.nbody))
+            # The arm's bodies, last in the model and a chain: in order from its base to its flange,
+            # the tool's slide after them.
+            self.bodies = list(range(model.body("base").id, model.body("tool").id))
             return
         self.qpos = self.model.joint("pusher_x").qposadr[0] + np.arange(4)
         self.qvel = self.model.joint("pusher_x").dofadr[0] + np.arange(4)
@@ -705,7 +707,8 @@ class World:
         (:meth:`_actuate`), at rest before ``u = 0``."""
         data = self.data
         self._ahead = None
-        while data.time < t - TIMESTEP / 2 and self.diverged is None:
+        step = TIMESTEP if self.arm is None else self.arm.timestep
+        while data.time < t - step / 2 and self.diverged is None:
             u = data.time - SETTLE
             pose = self._actuate(pusher, u)
             while self.bumps and self.bumps[0][0] <= u:

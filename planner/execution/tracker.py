@@ -75,11 +75,22 @@ meets a part askew turns it flush and funnels its error (open loop in MuJoCo), a
 may exist. Deviations are not looked at until the pusher has moved the part's radius on along the
 plan (or the plan ends); then the loop looks again. Each time counts against the budget.
 
-**Lost track.** A camera may not see the part (the pusher hides it, or it left the view): the
-perception then says so (:meth:`Tracker.unseen`) instead of giving a pose. The pusher stops
-where it is and the tracker looks again; once the part is seen again it is observed at rest as
-after a deviation and re-planned from, since it may have moved while unseen. Seen by no
-observation for :data:`LOST_PATIENCE` seconds, the tracker gives up.
+**Lost track.** A camera may not see the part (the pusher or the arm hides it, or it left the
+view): the perception then says so (:meth:`Tracker.unseen`) instead of giving a pose. Where the
+part is *hidden* (some of its outline is seen where it was expected, too little to fix its pose)
+and was last seen on the plan (within the thresholds), the pusher goes on blind: a stable push
+carries the part whatever its support and friction (that is what the plan was chosen for), a part
+waiting for the pusher stays where it is, and the part is judged again at the next observation,
+or when the plan ends (whether it is in its goal needs it seen). A single observation beyond the
+thresholds does not stop that (the debounce: only :data:`CONFIRM` in a row make a deviation).
+Otherwise (not seen at all, or a deviation confirmed) the pusher stops and the tracker looks
+again; where the part is hidden it stops backed off along its own -x by up to :data:`LOOK_BACK`
+(as far as the walls and obstacles let it, at the pusher's cruising speed), so that what hides
+the part (the pusher, the arm's hand over it) moves out of the way; once the part is seen again it is observed at rest as after a deviation and
+re-planned from, since it may have moved while unseen. Seen by no observation for
+:data:`LOST_PATIENCE` seconds while stopped, the tracker gives up. (An arm between an overhead
+camera and the part hides it for most of a push and of the approach to it: holding still does
+not help there, going on does.)
 
 **Giving up.** When the goal is certified unreachable from the observed pose
 (:meth:`planner.Planner.certify_unreachable`), when no plan is found from where the plan has
@@ -102,16 +113,17 @@ from numpy.typing import ArrayLike
 
 from mechanics import pose_error, wrap_angle
 
+from ..actions.transit import backed_off, standoff
 from ..model.bodies import pusher_frame_body, slider_at
 from ..model.fields import SceneError, poses
 from ..model.plan import Plan
 from ..model.segments import Transit
 from ..queries.session import Planner
-from .approach import approach, first_edge
-from .trajectory import Trajectory, planned_part, trajectory
+from .approach import CLEARANCE, approach, first_edge
+from .trajectory import MAX_SPEED, Trajectory, planned_part, trajectory
 
-__all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "LOST_PATIENCE", "REPLAN_LIMIT", "FRACTION", "ROOM",
-           "SETTLE", "SIGMAS",
+__all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "LOOK_BACK", "LOST_PATIENCE", "REPLAN_LIMIT", "FRACTION",
+           "ROOM", "SETTLE", "SIGMAS",
            "Action", "Command", "Replan", "Tracker", "mean_pose"]
 
 #: Thresholds: this fraction of the goal tolerance, and at least this many deviations of the
@@ -125,6 +137,9 @@ CONFIRM = 3
 SETTLE = 5
 #: Longest time, s, the part may go unseen before the tracker gives up (module docstring, "Lost track").
 LOST_PATIENCE = 3.0
+#: How far the pusher backs off to look at a part hidden when it stops, m (module docstring,
+#: "Lost track"): beyond the arm's hand over the pusher from an overhead camera's view.
+LOOK_BACK = 0.1
 #: Re-plans allowed in one run.
 BUDGET = 8
 #: Default time limit of a re-plan's search, s: a robot waits that long at most (a join to the
@@ -276,6 +291,8 @@ class Tracker:
         self._trigger: tuple[np.ndarray, tuple[float, float], str, bool] | None = None
         self._window: list[np.ndarray] = []  # the observations since the pusher stopped
         self._held: tuple[np.ndarray, float] | None = None  # where the pusher holds still (pose, height)
+        # Backing off to look before holding there: (start time, from pose, duration), or None.
+        self._backing: tuple[float, np.ndarray, float] | None = None
         self._stopped = 0.0  # where on the plan's clock the pusher stopped
         self._edge = -1  # the edge the pusher was on when it stopped
         # The plan followed, from _begin: its segments (the approach first), the pusher's timed
@@ -342,6 +359,8 @@ class Tracker:
         the plan), height, velocity ``(vx, vy, omega, vz)`` and whether it should be pushing."""
         if self._held is not None:
             pose, height = self._held
+            if self._still_backing(now):
+                return self._backed(now, pose, height)
             return pose.copy(), height, np.zeros(4), False
         m, u = self.motion, max(now - self._since, 0.0)  # before a re-plan's start: at its first sample, at rest
         column = [np.interp(u, m.t, c) for c in (m.x, m.y, self._theta, m.z, m.vx, m.vy, m.omega)]
@@ -358,7 +377,39 @@ class Tracker:
         self._stopped = min(max(now - self._since, 0.0), self.motion.duration)  # on the plan's clock
         k = self._sample(now)
         self._edge = self._segments[int(self.motion.segment[k])].edge
-        self._held, self._window = (pose, height), []
+        self._held, self._window, self._backing = (pose, height), [], None
+
+    def _look_back(self, now: float) -> bool:
+        """Back the held pusher off along its own -x, up to :data:`LOOK_BACK` where the way is
+        free (halving down to the transits' standoff), before holding there (module docstring,
+        "Lost track"); whether it does."""
+        pose, height = self._held
+        distance = LOOK_BACK
+        while distance >= standoff(self.scene) and not self.session.model.pusher_move_is_free(
+                pose, backed_off(pose, distance), CLEARANCE):
+            distance /= 2
+        if distance < standoff(self.scene):
+            return False
+        self._held = (backed_off(pose, distance), height)
+        self._backing = (now, pose, 2 * distance / MAX_SPEED)
+        return True
+
+    def _still_backing(self, now: float) -> bool:
+        """Whether the pusher is backing off to look (:meth:`_look_back`): the look begins when it stops."""
+        return self._backing is not None and now < self._backing[0] + self._backing[2]
+
+    def _backed(self, now: float, end: np.ndarray, height: float) -> tuple[np.ndarray, float, np.ndarray, bool]:
+        """:meth:`pusher_at` while backing off to ``end``: a half cosine in time (at rest at both
+        ends, at most :data:`~.trajectory.MAX_SPEED` times pi/4 on the way)."""
+        began, start, duration = self._backing
+        phase = math.pi * (now - began) / duration
+        share, pace = (1 - math.cos(phase)) / 2, math.pi * math.sin(phase) / (2 * duration)
+        way = end - start
+        return start + share * way, height, np.array([*(pace * way[:2]), pace * way[2], 0.0]), False
+
+    def planned(self, now: float) -> np.ndarray:
+        """The part's planned pose at ``now``."""
+        return self.expected[self._sample(now)].copy()
 
     def _sample(self, now: float) -> int:
         """The plan's sample at ``now`` (the caller's clock)."""
@@ -384,7 +435,7 @@ class Tracker:
 
     def error(self, now: float, pose: np.ndarray) -> tuple[float, float]:
         """The distance (m) and heading difference (rad) of ``pose`` from the part's planned pose at ``now``."""
-        return pose_error(pose, self.expected[self._sample(now)])
+        return pose_error(pose, self.planned(now))
 
     def observe(self, now: float, pose: ArrayLike, seen_at: float | None = None,
                 covariance: ArrayLike | None = None) -> Command:
@@ -406,6 +457,8 @@ class Tracker:
         error = self.error(seen, pose)
         if self.done or self.reason:
             return self._command(Action.DONE if self.done else Action.GIVE_UP, now, error)
+        if self._still_backing(now):  # the part at rest is observed once the pusher is
+            return self._command(Action.STOP, now, error)
         if self._held is not None:
             self._window.append(pose)
             if len(self._window) < self.settle:
@@ -429,18 +482,27 @@ class Tracker:
             return self._command(Action.STOP, now, error)
         return self._command(Action.FOLLOW, now, error)
 
-    def unseen(self, now: float, why: str) -> Command:
-        """The part was not seen at ``now`` (``why``): the pusher stops where it is and the tracker
-        looks again, giving up after :data:`LOST_PATIENCE` s unseen (module docstring, "Lost track")."""
+    def unseen(self, now: float, why: str, hidden: bool = False) -> Command:
+        """The part was not seen at ``now`` (``why``; ``hidden``: partly seen where it was expected):
+        a hidden part last seen on the plan is followed blind; else the pusher stops where it is
+        and the tracker looks again, giving up after :data:`LOST_PATIENCE` s unseen (module
+        docstring, "Lost track")."""
         now, error = float(now), (math.nan, math.nan)
         if self.done or self.reason:
             return self._command(Action.DONE if self.done else Action.GIVE_UP, now, error)
+        if (hidden and self._held is None and self._last is not None and self._strikes < self.confirm
+                and now - self._since < self.motion.duration):  # the plan's end needs the part seen
+            return self._command(Action.FOLLOW, now, error)  # blind (module docstring, "Lost track")
+        if self._still_backing(now):
+            return self._command(Action.STOP, now, error)
         self._unseen = now if self._unseen is None else self._unseen
         if now - self._unseen >= LOST_PATIENCE:
             return self._give_up(now, error, f"lost track of the part for {now - self._unseen:.1f} s: {why}")
         if self._held is None:
             self._trigger = (self.expected[self._sample(now)], error, f"lost track: {why}", False)
             self._stop(now)
+        if hidden and self._backing is None and self._look_back(now):
+            self._unseen = None  # the patience runs from the end of the backing off
         self._window = []  # the part at rest is observed anew once seen
         return self._command(Action.STOP, now, error)
 

@@ -7,6 +7,7 @@ overlap the part).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -15,7 +16,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import Slider, point_velocity, transform_points
 
-__all__ = ["body_outline", "cf_poses", "place", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at",
+__all__ = ["body_outline", "cf_poses", "edge_frame", "place", "pusher_frame_body", "pusher_polygon", "convex_pieces", "slider_at",
            "top_speed"]
 
 
@@ -58,6 +59,18 @@ def pusher_polygon(slider: Slider, edge: int, width: float, depth: float) -> sha
     back = -slider.inward_normal(edge) * depth
     half = along * width / 2
     return shapely.Polygon([mid - half, mid + half, mid + half + back, mid - half + back])
+
+
+def edge_frame(slider: Slider, edge: int) -> np.ndarray:
+    """The pusher frame's pose in the slider frame while it pushes ``edge``: its face centred on
+    the edge's midpoint and flush with it, its x axis along the edge's inward normal.
+
+    >>> edge_frame(Slider([[-1, 0], [1, 0], [1, 1], [-1, 1]]), 0).round(12).tolist()
+    [0.0, 0.0, 1.570796326795]
+    """
+    a, b = slider.edge(edge)
+    inward = slider.inward_normal(edge)
+    return np.array([*((a + b) / 2), math.atan2(inward[1], inward[0])])
 
 
 def pusher_frame_body(width: float, depth: float) -> np.ndarray:

@@ -106,7 +106,25 @@ to settle and the re-plans' latencies included; not on ``step``), at :data:`RUN_
   observed pose it was planned from, labelled ``re-plan <j> at <t> s``;
 * ``/log/closed_loop`` -- ``TextLog``: at 0 the loop's summary and the runs' lines (``WARN``
   when it failed), and a row at each re-plan's time saying what triggered it, and at each time
-  the run went on with its plan for want of a re-plan, saying why.
+  the run went on with its plan for want of a re-plan, saying why; for a camera run, a row when
+  it lost track of a part, saying why, and one when it saw it again.
+
+A run observed through the camera (``--observe camera``) also has, at the times its images were
+taken:
+
+* ``/world/closed_loop/<k>/camera`` -- static, the camera's pose (``Transform3D``) and lens
+  (``Pinhole``, of the images below), and ``/world/closed_loop/<k>/camera/depth`` the depth images
+  kept (``DepthImage``, mm): about :data:`~planner.execution.closed_loop.DEPTH_HZ` a second, each
+  the middle pixel of every square of :data:`~planner.execution.closed_loop.DEPTH_STEP` pixels, 0
+  where no ray was cast (the estimator reads only round the parts); coloured over the table's
+  depths and twice a part's height either side, so the table is mid-range, a part darker and the
+  pixels not cast the light end. The default blueprint shows run 1's in a 2-D view of its own
+  and leaves the cameras out of the world's view (there the images would be clouds of points
+  hiding the outlines, and the frustum lines across the view);
+* ``/world/closed_loop/<k>/seen/estimate`` -- each image's estimated outlines (none for a part
+  lost), orange, labelled ``camera``, over ``/world/closed_loop/<k>/seen/truth``, the outlines
+  where MuJoCo had the parts when the image was taken, drawn red and labelled ``lost track:
+  <why>`` for a part lost.
 
 (The re-plans' latencies are in the runs' clocks, so a closed loop's recording differs a little
 from one run of it to the next.)
@@ -150,7 +168,7 @@ from .frames import Frames, frames, history
 from .looks import Look, looks
 
 if TYPE_CHECKING:  # the simulators behind them import scipy or MuJoCo: not needed to draw a plan
-    from ..execution.closed_loop import ClosedLoop
+    from ..execution.closed_loop import ClosedLoop, Seen
     from ..execution.mujoco_sim import Simulation
     from ..execution.verify import Verification
     from ..queries.reachable_set import ReachableSet
@@ -166,6 +184,7 @@ _THIN, _LINE, _BOLD, _DOT = (float(r) for r in rr.components.Radius.ui_points([0
 _GREY, _DARK, _RED = [150, 150, 150], [60, 60, 60], [200, 50, 50]
 _SLIDER, _GOAL, _CF = (40, 110, 220), (40, 170, 70), (90, 160, 255)
 _CCW, _CW, _COR, _GHOST, _SIMULATED = [20, 170, 150], [230, 130, 20], [210, 40, 190], [140, 60, 230], [235, 70, 120]
+_CAMERA = [255, 150, 0]  # what the camera saw: orange, apart from MuJoCo's pink
 _LIFTED = [110, 110, 110, 110]  # a faint, see-through grey: the pusher off the table, seen from above
 _STATUS = dict(zip(STATUS, ([40, 170, 70], [230, 190, 40], [200, 50, 50])))
 #: Height of the views' eye over the table, in half-widths of what it must show (the viewer's field of view).
@@ -411,7 +430,65 @@ def _log_closed_loop(rec: rr.RecordingStream, scene: Scene, loop: ClosedLoop) ->
             rec.log("log/closed_loop", rr.TextLog(f"run {k} went on with its plan at {when:.2f} s: {reason}",
                                                   level="WARN"))
         rec.reset_time()
+        if run.seen is not None and run.seen.images:
+            _log_camera(rec, scene, root, k, run.seen)
     _log_text(rec, "log/closed_loop", [loop.summary(), *loop.lines()], "INFO" if loop.passed else "WARN")
+
+
+def _log_camera(rec: rr.RecordingStream, scene: Scene, root: str, k: int, seen: Seen) -> None:
+    """What run ``k``'s camera saw (module docstring): its pose and lens, the depth images kept,
+    each image's estimated outlines and MuJoCo's at the same time, and where it lost a part."""
+    from ..execution.closed_loop import DEPTH_STEP  # a camera run was made: the simulator is there
+    from ..execution.depth_camera import PART_TOP
+
+    camera, images = seen.camera, seen.images
+    width, height = camera.resolution
+    # Pixel i of a kept image is pixel DEPTH_STEP i + DEPTH_STEP // 2 of the camera's; rerun puts (0, 0)
+    # at the first pixel's corner, the camera model (Camera.K) at its centre.
+    lens = camera.K / DEPTH_STEP
+    lens[:2, 2] = (camera.K[:2, 2] - DEPTH_STEP // 2) / DEPTH_STEP + 0.5
+    lens[2, 2] = 1.0
+    rec.log(f"{root}/camera", rr.Transform3D(translation=camera.position, mat3x3=camera.T_world_camera[:3, :3]),
+            rr.Pinhole(image_from_camera=lens, resolution=[-(-width // DEPTH_STEP), -(-height // DEPTH_STEP)],
+                       camera_xyz=rr.ViewCoordinates.RDF, image_plane_distance=0.05), static=True)
+    kept = [image for image in images if image.depth is not None]
+    returns = np.concatenate([image.depth[image.depth > 0] for image in kept])
+    # Coloured over the table's depths and twice a part's height either side: a part stands out by
+    # colour, and the table is not drawn in the colour of the end of the range, where the viewer draws
+    # the pixels of no return, most of them those where no ray was cast.
+    margin = 2e3 * PART_TOP
+    span = ([float(np.percentile(returns, 2)) - margin, float(np.percentile(returns, 98)) + margin] if len(returns)
+            else None)
+    for image in kept:
+        rec.set_time("time", duration=image.taken)
+        rec.log(f"{root}/camera/depth", rr.DepthImage(image.depth, meter=1000.0, depth_range=span, colormap="Magma"))
+    rec.reset_time()
+    outlines = {part.name: _closed(part.slider.vertices) for part in scene.parts}
+    clock = [rr.TimeColumn("time", duration=[image.taken for image in images])]
+    estimates = [[place(outlines[n], e.pose[None])[0] for n, e in image.estimates.items() if e.tracked]
+                 for image in images]
+    rec.send_columns(f"{root}/seen/estimate", indexes=clock, columns=rr.LineStrips3D.columns(
+        strips=_zs([s for row in estimates for s in row], "part")).partition([len(row) for row in estimates]))
+    rec.log(f"{root}/seen/estimate", rr.LineStrips3D.from_fields(colors=_CAMERA, radii=_LINE, labels=["camera"]),
+            static=True)
+    lost = [[image.estimates[n].lost for n in image.truth] for image in images]
+    truth = [place(outlines[n], pose[None])[0] for image in images for n, pose in image.truth.items()]
+    why = [w for row in lost for w in row]
+    rec.send_columns(f"{root}/seen/truth", indexes=clock, columns=rr.LineStrips3D.columns(
+        strips=_zs(truth, "ghost"), colors=[_RED if w else _SIMULATED for w in why],
+        labels=[f"lost track: {w}" if w else "" for w in why]).partition([len(row) for row in lost]))
+    rec.log(f"{root}/seen/truth", rr.LineStrips3D.from_fields(radii=_LINE), static=True)
+    was: set[str] = set()
+    for image, row in zip(images, lost):
+        now = {n for n, w in zip(image.truth, row) if w}
+        rec.set_time("time", duration=image.taken)
+        for name in sorted(now - was):
+            rec.log("log/closed_loop", rr.TextLog(f"run {k} lost track of {name} at {image.taken:.2f} s: "
+                                                  f"{image.estimates[name].lost}", level="WARN"))
+        for name in sorted(was - now):
+            rec.log("log/closed_loop", rr.TextLog(f"run {k} sees {name} again at {image.taken:.2f} s", level="INFO"))
+        was = now
+    rec.reset_time()
 
 
 def _log_motion(rec: rr.RecordingStream, scene: Scene, plan: Plan, look: dict[str, Look]) -> Frames:
@@ -468,13 +545,14 @@ def _log_reach(rec: rr.RecordingStream, reach: ReachableSet) -> None:
                                        radii=0.35 * min(reach.cell)), static=True)
 
 
-def _top_view(origin: str, name: str, x: float, y: float, half: float) -> rrb.Spatial3DView:
+def _top_view(origin: str, name: str, x: float, y: float, half: float, hidden: tuple[str, ...] = ()) -> rrb.Spatial3DView:
     """A 3-D view looking straight down at ``(x, y)`` from high enough to see ``half`` round it, x
-    to the right and y up: rerun's 2-D views draw y downwards whatever the view coordinates say
-    (its issue #1387), and a pushing plan drawn upside down reads wrongly (a left turn looks right;
-    docs/stack.md, "What the viewer shows")."""
+    to the right and y up, showing what is under ``origin`` but the entities ``hidden``: rerun's 2-D
+    views draw y downwards whatever the view coordinates say (its issue #1387), and a pushing plan
+    drawn upside down reads wrongly (a left turn looks right; docs/stack.md, "What the viewer shows")."""
     return rrb.Spatial3DView(origin=origin, name=name, line_grid=False, eye_controls=rrb.EyeControls3D(
-        kind=rrb.Eye3DKind.Orbital, position=[x, y, _EYE * half], look_target=[x, y, 0.0], eye_up=[0.0, 1.0, 0.0]))
+        kind=rrb.Eye3DKind.Orbital, position=[x, y, _EYE * half], look_target=[x, y, 0.0], eye_up=[0.0, 1.0, 0.0]),
+        contents=["+ $origin/**", *(f"- {entity}" for entity in hidden)])
 
 
 def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Verification | None = None,
@@ -519,11 +597,18 @@ def write_recording(path: str | Path, scene: Scene, plan: Plan, verification: Ve
     look = looks(scene, (_SLIDER, _GOAL, _CF))
     name, edge = _analysed(scene, plan)
     first = scene.part(name).slider
+    # A camera run's depth images in a view of their own: in the world's, the viewer draws each as a
+    # cloud of fat points over the table, which hides the outlines, and the camera's frustum, near
+    # the view's eye, as lines across it.
+    cameras = closed_loop is not None and len(scene.parts) == 1 and closed_loop.runs[0].seen is not None
+    depths = tuple(f"/world/closed_loop/{k}/camera/**" for k in range(1, len(closed_loop.runs) + 1)) if cameras else ()
+    views = [_top_view("/world", scene.name, (xmin + xmax) / 2, (ymin + ymax) / 2, max(xmax - xmin, ymax - ymin) / 2,
+                       depths),
+             _top_view("/analysis", f"{look[name].label('pushed edge')} (slider frame)", *first.cf, 6 * first.radius)]
+    if cameras:
+        views.append(rrb.Spatial2DView(origin="/world/closed_loop/1/camera", name="depth camera, run 1"))
     blueprint = rrb.Blueprint(rrb.Vertical(
-        rrb.Horizontal(
-            _top_view("/world", scene.name, (xmin + xmax) / 2, (ymin + ymax) / 2, max(xmax - xmin, ymax - ymin) / 2),
-            _top_view("/analysis", f"{look[name].label('pushed edge')} (slider frame)", *first.cf, 6 * first.radius),
-            column_shares=[3, 2]),
+        rrb.Horizontal(*views, column_shares=[3, 2, 2][:len(views)]),
         rrb.TextLogView(origin="/log", name="summary"),
         row_shares=[3, 1]))
     rec = rr.RecordingStream("stablepush", recording_id=f"{scene.name}-{plan.planner}-seed{plan.seed}")

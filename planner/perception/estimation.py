@@ -10,6 +10,12 @@ prior a few millimetres off can hand a neighbour's edge to a part, a fit cannot.
 four poses alike, :attr:`mechanics.Slider.turns` about its centroid) is then given the look-alike
 pose nearest the prior: continuity decides what the image cannot.
 
+Only the pixels round the parts' priors are read: for each part, the image's rectangle round its
+outline at the prior widened by :data:`GATE`, so every edge point the gate lets through is in it,
+with the pixels its smoothed height depends on (:data:`PAD`); and a sparse lattice over the whole
+image that fits the table plane (:mod:`.table_view`). :func:`sight` says which pixels these are:
+a camera need cast no ray elsewhere, since what it would see there is never used.
+
 The estimate is checked before it is given (:class:`Estimate`): the track is *lost* if the part
 stands too little out of the depth noise where it is (half its height less than :data:`CONTRAST`
 deviations of the smoothed heights: then enough pixels of the table pass for the part, and of
@@ -20,8 +26,16 @@ footprint), if the pose is poorly fixed (its deviation beyond :data:`MAX_SIGMA`,
 straight side is seen), or if the camera sees the table inside the outline at the pose found
 (beyond :data:`TABLE_INSIDE` of its pixels): then the part is not where the fit put it.
 
+A lost track is *hidden* (:attr:`Estimate.hidden`) when it is lost for want of sight alone: too
+little of the outline seen (under :data:`MIN_VISIBLE`) where the points fit it, or too few points
+where something taller than the parts (the pusher, the arm) stands over at least :data:`HIDDEN`
+of the area where the part was. The part is then likely still there, under it; a part out of view,
+or gone from where the table now shows, is not hidden. The closed loop goes on blind through a
+hidden part's push (:mod:`planner.execution.tracker`, "Lost track").
+
 The covariance has two terms. The noise's is the Gauss-Newton one, the inverse of ``J^T J`` (``J``
-the distances' Jacobian at the inlying points) times their mean square distance, times
+the Jacobian of the inlying points' distances across their edges, the points at corners left out:
+:class:`.registration.Fit`) times their mean square distance, times
 :data:`CORRELATED`: the smoothing of the heights makes neighbouring edge points share their
 noise, so they are worth fewer independent measurements than their count; the pose is poorly
 fixed if this term's deviations pass :data:`MAX_SIGMA`. The other is what is left when the noise
@@ -44,21 +58,28 @@ from mechanics import Slider, transform_points, wrap_angle
 from ..model.bodies import slider_at
 from ..model.camera import Camera
 from .registration import Fit, distances, register
-from .silhouette import Silhouette, silhouette
-from .table_view import smoothed_noise, table_view
+from .silhouette import GUARD, Silhouette, silhouette
+from .table_view import SMOOTHING, plane_pixels, smoothed_noise, table_view
 
-__all__ = ["CONTRAST", "CORRELATED", "GATE", "MAX_SIGMA", "MIN_POINTS", "MIN_VISIBLE", "SYSTEMATIC", "TABLE_INSIDE", "Estimate", "estimate_poses"]
+__all__ = ["CONTRAST", "CORRELATED", "GATE", "HIDDEN", "MAX_SIGMA", "MIN_POINTS", "MIN_VISIBLE", "PAD", "SYSTEMATIC",
+           "TABLE_INSIDE", "Estimate", "estimate_poses", "sight"]
 
 #: Farthest an edge point may be from a part's outline at its prior and still be the part's, m:
 #: how far a part may move between two images (a knock of 2.5 cm and 12 degrees moves a 5 cm
 #: part's far corner by about 3 cm).
 GATE = 0.04
+#: Pixels round each part's rectangle of :func:`sight`: the smoothing's reach (three deviations), the
+#: guard round tall things (:data:`.silhouette.GUARD`), and the table pixel next to an edge's part pixel.
+PAD = 3 * round(SMOOTHING) + GUARD + 1
 #: Least ratio of half a part's height to the deviation of the smoothed heights there.
 CONTRAST = 3.0
 #: Fewest edge points of a part seen.
 MIN_POINTS = 20
 #: Least fraction of the outline seen (within two pixels' footprint of an inlying edge point).
 MIN_VISIBLE = 0.3
+#: Least share of where a part was, by area, that something taller must stand over for a part not
+#: seen at all to be hidden rather than gone (:class:`Estimate`).
+HIDDEN = 0.5
 #: Largest deviation of a good estimate's noise: m in position, radians in heading.
 MAX_SIGMA = (0.002, np.radians(2.0))
 #: Largest fraction of the pixels inside a part's outline (shrunk by two pixels) that may be table.
@@ -75,7 +96,9 @@ class Estimate:
     ``covariance`` (m, m, rad), the median distance of its points to the outline there
     (``residual``, m), the fraction of the outline seen (``visible``) and the number of edge points
     (``points``); ``lost`` says why the track is lost (then ``pose`` and ``covariance`` are None),
-    empty if it is not."""
+    empty if it is not, and ``hidden`` whether it is lost for want of sight alone: something taller
+    stands between the camera and where the part was, and what is seen of it does not say it left
+    (module docstring)."""
 
     pose: np.ndarray | None
     covariance: np.ndarray | None
@@ -83,6 +106,7 @@ class Estimate:
     visible: float
     points: int
     lost: str = ""
+    hidden: bool = False
 
     @property
     def tracked(self) -> bool:
@@ -94,7 +118,7 @@ def estimate_poses(depth: np.ndarray, camera: Camera, outlines: Mapping[str, Arr
     """Each part's :class:`Estimate` from ``depth`` (z-depths, m; 0: no return) taken by ``camera``
     (its calibration): ``outlines`` are the parts' polygons (their own frames), ``top`` the height
     of their tops over the table (m), ``priors`` their last known poses (module docstring)."""
-    seen = silhouette(table_view(depth, camera), top)
+    seen = silhouette(table_view(depth, camera, _window(_rectangles(camera, outlines, top, priors))), top)
     shapes = {name: np.asarray(outline, dtype=float) for name, outline in outlines.items()}
     priors = {name: np.asarray(priors[name], dtype=float) for name in shapes}
     pixels = {name: _footprint(camera, priors[name], top) for name in shapes}
@@ -114,6 +138,48 @@ def estimate_poses(depth: np.ndarray, camera: Camera, outlines: Mapping[str, Arr
             refit = None if first[name] is None else _fit(points, shapes[name], found[name], pixels[name])
             estimates[name] = _judge(seen, shapes[name], priors[name], points, pixels[name], refit)
     return estimates
+
+
+def sight(camera: Camera, outlines: Mapping[str, ArrayLike], top: float, priors: Mapping[str, ArrayLike]) -> np.ndarray:
+    """The pixels :func:`estimate_poses` reads of ``camera``'s images, a mask of the image, for parts of
+    ``outlines`` at ``priors`` whose tops are ``top`` over the table (module docstring): the
+    rectangles round the parts (:func:`_rectangles`) and the lattice that fits the table plane
+    (:func:`.table_view.plane_pixels`)."""
+    width, height = camera.resolution
+    mask = plane_pixels((height, width))
+    for rows, columns in _rectangles(camera, outlines, top, priors):
+        mask[rows, columns] = True
+    return mask
+
+
+def _rectangles(camera: Camera, outlines: Mapping[str, ArrayLike], top: float,
+                priors: Mapping[str, ArrayLike]) -> list[tuple[slice, slice]]:
+    """For each part (``outlines`` at ``priors``, their tops ``top`` over the table), the rectangle
+    of the image (rows, columns) round its outline widened by :data:`GATE`, on the table and at
+    ``top``, and :data:`PAD` pixels more (empty where it is out of view); the whole image if some of
+    that is behind the camera."""
+    width, height = camera.resolution
+    found = []
+    for name, outline in outlines.items():
+        ring = np.asarray(slider_at(shapely.Polygon(outline), np.asarray(priors[name], dtype=float)).buffer(GATE)
+                          .exterior.coords)
+        points = np.vstack([np.column_stack([ring, np.full(len(ring), z)]) for z in (0.0, top)])
+        if ((points - camera.position) @ camera.T_world_camera[:3, 2] <= 0).any():
+            return [(slice(0, height), slice(0, width))]
+        pixels = camera.pixels(points)
+        (u0, v0), (u1, v1) = np.floor(pixels.min(axis=0)) - PAD, np.ceil(pixels.max(axis=0)) + PAD + 1
+        found.append((slice(int(np.clip(v0, 0, height)), int(np.clip(v1, 0, height))),
+                      slice(int(np.clip(u0, 0, width)), int(np.clip(u1, 0, width)))))
+    return found
+
+
+def _window(rectangles: list[tuple[slice, slice]]) -> tuple[slice, slice]:
+    """The smallest rectangle of the image holding all of ``rectangles`` (those not empty)."""
+    full = [(r, c) for r, c in rectangles if r.stop > r.start and c.stop > c.start]
+    if not full:
+        return slice(0, 0), slice(0, 0)
+    return (slice(min(r.start for r, _ in full), max(r.stop for r, _ in full)),
+            slice(min(c.start for _, c in full), max(c.stop for _, c in full)))
 
 
 def _shares(points: np.ndarray, shapes: dict[str, np.ndarray], poses: dict[str, np.ndarray],
@@ -150,6 +216,11 @@ def _judge(seen: Silhouette, outline: np.ndarray, prior: np.ndarray, points: np.
     """The estimate of ``fit`` of ``points`` (a part of ``outline`` last at ``prior``), or a lost
     track if it fails a check (module docstring); ``pixel`` is a pixel's footprint there (m)."""
     if fit is None or len(points) < MIN_POINTS:
+        where = slider_at(shapely.Polygon(outline), prior)
+        covered = seen.occluded_inside(where) / max(where.area / pixel ** 2, 1.0)
+        if covered >= HIDDEN:
+            return Estimate(None, None, np.nan, 0.0, len(points),
+                            f"hidden: something taller stands over {min(covered, 1.0):.0%} of where it was", hidden=True)
         return Estimate(None, None, np.nan, 0.0, len(points), "not seen: the part is out of view or hidden")
     fit = _nearest_alike(fit, outline, prior)
     inlying = fit.distance <= 2 * pixel
@@ -164,7 +235,7 @@ def _judge(seen: Silhouette, outline: np.ndarray, prior: np.ndarray, points: np.
            "ambiguous: the points do not fix the pose" if max(sigma[:2]) > MAX_SIGMA[0] or sigma[2] > MAX_SIGMA[1] else
            f"the table is seen where the part would be ({table:.0%} of it)" if table > TABLE_INSIDE else "")
     if why:
-        return Estimate(None, None, residual, visible, len(points), why)
+        return Estimate(None, None, residual, visible, len(points), why, hidden=visible < MIN_VISIBLE)
     floor = SYSTEMATIC * pixel
     covariance = noise + np.diag([floor ** 2, floor ** 2, (floor / Slider(outline).radius) ** 2])
     return Estimate(fit.pose, covariance, residual, visible, len(points))

@@ -24,7 +24,11 @@ __all__ = ["Fit", "distances", "register"]
 @dataclass(frozen=True)
 class Fit:
     """A registration: the ``pose`` (world ``(x, y, theta)``), each point's distance to the outline
-    there (``distance``, m) and the Jacobian of those distances in the pose (``jacobian``, ``(n, 3)``)."""
+    there (``distance``, m) and the Jacobian in the pose of each point's distance to the line of its
+    nearest edge (``jacobian``, ``(n, 3)``): what an edge point measures is how far the edge is
+    across it, not where the edge ends, since an edge may end in the image where something hides
+    the rest of it (the pusher, the image's border). With only parallel edges seen, the pose along
+    them is not fixed, and the Jacobian says so."""
 
     pose: np.ndarray
     distance: np.ndarray
@@ -43,25 +47,47 @@ def distances(points: np.ndarray, outline: np.ndarray, pose: np.ndarray) -> np.n
     >>> distances(np.array([[0.5, -0.25], [1.5, 1.5], [0.5, 0.5]]), square, np.zeros(3)).round(6).tolist()
     [0.25, 0.707107, 0.5]
     """
+    return _nearest(points, outline, pose)[0]
+
+
+def _nearest(points: np.ndarray, outline: np.ndarray,
+             pose: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """For each world point of ``points``, with ``outline`` at ``pose``: its distance to the outline,
+    the gradient of that distance in the pose (``(n, 3)``), its nearest edge (an index) and how far
+    along that edge's line from its first vertex it is (m; below 0 or beyond the edge's length: it is
+    nearest a corner)."""
+    theta = pose[2]
     local = transform_points(points, inverse(pose))
     a, b = outline, np.roll(outline, -1, axis=0)
     edge = b - a
-    along = np.einsum("nmk,mk->nm", local[:, None, :] - a, edge) / np.einsum("mk,mk->m", edge, edge)
-    nearest = a + np.clip(along, 0.0, 1.0)[..., None] * edge
-    return np.linalg.norm(local[:, None, :] - nearest, axis=-1).min(axis=1)
+    length = np.linalg.norm(edge, axis=1)
+    along = np.einsum("nmk,mk->nm", local[:, None, :] - a, edge) / length ** 2
+    gap = local[:, None, :] - (a + np.clip(along, 0.0, 1.0)[..., None] * edge)
+    each = np.linalg.norm(gap, axis=-1)
+    rows, edges = np.arange(len(points)), each.argmin(axis=1)
+    distance = each[rows, edges]
+    # The distance grows along the unit vector from the nearest point to the point (the outline's
+    # frame; none for a point on the outline), which the pose moves by -R(-theta) per step of (x,
+    # y) and by (y, -x) (the point in the outline's frame) per radian.
+    unit = gap[rows, edges] / np.maximum(distance, 1e-300)[:, None]
+    c, s = np.cos(theta), np.sin(theta)
+    gradient = np.column_stack([-(unit[:, 0] * c - unit[:, 1] * s), -(unit[:, 0] * s + unit[:, 1] * c),
+                                unit[:, 0] * local[:, 1] - unit[:, 1] * local[:, 0]])
+    return distance, gradient, edges, along[rows, edges] * length[edges]
 
 
 def register(points: np.ndarray, outline: np.ndarray, start: np.ndarray, scale: float) -> Fit:
     """The pose of ``outline`` nearest ``start`` through ``points`` (module docstring); ``scale``
     (m) is the distance beyond which a point counts as an outlier, about a pixel's footprint."""
-    def residuals(pose: np.ndarray) -> np.ndarray:
-        return distances(points, outline, pose)
-
-    found = least_squares(residuals, np.asarray(start, dtype=float), loss="soft_l1", f_scale=scale,
+    found = least_squares(lambda pose: _nearest(points, outline, pose)[0], np.asarray(start, dtype=float),
+                          jac=lambda pose: _nearest(points, outline, pose)[1], loss="soft_l1", f_scale=scale,
                           x_scale=np.array([scale, scale, scale / max(float(np.abs(outline).max()), scale)]),
-                          diff_step=1e-6, max_nfev=200)
+                          max_nfev=200)
     pose = np.array([*found.x[:2], float(wrap_angle(found.x[2]))])
-    step = np.diag([1e-6, 1e-6, 1e-6])
-    here = residuals(pose)
-    jacobian = np.column_stack([(residuals(pose + d) - here) / 1e-6 for d in step])
-    return Fit(pose, here, jacobian)
+    distance, jacobian, edges, at = _nearest(points, outline, pose)
+    # Inside its edge's span a point's gradient is the edge's normal: it measures the edge across.
+    # A point at a corner (within two scales of its edge's ends, or beyond them) says where the edge
+    # ends, which may be where the rest of it is hidden: it measures nothing (Fit).
+    length = np.linalg.norm(np.roll(outline, -1, axis=0) - outline, axis=1)[edges]
+    jacobian[(at < 2 * scale) | (at > length - 2 * scale)] = 0.0
+    return Fit(pose, distance, jacobian)

@@ -42,22 +42,32 @@ SPECK = 10
 @dataclass(frozen=True)
 class Silhouette:
     """The edge points of a depth image's part-high regions (module docstring): ``points``, world
-    ``(x, y)`` (m); and the image's table pixels (``table``, a mask of the image), which say where
-    no part is (:meth:`table_inside`)."""
+    ``(x, y)`` (m); the image's table pixels (``table``, a mask of the image), which say where
+    no part is (:meth:`table_inside`), and its occluded pixels (``occluded``), where something
+    taller than the parts stands between the camera and the table (:meth:`occluded_inside`)."""
 
     points: np.ndarray
     table: np.ndarray
     view: TableView
+    occluded: np.ndarray
 
     def table_inside(self, outline: shapely.Polygon) -> int:
         """How many table pixels, on the table plane, fall inside ``outline`` (world frame)."""
+        return self._inside(self.table, outline)
+
+    def occluded_inside(self, outline: shapely.Polygon) -> int:
+        """How many occluded pixels' rays meet the table plane inside ``outline`` (world frame)."""
+        return self._inside(self.occluded, outline)
+
+    def _inside(self, mask: np.ndarray, outline: shapely.Polygon) -> int:
+        """How many pixels of ``mask`` see the table plane inside ``outline``."""
         ring = np.asarray(outline.exterior.coords)
-        corners = self.view.camera.pixels(np.column_stack([ring, np.zeros(len(ring))]))
+        corners = self.view.camera.pixels(np.column_stack([ring, np.zeros(len(ring))])) - self.view.corner
         (u0, v0), (u1, v1) = corners.min(axis=0), corners.max(axis=0)
         height, width = self.table.shape
         rows = slice(max(int(np.floor(v0)), 0), max(min(int(np.ceil(v1)) + 1, height), 0))
         columns = slice(max(int(np.floor(u0)), 0), max(min(int(np.ceil(u1)) + 1, width), 0))
-        v, u = np.nonzero(self.table[rows, columns])
+        v, u = np.nonzero(mask[rows, columns])
         if not len(v):
             return 0
         xy = self.view.on_plane(np.column_stack([u + columns.start, v + rows.start]).astype(float), 0.0)
@@ -91,13 +101,13 @@ def silhouette(view: TableView, top: float) -> Silhouette:
             pixels.append(crossing[:, ::-1])  # (row, column) to (u, v)
             faces.append((pairs - p)[:, ::-1].astype(float))
     if not pixels:
-        return Silhouette(np.zeros((0, 2)), table, view)
+        return Silhouette(np.zeros((0, 2)), table, view, occluded)
     pixels, faces = np.vstack(pixels), np.vstack(faces)
     at_top = view.on_plane(pixels, top)
     outward = view.on_plane(pixels + faces, top)[:, :2] - at_top[:, :2]
     facing = np.einsum("ij,ij->i", outward, view.camera.position[:2] - at_top[:, :2]) > 0
     points = np.where(facing[:, None], view.on_plane(pixels, half)[:, :2], at_top[:, :2])
-    return Silhouette(points, table, view)
+    return Silhouette(points, table, view, occluded)
 
 
 def _beside_tall(view: TableView, tall: np.ndarray, candidates: np.ndarray) -> np.ndarray:

@@ -131,10 +131,7 @@ class RunOptions:
 
     def _fit_arm(self) -> None:
         """Refuse, before the work, what needs the arm's joints (written, or followed by the arm
-        in the simulation) without mink; and a closed loop, which drives a free pusher, not the arm."""
-        if self.simulate is not None and self.closed_loop:
-            raise SceneError("closed_loop", "not with a robot yet: the closed loop moves a free pusher, not the arm "
-                                            "(docs/arm.md)")
+        in the simulation, open or closed loop) without mink."""
         for name, asked in (("trajectory", self.trajectory), ("simulate", self.simulate is not None)):
             if asked and not have("mink"):
                 raise SceneError(name, f"the arm's joints {needs('mink')}")

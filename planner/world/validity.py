@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import transform_points, wrap_angle
 
-from ..model.bodies import body_outline, convex_pieces, pusher_frame_body, pusher_polygon
+from ..model.bodies import body_outline, convex_pieces, edge_frame, pusher_frame_body, pusher_polygon
 from .free_space import SCREEN_SHRINK, disk_free_space
 from .reach import reach_zone
 from .room import Room
@@ -263,9 +263,7 @@ class CollisionModel:
             if key == _PUSHER:
                 self._holds[key] = (0.0, 0.0, 0.0, turn)
             else:
-                a, b = self._slider.edge(key)
-                inward = self._slider.inward_normal(key)
-                self._holds[key] = (*((a + b) / 2).tolist(), math.atan2(inward[1], inward[0]), turn)
+                self._holds[key] = (*edge_frame(self._slider, key).tolist(), turn)
         hx, hy, hphi, turn = self._holds[key]
         x, y, theta = pose
         c, s = math.cos(theta), math.sin(theta)
