@@ -423,7 +423,8 @@ class Tracker:
             sigma = self.noise
         else:
             c = np.asarray(covariance, dtype=float)
-            sigma = (math.sqrt(max(float(np.linalg.eigvalsh(c[:2, :2])[-1]), 0.0)), math.sqrt(max(float(c[2, 2]), 0.0)))
+            worst = float(np.linalg.eigvalsh(c[:2, :2])[-1])  # the position's variance along its worst axis
+            sigma = (math.sqrt(max(worst, 0.0)), math.sqrt(max(float(c[2, 2]), 0.0)))
         room = ROOM * float(self.ahead[self._sample(now)])
         return (*self._raised(sigma), max(room, SIGMAS * (sigma[0] + self._reach * sigma[1])))
 
@@ -499,7 +500,7 @@ class Tracker:
         if now - self._unseen >= LOST_PATIENCE:
             return self._give_up(now, error, f"lost track of the part for {now - self._unseen:.1f} s: {why}")
         if self._held is None:
-            self._trigger = (self.expected[self._sample(now)], error, f"lost track: {why}", False)
+            self._trigger = (self.planned(now), error, f"lost track: {why}", False)
             self._stop(now)
         if hidden and self._backing is None and self._look_back(now):
             self._unseen = None  # the patience runs from the end of the backing off
