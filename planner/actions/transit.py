@@ -211,6 +211,11 @@ class TransitPlanner:
             self._sides[e] = (slider.hull_side(e), mid, out)
         self._cache: dict[tuple, Transit | None] = {}
 
+    @property
+    def edges(self) -> tuple[int, ...]:
+        """The edges it finds transits between."""
+        return tuple(self._sides)
+
     def find(self, part_pose: ArrayLike, a: int, b: int) -> Transit | None:
         """The quickest free transit from edge ``a`` to edge ``b`` with the part at ``part_pose``, or None."""
         key = (tuple(float(v) for v in part_pose), a, b)

@@ -92,8 +92,10 @@ def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | Non
     fronts = [backed_off(contact, near) for near in (gap, gap / 2, gap / 4)]
     ways = [[pusher, front, contact] for front in fronts]
     walks = []
-    if transits is not None:
-        others = {e: backed_off(edge_contact_pose(scene.slider, e, part), gap) for e in edges if e != edge}
+    # (A session with less friction, after slip, may not push the edge the pusher was on: no walk to it.)
+    if transits is not None and edge in transits.edges:
+        others = {e: backed_off(edge_contact_pose(scene.slider, e, part), gap)
+                  for e in edges if e != edge and e in transits.edges}
         if others:
             near = min(others, key=lambda e: np.linalg.norm(others[e][:2] - pusher[:2]))
             walk = transits.find(part, near, edge)

@@ -215,3 +215,22 @@ def test_where_the_arm_lifts_the_pusher_is_lifted_over_to_a_face_it_cannot_walk_
     # Backed straight off the face it left; landed in front of the new one, facing it.
     assert np.isclose(path[1][2], at[2]) and np.isclose(path[2][2], contact[2])
     assert 0 < np.linalg.norm(path[2][:2] - contact[:2]) <= 0.02
+
+
+def test_an_approach_to_an_edge_the_transits_do_not_serve_goes_straight_and_does_not_fail():
+    """After slip the tracker re-plans with less friction, where the edge the pusher was on may push
+    no stable push and the session's transits not know it (an L part in a random scene once raised
+    a KeyError there): the approach to it is then tried without the walk round."""
+    from planner.actions.transit import TransitPlanner
+
+    scene = load_scene(ROOT / "scenes" / "junction.yaml")
+    session = Planner(scene)
+    served = list(session.stable_edges)
+    target = served[-1]
+    fewer = TransitPlanner(scene, served[:-1], session.model, 0.001, "plane")
+    assert target not in fewer.edges
+    at = edge_contact_pose(scene.slider, target, scene.start)
+    backed = at.copy()
+    backed[:2] -= 0.05 * np.array([np.cos(at[2]), np.sin(at[2])])  # 5 cm behind the contact, facing it
+    way = approach(scene, session.model, fewer, backed, scene.start, target, served[:-1])
+    assert way is not None and np.allclose(way.pusher_path[-1], at)
