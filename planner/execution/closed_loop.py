@@ -311,9 +311,11 @@ class _Loop:
         return self.tracker.pusher_at(now)
 
     def observe(self, now: float, seen: dict[str, np.ndarray], taken: float | None = None,
-                lost: Mapping[str, str] | None = None, hidden: Collection[str] = ()) -> bool:
+                lost: Mapping[str, str] | None = None, hidden: Collection[str] = (),
+                covariances: Mapping[str, np.ndarray] | None = None) -> bool:
         """Take every part's observed pose at ``now``, of the parts as they were at ``taken``
-        (default: ``now``; a camera's latency before), and the parts not seen with why (``lost``,
+        (default: ``now``; a camera's latency before), with their ``covariances`` (a camera's
+        estimates'; default: the configured noise's), and the parts not seen with why (``lost``,
         those of them ``hidden`` partly seen: :meth:`.tracker.Tracker.unseen`; a part not seen is
         not judged); whether the run has ended."""
         lost = lost or {}
@@ -326,7 +328,7 @@ class _Loop:
         if self.moving in lost:
             command = self.tracker.unseen(now, lost[self.moving], self.moving in hidden)
         else:
-            command = self.tracker.observe(now, seen[self.moving], taken)
+            command = self.tracker.observe(now, seen[self.moving], taken, (covariances or {}).get(self.moving))
             self._seen = seen[self.moving]
         if command.contact:
             self._left = None
@@ -500,11 +502,13 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
         while frames and frames[0][0] <= u + 1e-9 and not ended:
             _, image = frames.popleft()
             found = image.estimates
-            errors += [pose_error(e.pose, image.truth[n]) for n, e in found.items() if e.tracked]
+            tracked = {n: e for n, e in found.items() if e.tracked}
+            errors += [pose_error(e.pose, image.truth[n]) for n, e in tracked.items()]
             lost = {n: e.lost for n, e in found.items() if not e.tracked}
             lost_time += 1 / camera.rate if lost else 0.0
             hidden = {n for n, e in found.items() if e.hidden}
-            ended = loop.observe(u, {n: e.pose for n, e in found.items() if e.tracked}, image.taken, lost, hidden)
+            ended = loop.observe(u, {n: e.pose for n, e in tracked.items()}, image.taken, lost, hidden,
+                                 {n: e.covariance for n, e in tracked.items()})
             if loop.moving in hidden:  # pushed blind: it is looked for where the plan has it next
                 eye.priors[loop.moving] = loop.tracker.planned(u)
         if ended or u > limit:

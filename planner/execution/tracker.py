@@ -8,18 +8,43 @@ first contact in front, :func:`.approach.approach`) and the part's planned pose 
 any time; :meth:`Tracker.observe` takes an observed part pose and says what to do.
 
 **When to re-plan.** The part's observed pose is compared with the planned one at the same time:
-the distance of the slider frame's origins and the wrapped heading difference. A lost contact
-shows the same way (the part stays behind while the plan moves on). The thresholds are
+the distance ``e`` of the slider frame's origins and the wrapped heading difference ``phi``. A lost
+contact shows the same way (the part stays behind while the plan moves on). It is off the plan
+when one of three thresholds (:meth:`Tracker.threshold_at`) is passed:
 
-* half the goal tolerance (position and angle): a stable push funnels smaller errors away (open
-  loop in MuJoCo, parts started up to a centimetre off mostly end inside the 1 cm tolerance,
-  ``python -m planner.bench.closed_loop``), and a plan joined from the observed pose is only as
-  good as that observation, so re-planning for less would chase the perception's noise;
-* at least :data:`SIGMAS` standard deviations of the observation noise: the chance that noise
-  alone exceeds 5 sigma is about 4e-6 per observation for the position (Rayleigh) and 6e-7 for
-  the heading (Gaussian);
+* ``e`` or ``|phi|`` beyond half the goal tolerance: a stable push funnels smaller errors away
+  (open loop in MuJoCo, parts started up to a centimetre off mostly end inside the 1 cm
+  tolerance, ``python -m planner.bench.closed_loop``), and a plan joined from the observed pose
+  is only as good as that observation;
+* the *sweep* ``e + R |phi|`` (``R`` the part's farthest point from its origin: no point of the
+  part is farther than that from where the plan has it) beyond :data:`ROOM` of the room ahead:
+  the least clearance the planned part keeps from the walls, the obstacles and the other parts
+  (:meth:`~planner.world.validity.CollisionModel.part_clearance`) from now until it has swept
+  ``R`` further. Ahead, because a deviation is carried along by the pushes into the tight places
+  that follow: caught while the part still has room (as the pusher lifts over to another face),
+  it is re-planned from; caught in the tight place, there may be no plan from there (the pusher
+  needs room flush on a face) and the pusher can only go on. Where the plan keeps more than
+  ``(e + R |phi|) / ROOM`` at half the tolerance (1.2 cm for narrow_junction's block) the first
+  rule is the stricter. The rest of the room is for what the part strays while the deviation
+  is confirmed (below) and the pusher stops: two observation periods (0.1 s at 20 Hz; a
+  camera's two frames and its latency, about 0.12 s at 30 Hz and 50 ms). A plan keeps at least a
+  fortieth of the part's radius (:func:`~planner.actions.controls.clearance_margin`), so the
+  sweep's threshold is never below an eightieth of it, 0.73 mm for narrow_junction's 10 x 6 cm
+  block, twenty times what an unperturbed run strays from its plan in MuJoCo (0.03 mm), and the
+  other half is as much: in narrow_junction's runs with half the friction or the centre of
+  pressure 5 mm off, the sweep grew by at most 3.4 mm/s, 0.4 mm in 0.12 s. The pusher is not
+  counted: it follows the plan whatever the part does;
+* each never below :data:`SIGMAS` standard deviations of the observation (the sweep's: the
+  position's plus ``R`` times the heading's), from the observer's configured noise (the truth
+  observer) or from each estimate's covariance (a camera; the position's along its worst axis):
+  a tight corridor must not make the loop chase noise. Noise alone passes 3 sigma in one
+  observation with probability 0.011 for the position (Rayleigh, ``exp(-9/2)``) and 0.0027 for
+  the heading, and the sweep only where one of them does (0.014 in all); :data:`CONFIRM` (3)
+  observations in a row, independent, with probability 3e-6: about one stop for nothing in 300
+  runs of a minute at 20 Hz, and such a stop costs a re-plan of tens of milliseconds, not the
+  run. (A camera's covariance is on the safe side: ``docs/camera.md``, "Accuracy".)
 
-and an observation beyond them counts only when :data:`CONFIRM` consecutive ones are (a debounce:
+An observation beyond them counts only when :data:`CONFIRM` consecutive ones are (a debounce:
 one outlier of the perception does not stop the robot). Then the pusher stops where it is
 (``'stop'`` commands) and the tracker takes :data:`SETTLE` more observations of the part at rest;
 their mean (the noise down by ``sqrt(SETTLE)``) is where it re-plans from, with the planner
@@ -97,12 +122,15 @@ from ..queries.session import Planner
 from .approach import CLEARANCE, approach, first_edge
 from .trajectory import MAX_SPEED, Trajectory, planned_part, trajectory
 
-__all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "LOOK_BACK", "LOST_PATIENCE", "REPLAN_LIMIT", "FRACTION", "SETTLE",
-           "SIGMAS",
+__all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "LOOK_BACK", "LOST_PATIENCE", "REPLAN_LIMIT", "FRACTION",
+           "ROOM", "SETTLE", "SIGMAS",
            "Action", "Command", "Replan", "Tracker", "mean_pose"]
 
-#: Thresholds: this fraction of the goal tolerance, and at least this many noise deviations.
-FRACTION, SIGMAS = 0.5, 5.0
+#: Thresholds: this fraction of the goal tolerance, and at least this many deviations of the
+#: observation (module docstring, "When to re-plan").
+FRACTION, SIGMAS = 0.5, 3.0
+#: The share of the planned part's clearance a deviation may sweep before it counts (module docstring).
+ROOM = 0.5
 #: Consecutive observations beyond the thresholds that make a deviation (the debounce).
 CONFIRM = 3
 #: Observations of the part at rest averaged before a re-plan or the final check.
@@ -199,7 +227,8 @@ class Tracker:
     time : float
         The caller's clock when the run begins.
     noise : (float, float)
-        Standard deviations of the observations: position (m, per axis) and heading (rad).
+        Standard deviations of the observations: position (m, per axis) and heading (rad), where
+        an observation comes without a covariance (:meth:`observe`).
     confirm, settle, budget : int
         :data:`CONFIRM`, :data:`SETTLE`, :data:`BUDGET`.
     seed : int, optional
@@ -239,9 +268,11 @@ class Tracker:
                 raise SceneError(name, f"must be an integer >= {0 if name == 'budget' else 1}, got {value!r}")
         self.session, self.scene = session, session.scene
         scene = self.scene
-        #: Position (m) and heading (rad) thresholds.
-        self.threshold = (max(FRACTION * scene.tolerance_position, SIGMAS * float(noise[0])),
-                          max(FRACTION * scene.tolerance_angle, SIGMAS * float(noise[1])))
+        self.noise = (float(noise[0]), float(noise[1]))
+        self._reach = float(np.linalg.norm(scene.slider.hull, axis=1).max())  # R of the module docstring
+        #: Position (m) and heading (rad) thresholds for the configured noise (:meth:`threshold_at`;
+        #: near walls the sweep's is stricter).
+        self.threshold = self._raised(self.noise)
         if not 0 < float(time_limit) < math.inf:
             raise SceneError("time_limit", f"must be a positive number of seconds, got {time_limit}")
         self.confirm, self.settle, self.budget, self.seed = confirm, settle, budget, seed
@@ -271,6 +302,7 @@ class Tracker:
         self._segments: list = []
         self.motion: Trajectory | None = None
         self.expected = np.zeros((0, 3))
+        self.ahead = np.zeros(0)  # the room ahead of each sample, m (_room_ahead)
         self._theta = np.zeros(0)
         self._since, self._quiet = float(time), 0.0
         start = self._pose(plan.start, "plan.start")
@@ -298,10 +330,25 @@ class Tracker:
         led = plan.with_segments(segments)
         self.motion = trajectory(self.scene, led)
         self.expected = planned_part(self.scene, led, self.motion)
+        self.ahead = self._room_ahead()
         self._theta = np.unwrap(self.motion.theta)
         self._since, self._quiet = now, 0.0
         self._strikes, self._held, self._last = 0, None, None
         return ""
+
+    def _room_ahead(self) -> np.ndarray:
+        """At each sample of the plan, the least clearance the planned part keeps from there until
+        it has swept ``R`` further (module docstring, "When to re-plan"), m."""
+        # Beyond this clearance the sweep's threshold is looser than the position's and the
+        # heading's together (threshold_at): it is not worked out farther, far from everything.
+        wide = FRACTION * (self.scene.tolerance_position + self._reach * self.scene.tolerance_angle) / ROOM
+        model = self.session.model
+        here = np.array([model.part_clearance(pose, wide) for pose in self.expected])
+        step = np.diff(self.expected[:, :2], axis=0)
+        swept = np.hypot(step[:, 0], step[:, 1]) + self._reach * np.abs(np.diff(np.unwrap(self.expected[:, 2])))
+        travel = np.concatenate([[0.0], np.cumsum(swept)])
+        ends = np.searchsorted(travel, travel + self._reach, side="right")
+        return np.array([here[k:j].min() for k, j in enumerate(ends)])
 
     def _approach(self, pusher: np.ndarray, part: np.ndarray, edge: int) -> Transit | None:
         return approach(self.scene, self.session.model, self.session.transits, pusher, part, edge,
@@ -317,7 +364,7 @@ class Tracker:
             return pose.copy(), height, np.zeros(4), False
         m, u = self.motion, max(now - self._since, 0.0)  # before a re-plan's start: at its first sample, at rest
         column = [np.interp(u, m.t, c) for c in (m.x, m.y, self._theta, m.z, m.vx, m.vy, m.omega)]
-        k = min(int(np.searchsorted(m.t, u)), len(m.t) - 1)
+        k = self._sample(now)
         rise = np.interp(u, m.t, np.gradient(m.z, m.t)) if len(m.t) > 1 else 0.0
         return np.array(column[:3]), float(column[3]), np.array([*column[4:], rise]), bool(m.contact[k])
 
@@ -328,7 +375,7 @@ class Tracker:
     def _stop(self, now: float) -> None:
         pose, height, _, _ = self.pusher_at(now)
         self._stopped = min(max(now - self._since, 0.0), self.motion.duration)  # on the plan's clock
-        k = min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
+        k = self._sample(now)
         self._edge = self._segments[int(self.motion.segment[k])].edge
         self._held, self._window, self._backing = (pose, height), [], None
 
@@ -362,17 +409,42 @@ class Tracker:
 
     def planned(self, now: float) -> np.ndarray:
         """The part's planned pose at ``now``."""
-        k = min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
-        return self.expected[k].copy()
+        return self.expected[self._sample(now)].copy()
+
+    def _sample(self, now: float) -> int:
+        """The plan's sample at ``now`` (the caller's clock)."""
+        return min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
+
+    def threshold_at(self, now: float, covariance: ArrayLike | None = None) -> tuple[float, float, float]:
+        """The thresholds at ``now`` on the plan of an observation of ``covariance`` (3 x 3, m and
+        rad; default: the configured noise): position (m), heading (rad) and sweep (m), module
+        docstring, "When to re-plan"."""
+        if covariance is None:
+            sigma = self.noise
+        else:
+            c = np.asarray(covariance, dtype=float)
+            worst = float(np.linalg.eigvalsh(c[:2, :2])[-1])  # the position's variance along its worst axis
+            sigma = (math.sqrt(max(worst, 0.0)), math.sqrt(max(float(c[2, 2]), 0.0)))
+        room = ROOM * float(self.ahead[self._sample(now)])
+        return (*self._raised(sigma), max(room, SIGMAS * (sigma[0] + self._reach * sigma[1])))
+
+    def _raised(self, sigma: tuple[float, float]) -> tuple[float, float]:
+        """The position (m) and heading (rad) thresholds for deviations ``sigma``: half the
+        tolerance, or :data:`SIGMAS` deviations."""
+        return (max(FRACTION * self.scene.tolerance_position, SIGMAS * sigma[0]),
+                max(FRACTION * self.scene.tolerance_angle, SIGMAS * sigma[1]))
 
     def error(self, now: float, pose: np.ndarray) -> tuple[float, float]:
         """The distance (m) and heading difference (rad) of ``pose`` from the part's planned pose at ``now``."""
         return pose_error(pose, self.planned(now))
 
-    def observe(self, now: float, pose: ArrayLike, seen_at: float | None = None) -> Command:
+    def observe(self, now: float, pose: ArrayLike, seen_at: float | None = None,
+                covariance: ArrayLike | None = None) -> Command:
         """Take the part's observed pose at ``now`` and say what the pusher does (module docstring).
         ``seen_at`` is when the part was where ``pose`` says (default: ``now``): a camera's image
         is in hand its latency after it was taken, and it is compared with the plan at that time.
+        ``covariance`` is the observation's (3 x 3; default: the configured noise's), which
+        bounds the thresholds below (:meth:`threshold_at`).
 
         Raises
         ------
@@ -382,7 +454,8 @@ class Tracker:
         pose = self._pose(pose, "pose")
         now = float(now)
         self._unseen = None
-        error = self.error(now if seen_at is None else float(seen_at), pose)
+        seen = now if seen_at is None else float(seen_at)
+        error = self.error(seen, pose)
         if self.done or self.reason:
             return self._command(Action.DONE if self.done else Action.GIVE_UP, now, error)
         if self._still_backing(now):  # the part at rest is observed once the pusher is
@@ -392,14 +465,19 @@ class Tracker:
             if len(self._window) < self.settle:
                 return self._command(Action.STOP, now, error)
             return self._settled(now, mean_pose(self._window), error)
-        beyond = (error[0] > self.threshold[0] or error[1] > self.threshold[1]) and now - self._since >= self._quiet
+        limit = self.threshold_at(seen, covariance)
+        sweep = error[0] + self._reach * error[1]
+        off = error[0] > limit[0] or error[1] > limit[1] or sweep > limit[2]
+        beyond = off and now - self._since >= self._quiet
         step = 0.0 if self._last is None else max(abs(a - b) / t for a, b, t in zip(error, self._last, self.threshold))
         self._strikes, self._last = self._strikes + 1 if beyond else 0, error
         self._jump = max(self._jump, step) if beyond else 0.0  # from the last observation within the thresholds on
         ended = now - self._since >= self.motion.duration
         if self._strikes >= self.confirm or ended:
             why = "the plan ended" if ended and self._strikes < self.confirm else (
-                f"off the plan by {error[0] * 1000:.1f} mm, {math.degrees(error[1]):.1f} deg")
+                f"off the plan by {error[0] * 1000:.1f} mm, {math.degrees(error[1]):.1f} deg"
+                f" (thresholds {limit[0] * 1000:.1f} mm, {math.degrees(limit[1]):.1f} deg, sweep"
+                f" {sweep * 1000:.1f} of {limit[2] * 1000:.1f} mm)")
             self._trigger = (pose, error, why, self._strikes >= self.confirm and self._slid(now, pose))
             self._stop(now)
             return self._command(Action.STOP, now, error)
@@ -422,8 +500,7 @@ class Tracker:
         if now - self._unseen >= LOST_PATIENCE:
             return self._give_up(now, error, f"lost track of the part for {now - self._unseen:.1f} s: {why}")
         if self._held is None:
-            k = min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
-            self._trigger = (self.expected[k], error, f"lost track: {why}", False)
+            self._trigger = (self.planned(now), error, f"lost track: {why}", False)
             self._stop(now)
         if hidden and self._backing is None and self._look_back(now):
             self._unseen = None  # the patience runs from the end of the backing off

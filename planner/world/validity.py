@@ -181,6 +181,12 @@ class CollisionModel:
         """The same for the pusher alone, ``pose`` being its own frame's (:func:`pusher_frame_body`)."""
         return self._clearance(pose, _PUSHER)
 
+    def part_clearance(self, pose: ArrayLike, enough: float = math.inf) -> float:
+        """The same for the part alone at ``pose``; where it exceeds ``enough``, possibly only a
+        lower bound that is itself at least ``enough`` (cheaper far from everything)."""
+        x, y, theta = pose
+        return self._body_clearance((float(x), float(y), float(theta)), _PART, enough, [])
+
     def surely_blocked(self, poses: ArrayLike) -> np.ndarray:
         """Per pose (shape ``(..., 3)``), True if the part itself certainly overlaps an obstacle or
         leaves the workspace there: its CF lies outside where the disk about the CF inside the part

@@ -75,12 +75,16 @@ def test_a_known_start_offset_is_re_planned_from_the_observed_pose(junction):
 
 
 def test_noise_alone_does_not_re_plan(junction):
-    """1 mm (per axis) and 0.5 degree of noise: the thresholds are 5 sigma (5 mm, 2.5 degrees)
-    and three observations in a row must exceed them, so nothing triggers."""
+    """1 mm (per axis) and 0.5 degree of noise: the thresholds are never below 3 sigma (3 mm, 1.5
+    degrees, and the sweep's 3 x (1 mm + R x 0.5 degree), R the block's half-diagonal; the
+    position's is half the tolerance's 1 cm, the larger) and three observations in a row must
+    exceed them, so nothing triggers, though the plan passes 1.6 mm from a wall."""
     session, plan = junction
     noise = (0.001, math.radians(0.5))
     tracker = Tracker(session, plan, noise=noise)
-    assert tracker.threshold == pytest.approx((0.005, math.radians(2.5)))
+    assert tracker.threshold == pytest.approx((0.005, math.radians(1.5)))
+    least = min(tracker.threshold_at(t)[2] for t in tracker.motion.t)
+    assert least == pytest.approx(3 * (0.001 + math.hypot(0.05, 0.03) * math.radians(0.5)))
     rng = np.random.default_rng(7)
     now, kinds = 0.0, []
     while not kinds or kinds[-1] not in ("done", "give_up"):
