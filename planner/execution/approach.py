@@ -33,7 +33,7 @@ from ..model.segments import Transit
 from ..model.scene import Scene
 from ..world.validity import CollisionModel
 
-__all__ = ["CLEARANCE", "GRAZE", "LEAD_IN", "PART_STEP", "approach", "first_edge", "lead_in_pose"]
+__all__ = ["CLEARANCE", "GRAZE", "LEAD_IN", "PART_STEP", "approach", "first_edge", "free_back_off", "lead_in_pose"]
 
 #: How far behind the first contact a run begins, m: more than the start errors a perception
 #: system makes (a centimetre or two), so the part is met, not overlapped.
@@ -56,10 +56,19 @@ def lead_in_pose(scene: Scene, model: CollisionModel, plan: Plan) -> np.ndarray:
     """Where a run's pusher starts: :data:`LEAD_IN` behind ``plan``'s first contact, or nearer
     (halving down to the transits' standoff) where a wall or obstacle is in the way."""
     contact = edge_contact_pose(scene.slider, first_edge(plan), plan.start)
-    distance = LEAD_IN
-    while distance > standoff(scene) and not model.pusher_move_is_free(backed_off(contact, distance), contact, CLEARANCE):
+    back = free_back_off(scene, model, contact, LEAD_IN)
+    return backed_off(contact, standoff(scene) if back is None else back)
+
+
+def free_back_off(scene: Scene, model: CollisionModel, pose: ArrayLike, distance: float) -> float | None:
+    """The farthest of ``distance``, its half, its quarter, ... above the transits' standoff by
+    which the pusher at ``pose`` backs straight off along its own -x keeping :data:`CLEARANCE` from
+    obstacles and walls; None if none is."""
+    while distance > standoff(scene):
+        if model.pusher_move_is_free(backed_off(pose, distance), pose, CLEARANCE):
+            return distance
         distance /= 2
-    return backed_off(contact, max(distance, standoff(scene)))
+    return None
 
 
 def _off_part(scene: Scene, part: shapely.Polygon, a: np.ndarray, b: np.ndarray) -> bool:

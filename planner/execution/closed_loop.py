@@ -471,11 +471,11 @@ def _run(session: Planner, plan: Plan, supports: dict[str, Feet], mu: float | No
     rows, moving, collisions, faults, k = [], [], 0, {}, 0
     while True:
         u = k / RATE
+        # Where the loop has the pusher at the sample: the loop changes only when it observes, below.
+        pose, height, rate, contact = loop.pusher_at(u)
         if joints is not None and k > 0:
-            pose, height, _, _ = loop.pusher_at(u)
             joints.advance(u, pose, height)
         world.step_to(SETTLE + u, pusher)
-        pose, height, rate, contact = loop.pusher_at(u)
         parts = np.ravel([world.pose(n) for n in scene.names])
         rows.append([u, *pose, *rate[:3], height, contact, len(loop.replans), *parts])
         moving.append(loop.moving)

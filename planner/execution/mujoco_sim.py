@@ -707,7 +707,7 @@ class World:
         (:meth:`_actuate`), at rest before ``u = 0``."""
         data = self.data
         self._ahead = None
-        step = TIMESTEP if self.arm is None else self.arm.timestep
+        step = self.model.opt.timestep  # the free pusher's TIMESTEP, or the arm's (arm_sim)
         while data.time < t - step / 2 and self.diverged is None:
             u = data.time - SETTLE
             pose = self._actuate(pusher, u)

@@ -113,13 +113,13 @@ from numpy.typing import ArrayLike
 
 from mechanics import pose_error, wrap_angle
 
-from ..actions.transit import backed_off, standoff
+from ..actions.transit import backed_off
 from ..model.bodies import pusher_frame_body, slider_at
 from ..model.fields import SceneError, poses
 from ..model.plan import Plan
 from ..model.segments import Transit
 from ..queries.session import Planner
-from .approach import CLEARANCE, approach, first_edge
+from .approach import approach, first_edge, free_back_off
 from .trajectory import MAX_SPEED, Trajectory, planned_part, trajectory
 
 __all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "LOOK_BACK", "LOST_PATIENCE", "REPLAN_LIMIT", "FRACTION",
@@ -384,11 +384,8 @@ class Tracker:
         free (halving down to the transits' standoff), before holding there (module docstring,
         "Lost track"); whether it does."""
         pose, height = self._held
-        distance = LOOK_BACK
-        while distance >= standoff(self.scene) and not self.session.model.pusher_move_is_free(
-                pose, backed_off(pose, distance), CLEARANCE):
-            distance /= 2
-        if distance < standoff(self.scene):
+        distance = free_back_off(self.scene, self.session.model, pose, LOOK_BACK)
+        if distance is None:
             return False
         self._held = (backed_off(pose, distance), height)
         self._backing = (now, pose, 2 * distance / MAX_SPEED)
