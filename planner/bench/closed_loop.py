@@ -86,8 +86,16 @@ def _camera(run) -> str:
              f"{errors[:, 0].max() * 1e3:.2f} mm, {np.degrees(np.median(errors[:, 1])):.2f}/"
              f"{np.degrees(np.percentile(errors[:, 1], 95)):.2f}/{np.degrees(errors[:, 1].max()):.2f} deg"
              if len(errors) else "no estimate")
-    return (f" {'ok' if run.passed else 'FAIL'} ({run.goal_error[0] * 1e3:.1f} mm"
-            f"{'; ' + run.reason if run.reason else ''}) | {error} | {run.seen.lost:.1f} s |")
+    return (f" {'ok' if run.passed else 'FAIL'} ({_outcome(run)}; {len(run.replans)} re-plans) | {error} "
+            f"| {run.seen.lost:.1f} s |")
+
+
+def _outcome(run) -> str:
+    """How a closed-loop run ended, in brief: its goal error, whether it touched a wall or
+    obstacle, why it gave up and the times it went on with its plan."""
+    return (f"{run.goal_error[0] * 1e3:.1f} mm{', collides' if run.collisions else ''}"
+            f"{'; ' + run.reason if run.reason else ''}"
+            f"{f'; went on {len(run.carried)} times' if run.carried else ''}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -143,9 +151,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"| {scene.name} | {kind}: {_shown({k: v for k, v in case.items() if v is not None})} "
                   f"| {'ok' if open_ok else 'FAIL'} ({open_run.goal_error[0] * 1e3:.1f} mm"
                   f"{', collides' if open_run.collisions else ''}) "
-                  f"| {'ok' if closed_run.passed else 'FAIL'} ({closed_run.goal_error[0] * 1e3:.1f} mm"
-                  f"{', collides' if closed_run.collisions else ''}{'; ' + closed_run.reason if closed_run.reason else ''}"
-                  f"{f'; went on {len(closed_run.carried)} times' if closed_run.carried else ''}) "
+                  f"| {'ok' if closed_run.passed else 'FAIL'} ({_outcome(closed_run)}) "
                   f"| {len(closed_run.replans)} | {timing} |{_camera(camera_run) if looks else ''}",
                   flush=True)
     if total:

@@ -84,7 +84,8 @@ def _off_part(scene: Scene, part: shapely.Polygon, a: np.ndarray, b: np.ndarray)
 
 
 def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | None, pusher: ArrayLike,
-             part: ArrayLike, edge: int, edges: list[int]) -> Transit | None:
+             part: ArrayLike, edge: int, edges: list[int], behind: float = 0.0,
+             actual: ArrayLike | None = None, airborne: bool = False) -> Transit | None:
     """The pusher's collision-checked path from its pose ``pusher`` to the contact on ``edge`` of
     the part at ``part`` (module docstring), as a transit (mode ``'plane'``, or ``'lift'`` where
     the scene lifts), or None if none of the ways tried is free. ``edges`` are those the pusher may be put on (for a walk round).
@@ -94,11 +95,20 @@ def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | Non
     part, and its backing off is not checked against the part), then so, or round the part from
     the standoff pose of the edge of ``edges`` nearest the pusher as a transit goes. The standoff
     in front of ``edge`` is tried at a half and a quarter of the transits' where a wall is close
-    behind the edge."""
+    behind the edge.
+
+    To square a part (:mod:`.squaring`), ``part`` is where it will be and ``actual`` where it is:
+    the moves but the last keep off it there too, and the standoff poses are ``behind`` (m)
+    farther back, by as much as its face sticks out towards the pusher.
+
+    A pusher stopped ``airborne`` (on a lift's flight) is not put down where it is, which may be
+    over the part: it flies on to the standoff pose and comes down there (a lift transit whose
+    first move has no length; the caller keeps it at its height until the flight,
+    :meth:`.tracker.Tracker.pusher_at`)."""
     pusher, part = np.asarray(pusher, dtype=float), np.asarray(part, dtype=float)
     gap = standoff(scene)
     contact = edge_contact_pose(scene.slider, edge, part)
-    fronts = [backed_off(contact, near) for near in (gap, gap / 2, gap / 4)]
+    fronts = [backed_off(contact, near + behind) for near in (gap, gap / 2, gap / 4)]
     ways = [[pusher, front, contact] for front in fronts]
     walks = []
     # (A session with less friction, after slip, may not push the edge the pusher was on: no walk to it.)
@@ -114,8 +124,10 @@ def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | Non
         retreat = backed_off(pusher, back)
         ways += [[pusher, retreat, front, contact] for front in fronts] + [[pusher, retreat, *w] for w in walks]
     body = slider_at(scene.slider.polygon, part)
+    if actual is not None:
+        body = body.union(slider_at(scene.slider.polygon, actual))
     reach = float(np.linalg.norm(pusher_frame_body(scene.pusher.width, scene.pusher.depth), axis=1).max())
-    for way in ways:
+    for way in [] if airborne else ways:
         way = [p for k, p in enumerate(way) if k == 0 or np.abs(p - way[k - 1]).max() > 1e-12]
         moves = list(zip(way, way[1:]))
         backing = len(way) > 3  # the first move backs straight off, away from the face: not checked on the part
@@ -124,10 +136,10 @@ def approach(scene: Scene, model: CollisionModel, transits: TransitPlanner | Non
             path = np.array(way)
             return Transit(edge, edge, "plane", path, path_duration(path, reach), part.copy())
     if transits is not None and transits.mode == "lift":
-        for back in (gap, 3 * gap, LEAD_IN):
+        for back in (0.0,) if airborne else (gap, 3 * gap, LEAD_IN):
             for front in fronts:
                 path = np.array([pusher, backed_off(pusher, back), front, contact])
                 lift = Transit(edge, edge, "lift", path, path_duration(path, reach), part.copy())
-                if all(model.pusher_move_is_free(a, b, CLEARANCE) for a, b in in_plane_moves(lift)):
+                if all(model.pusher_move_is_free(a, b, CLEARANCE) for a, b in in_plane_moves(lift)[int(airborne):]):
                     return lift
     return None

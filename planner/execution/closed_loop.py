@@ -395,7 +395,7 @@ class _Loop:
                                                lone.start), *lone.segments])
         try:
             tracker = Tracker(mover, lone, pusher=None if way is not None else pusher, time=now + latency,
-                              noise=self.noise, seed=self.seed, goal=goal)
+                              noise=self.noise, seed=self.seed, goal=goal, height=0.0 if way is not None else self._held[1])
         except SceneError as err:
             self.reason = f"no way for the pusher from {left} to {lone.part}: {err.problem}"
             return

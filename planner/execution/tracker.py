@@ -68,11 +68,22 @@ assume :data:`FRICTION_STEP` times the friction the last plan assumed (a session
 to :data:`FRICTION_FLOOR` times the planned. Sticking at a lower friction implies sticking at any
 higher one, so a plan for too low a friction still holds; it is only more cautious.
 
-**Going on.** When the planner finds no plan from the observed pose, or the pusher has no free
-approach to any edge (a part turned in a narrow corridor leaves no room for the pusher flush on
-any face), the pusher goes on with the plan it has, from where it stopped: a flat pusher that
-meets a part askew turns it flush and funnels its error (open loop in MuJoCo), after which a plan
-may exist. Deviations are not looked at until the pusher has moved the part's radius on along the
+**Squaring.** When the planner finds no plan from the observed pose, or the pusher has no free
+approach to any edge, the part is often turned off the plan in a narrow corridor: it leaves no
+room for the pusher flush on any face, or for the margin a plan keeps from the walls. A flat
+pusher that meets a part askew turns it flush against itself, and pushing one face moves it
+towards the wall while it turns, the opposite face away from it (:mod:`.squaring`). So where the
+part is turned off the plan's heading (where the pusher stopped) by more than the heading
+threshold, the pusher is driven straight, at that heading, to the contact of the part as
+:func:`.squaring.squared` predicts it once flush, on the face that leaves it most room (its
+sweep and the pusher flush at the end keeping the margin a push keeps, and the way there free,
+:func:`.approach.approach`); deviations are not counted on the way; at the end the part is
+observed at rest and re-planned from as after a deviation. It counts as a re-plan (a plan of one
+transit, planner ``'squaring'``).
+
+**Going on.** Where no face can be squared either, the pusher goes on with the plan it has, from
+where it stopped: a flat pusher that meets a part askew turns it flush and funnels its error
+(open loop in MuJoCo), after which a plan may exist. Deviations are not looked at until the pusher has moved the part's radius on along the
 plan (or the plan ends); then the loop looks again. Each time counts against the budget.
 
 **Lost track.** A camera may not see the part (the pusher or the arm hides it, or it left the
@@ -104,7 +115,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import StrEnum
 
 import numpy as np
@@ -113,6 +124,7 @@ from numpy.typing import ArrayLike
 
 from mechanics import pose_error, wrap_angle
 
+from ..actions.controls import clearance_margin
 from ..actions.transit import backed_off
 from ..model.bodies import pusher_frame_body, slider_at
 from ..model.fields import SceneError, poses
@@ -120,7 +132,8 @@ from ..model.plan import Plan
 from ..model.segments import Transit
 from ..queries.session import Planner
 from .approach import approach, first_edge, free_back_off
-from .trajectory import MAX_SPEED, Trajectory, planned_part, trajectory
+from .squaring import squared
+from .trajectory import LIFT_HEIGHT, MAX_SPEED, Trajectory, planned_part, trajectory
 
 __all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "LOOK_BACK", "LOST_PATIENCE", "REPLAN_LIMIT", "FRACTION",
            "ROOM", "SETTLE", "SIGMAS",
@@ -238,6 +251,9 @@ class Tracker:
     goal : (3,) array_like, optional
         Where the part is taken (default: the scene's goal): a move of a scene of several parts
         may leave its part aside, at a buffer pose, for a later move.
+    height : float
+        How high above the table the pusher is at ``pusher`` (> 0: stopped on a lift's flight, it
+        is brought down at the standoff pose, not where it is).
 
     Raises
     ------
@@ -256,7 +272,7 @@ class Tracker:
     def __init__(self, session: Planner, plan: Plan, *, pusher: ArrayLike | None = None, time: float = 0.0,
                  noise: tuple[float, float] = (0.0, 0.0), confirm: int = CONFIRM, settle: int = SETTLE,
                  budget: int = BUDGET, seed: int | None = None, time_limit: float = REPLAN_LIMIT,
-                 goal: ArrayLike | None = None):
+                 goal: ArrayLike | None = None, height: float = 0.0):
         if not isinstance(session, Planner):
             raise SceneError("session", f"must be a Planner, got {type(session).__name__}")
         if not (isinstance(plan, Plan) and plan.solved and plan.segments):
@@ -306,7 +322,8 @@ class Tracker:
         self._theta = np.zeros(0)
         self._since, self._quiet = float(time), 0.0
         start = self._pose(plan.start, "plan.start")
-        first = self._begin(plan, self._pose(pusher, "pusher") if pusher is not None else None, start, float(time))
+        first = self._begin(plan, self._pose(pusher, "pusher") if pusher is not None else None, start, float(time),
+                            float(height))
         if first:
             raise SceneError("pusher", first)
 
@@ -317,18 +334,23 @@ class Tracker:
             raise SceneError(name, f"must be one pose (x, y, theta), got {len(rows)}")
         return rows[0]
 
-    def _begin(self, plan: Plan, pusher: np.ndarray | None, part: np.ndarray, now: float) -> str:
+    def _begin(self, plan: Plan, pusher: np.ndarray | None, part: np.ndarray, now: float, height: float = 0.0) -> str:
         """Follow ``plan`` from ``now``, the pusher first approaching its first contact from
-        ``pusher`` (if given); the reason if there is no free approach."""
+        ``pusher`` (if given), ``height`` above the table; the reason if there is no free approach."""
         segments = list(plan.segments)
         if pusher is not None:
-            way = self._approach(pusher, part, first_edge(plan))
+            way = self._approach(pusher, part, first_edge(plan), height)
             if way is None:
                 return "no free approach from the pusher to the plan's first contact"
             segments.insert(0, way)
         self.plan, self._segments = plan, segments
         led = plan.with_segments(segments)
         self.motion = trajectory(self.scene, led)
+        up = self.motion.z >= LIFT_HEIGHT - 1e-12
+        if height > 0 and up.any():  # stopped in the air: it stays up until its approach's flight (approach, airborne)
+            top, z = int(np.argmax(up)), self.motion.z.copy()
+            z[:top] = np.maximum(z[:top], height)
+            self.motion = replace(self.motion, z=z)
         self.expected = planned_part(self.scene, led, self.motion)
         self.ahead = self._room_ahead()
         self._theta = np.unwrap(self.motion.theta)
@@ -350,9 +372,10 @@ class Tracker:
         ends = np.searchsorted(travel, travel + self._reach, side="right")
         return np.array([here[k:j].min() for k, j in enumerate(ends)])
 
-    def _approach(self, pusher: np.ndarray, part: np.ndarray, edge: int) -> Transit | None:
+    def _approach(self, pusher: np.ndarray, part: np.ndarray, edge: int, height: float = 0.0, **squaring) -> Transit | None:
+        """:func:`.approach.approach` from ``pusher``, ``height`` above the table (> 0: on a lift's flight)."""
         return approach(self.scene, self.session.model, self.session.transits, pusher, part, edge,
-                        list(self.session.stable_edges))
+                        list(self.session.stable_edges), airborne=height > 0, **squaring)
 
     def pusher_at(self, now: float) -> tuple[np.ndarray, float, np.ndarray, bool]:
         """Where the pusher frame should be at ``now``: pose ``(x, y, theta)`` (theta unwrapped along
@@ -537,39 +560,43 @@ class Tracker:
         certificate = self.session.certify_unreachable(self.goal, start=part)
         if certificate:
             return self._give_up(now, error, f"the goal is unreachable from the observed pose: {certificate}")
-        pusher = self._held[0]
+        pusher, height = self._held
         try:
             # First a plan that begins on the edge the pusher is at, so that it only has to come
             # back to the part; then one that begins on an edge the pusher can get to from there.
             found = None
-            if self._approach(pusher, part, self._edge) is not None:
+            if self._approach(pusher, part, self._edge, height) is not None:
                 found = self.session.plan(start=part, goal=self.goal, seed=self.seed, time_limit=self.time_limit,
                                           edges=[self._edge], observed=True)
             if found is None or not found.solved:
                 others = [e for e in self.session.stable_edges if e != self._edge]
-                reached = [e for e in others if self._approach(pusher, part, e) is not None]
+                reached = [e for e in others if self._approach(pusher, part, e, height) is not None]
                 if not reached and found is None:
-                    return self._carry_on(now, error, "no free approach from the pusher to any edge of the part", clock)
+                    return self._carry_on(now, part, error, "no free approach from the pusher to any edge of the part", clock)
                 if reached:
                     found = self.session.plan(start=part, goal=self.goal, seed=self.seed, time_limit=self.time_limit,
                                               edges=reached, observed=True)
         except SceneError as err:  # the pusher has no room at the observed pose
-            return self._carry_on(now, error, f"no plan from the observed pose: {err.problem}", clock)
+            return self._carry_on(now, part, error, f"no plan from the observed pose: {err.problem}", clock)
         if not found.solved or not found.segments:
-            return self._carry_on(now, error, f"no plan from the observed pose: {found.reason or 'no segments'}", clock)
+            return self._carry_on(now, part, error, f"no plan from the observed pose: {found.reason or 'no segments'}", clock)
         latency = time.perf_counter() - clock
         # The new plan begins when it is there: the pusher held still until then.
-        problem = self._begin(found, pusher, part, now + latency)
+        problem = self._begin(found, pusher, part, now + latency, height)
         if problem:
             self._held = (pusher, 0.0)
             return self._give_up(now, error, problem)
         self.replans.append(Replan(now, part, trigger, trigger_error, why, latency, found, self.session.scene.pusher.mu))
         return self._command(Action.REPLAN, now, error, found)
 
-    def _carry_on(self, now: float, error: tuple[float, float], reason: str, clock: float) -> Command:
-        """No plan from where the part is (``reason``): go on with the plan from where the pusher
-        stopped, deaf to deviations until it has moved the part's radius on (module docstring,
-        "Going on"); give up if the plan had ended or the budget is spent."""
+    def _carry_on(self, now: float, part: np.ndarray, error: tuple[float, float], reason: str,
+                  clock: float) -> Command:
+        """No plan from where the part is, observed at ``part`` (``reason``): square it if it is
+        askew (:meth:`_square`), else go on with the plan from where the pusher stopped, deaf to
+        deviations until it has moved the part's radius on (module docstring, "Going on"); give
+        up if the plan had ended or the budget is spent."""
+        if len(self.replans) + len(self.carried) < self.budget and (squaring := self._square(now, part, reason, clock)):
+            return squaring
         if self._stopped >= self.motion.duration or len(self.replans) + len(self.carried) >= self.budget:
             return self._give_up(now, error, reason)
         self.carried.append((now, reason))
@@ -581,6 +608,45 @@ class Tracker:
         self._since = now + (time.perf_counter() - clock) - self._stopped
         self._held, self._strikes, self._last = None, 0, None
         return self._command(Action.FOLLOW, now, error)
+
+    def _square(self, now: float, part: np.ndarray, reason: str, clock: float) -> Command | None:
+        """Square the part observed at ``part`` turned off the plan's heading where the pusher
+        stopped (module docstring, "Squaring"): drive the pusher straight at the face whose
+        squared part (:func:`.squaring.squared`) keeps most room from the walls, obstacles and
+        other parts, to that part's contact, deaf to deviations on the way, then observe it at
+        rest and re-plan. None where the part is not turned beyond the heading threshold, or no
+        face has a squared part with room for it and for the pusher flush, and a free way there."""
+        stopped = min(int(np.searchsorted(self.motion.t, self._stopped)), len(self.motion.t) - 1)
+        heading = float(self.expected[stopped, 2])
+        turn = abs(float(wrap_angle(part[2] - heading)))
+        if turn <= self.threshold[1]:
+            return None
+        model, room = self.session.model, clearance_margin(self.scene)
+        (pusher, height), best = self._held, None
+        for edge in self.session.stable_edges:
+            square, advance = squared(self.scene.slider, part, edge, heading)
+            # The part swept while it turns, and its pusher flush once square, keep the room a push keeps.
+            sweep = [squared(self.scene.slider, part, edge, float(wrap_angle(part[2] + u * float(
+                wrap_angle(heading - part[2])))))[0] for u in (0.25, 0.5, 0.75)]
+            if not (model.is_clear(square, edge, room) and all(model.part_clearance(p, room) > room for p in sweep)):
+                continue
+            way = self._approach(pusher, square, edge, height, behind=advance, actual=part)
+            if way is not None:
+                clear = model.part_clearance(square)
+                if best is None or clear > best[0]:
+                    best = (clear, edge, square, way)
+        if best is None:
+            return None
+        _, edge, square, way = best
+        plan = Plan.of_part(self.plan.part, part, square, [way], solved=True, scene=self.plan.scene,
+                            planner="squaring", seed=self.seed or 0, planning_time_s=time.perf_counter() - clock)
+        latency = time.perf_counter() - clock
+        self._begin(plan, None, part, now + latency, height)
+        self._quiet = self.motion.duration  # the part turns against the pusher on the way: judged once square
+        why = f"{reason}; squaring the part, {math.degrees(turn):.1f} deg askew, against edge {edge}"
+        trigger, trigger_error, _, _ = self._trigger
+        self.replans.append(Replan(now, part, trigger, trigger_error, why, latency, plan, self.session.scene.pusher.mu))
+        return self._command(Action.REPLAN, now, (math.nan, math.nan), plan)
 
     def _give_up(self, now: float, error: tuple[float, float], reason: str) -> Command:
         self.reason = reason

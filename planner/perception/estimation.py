@@ -61,7 +61,7 @@ from .registration import Fit, distances, register
 from .silhouette import GUARD, Silhouette, silhouette
 from .table_view import SMOOTHING, plane_pixels, smoothed_noise, table_view
 
-__all__ = ["CONTRAST", "CORRELATED", "GATE", "HIDDEN", "MAX_SIGMA", "MIN_POINTS", "MIN_VISIBLE", "PAD", "SYSTEMATIC",
+__all__ = ["AS_WELL", "CONTRAST", "CORRELATED", "GATE", "HIDDEN", "MAX_SIGMA", "MIN_POINTS", "MIN_VISIBLE", "PAD", "SYSTEMATIC",
            "TABLE_INSIDE", "Estimate", "estimate_poses", "sight"]
 
 #: Farthest an edge point may be from a part's outline at its prior and still be the part's, m:
@@ -88,6 +88,10 @@ TABLE_INSIDE = 0.02
 CORRELATED = 4.0
 #: The deviation left without noise, in pixels' footprints (module docstring).
 SYSTEMATIC = 0.25
+#: Two registrations fit the points as well when one's cost is within this factor of the other's
+#: (:func:`_fit`): far below what a fit caught a centimetre off costs (points a centimetre off, eight
+#: pixels' footprints, cost over a hundred times those on the outline).
+AS_WELL = 1.5
 
 
 @dataclass(frozen=True)
@@ -202,13 +206,19 @@ def _footprint(camera: Camera, pose: np.ndarray, top: float) -> float:
 
 def _fit(points: np.ndarray, outline: np.ndarray, start: np.ndarray, pixel: float) -> Fit | None:
     """The better registration of ``outline`` to ``points`` from ``start`` and from ``start`` moved
-    onto the points' centre (None if there are fewer than :data:`MIN_POINTS`)."""
+    onto the points' centre; where both fit as well (the cost within :data:`AS_WELL` times the
+    other's), the one from ``start`` (None if there are fewer than :data:`MIN_POINTS`).
+
+    Two fits as good are two poses the points cannot tell apart: a corner seen with parts of its
+    two edges, the rest hidden, fits the outline's other corners too, turned a quarter. Continuity
+    decides, as for look-alikes (module docstring)."""
     if len(points) < MIN_POINTS:
         return None
     ring = np.vstack([outline, outline[:1]])
     centre = shapely.LinearRing(ring).centroid  # where the points' centre is when all of it is seen
     moved = np.array([*(points.mean(axis=0) - transform_points([centre.x, centre.y], start) + start[:2]), start[2]])
-    return min((register(points, outline, s, pixel) for s in (start, moved)), key=lambda f: f.cost(pixel))
+    near, other = (register(points, outline, s, pixel) for s in (start, moved))
+    return near if near.cost(pixel) <= AS_WELL * other.cost(pixel) else other
 
 
 def _judge(seen: Silhouette, outline: np.ndarray, prior: np.ndarray, points: np.ndarray, pixel: float,

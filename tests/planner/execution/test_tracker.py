@@ -18,8 +18,10 @@ import pytest
 
 from planner import Planner, load_scene
 from planner.actions.transit import edge_contact_pose
-from planner.execution.approach import approach, lead_in_pose
+from planner.execution.approach import GRAZE, approach, lead_in_pose
 from planner.execution.tracker import CONFIRM, SETTLE, Tracker, mean_pose
+from planner.execution.trajectory import LIFT_HEIGHT
+from planner.model.bodies import slider_at
 from planner.model.fields import SceneError
 from planner.model.scene_file import parse_scene
 
@@ -170,15 +172,17 @@ def test_a_part_sliding_along_the_pusher_is_re_planned_for_less_friction(junctio
 
 
 def test_where_no_plan_starts_the_pusher_goes_on_with_its_plan_then_looks_again():
-    """narrow_junction's block 12 mm along and 6 mm across its corridor, turned 7 degrees, leaves
-    the pusher no room flush on any face: no plan starts there. The pusher goes on with the plan
-    from where it stopped, deaf to the part being off it until it has moved the part's radius on;
-    then a part back on the plan is followed to the goal."""
+    """narrow_junction's block 12 mm along and 12.5 mm across its corridor, turned half a degree,
+    is 0.06 mm from the wall (12.5 + 30 cos 0.5 + 50 sin 0.5 = 42.94 mm of 43), less than the
+    margin a plan keeps: no plan starts there; and it is turned less than the heading threshold
+    (1 degree), so squaring it would not help. The pusher goes on with the plan from where it
+    stopped, deaf to the part being off it until it has moved the part's radius on; then a part
+    back on the plan is followed to the goal."""
     scene = load_scene(ROOT / "scenes" / "narrow_junction.yaml")
     session = Planner(scene)
     plan = session.plan(seed=1)
     tracker = Tracker(session, plan, pusher=lead_in_pose(scene, session.model, plan))
-    askew = scene.start + [0.012, 0.006, math.radians(-7)]
+    askew = scene.start + [0.012, 0.0125, math.radians(-0.5)]
     assert max(session.model.clearance(askew, e) for e in scene.edges) < scene.slider.radius / 40
     kinds = [tracker.observe(k / RATE, askew).kind for k in range(CONFIRM + SETTLE)]
     assert kinds[-1] == "follow" and tracker.replans == [] and not tracker.reason
@@ -195,6 +199,34 @@ def test_where_no_plan_starts_the_pusher_goes_on_with_its_plan_then_looks_again(
         last = tracker.observe(now, on_plan(tracker, now)).kind
         now += 1 / RATE
     assert last == "done" and tracker.replans == [] and len(tracker.carried) == 1
+
+
+def test_a_pusher_stopped_in_the_air_over_the_part_comes_down_beside_it_not_on_it():
+    """narrow_junction's plan lifts the pusher over the block to its opposite face. Stopped half way
+    over (the block seen 8 mm off the plan there), the pusher is held in the air above the block;
+    the re-plan's way to the block must keep it up until it is over the standoff pose and come down
+    there: wherever it is lower than it was held on that way, the pusher is off the block."""
+    scene = load_scene(ROOT / "scenes" / "narrow_junction.yaml")
+    session = Planner(scene)
+    tracker = Tracker(session, session.plan(seed=1))
+    m = tracker.motion
+    flight = np.flatnonzero(m.z >= LIFT_HEIGHT - 1e-12)
+    middle = m.t[flight[len(flight) // 2]]
+    now = 0.0
+    while now < middle:
+        assert tracker.observe(now, on_plan(tracker, now)).kind == "follow"
+        now += 1 / RATE
+    off = on_plan(tracker, now) + [0.008, 0.0, 0.0]
+    block = slider_at(scene.slider.polygon, off)
+    held, height, _, _ = tracker.pusher_at(now)
+    assert height == pytest.approx(LIFT_HEIGHT) and slider_at(tracker._body, held).intersects(block)
+    kinds = [tracker.observe(now + k / RATE, off).kind for k in range(CONFIRM + SETTLE)]
+    assert kinds[-1] == "replan" and tracker.pusher_at(now + 1.0)[1] == pytest.approx(LIFT_HEIGHT)
+    m, lower = tracker.motion, tracker.motion.z < height - 1e-9
+    assert lower.any() and m.z[0] == pytest.approx(height)
+    body = tracker._body.buffer(-GRAZE, join_style="mitre")
+    for k in np.flatnonzero(lower & (m.segment == 0)):  # the way to the block, before any push
+        assert not slider_at(body, [m.x[k], m.y[k], m.theta[k]]).intersects(block), m.t[k]
 
 
 def test_where_the_arm_lifts_the_pusher_is_lifted_over_to_a_face_it_cannot_walk_to():
