@@ -17,10 +17,13 @@ plan has them, :meth:`~planner.queries.session.Planner.move_session`), which tak
 the move's end (its goal, or the buffer pose it is left at for a later move). Every part is
 observed, each with noise of its own. The moves left are re-planned when the move's tracker is
 done or gives up, or when a part not being moved is observed off where the plan has it (beyond
-the tracker's thresholds on :data:`~.tracker.CONFIRM` observations in a row: it was knocked or
-shoved): the pusher is held still, :data:`~.tracker.SETTLE` observations of every part at rest
-are averaged, and a fresh session of the scene, every part's start at its mean (parts in their
-goals stay, as the search leaves them), plans the moves left; the re-plan's latency runs on the
+the tracker's position and heading thresholds for that observation's noise,
+:meth:`.tracker.Tracker.threshold_at`, on :data:`~.tracker.CONFIRM` observations in a row: it
+was knocked or shoved): the pusher is held still, :data:`~.tracker.SETTLE` observations of every
+part at rest are averaged (where a part is hidden, the pusher first backs off to look, and the
+run gives up once a part has gone unseen for :data:`~.tracker.LOST_PATIENCE` s), and a fresh
+session of the scene, every part's start at its mean (parts in their goals stay, as the search
+leaves them), plans the moves left; the re-plan's latency runs on the
 simulated clock as a tracker's does. The new plan's first move begins from where the pusher is:
 from another part by a transfer as the planner makes them
 (:class:`~planner.search.transfer.TransferPaths`, the parts where they are observed), from the
@@ -74,7 +77,7 @@ from .approach import first_edge, lead_in_pose
 from .camera_observer import CameraObserver
 from .mujoco_sim import (SETTLE, TABLE_MU, ByPart, Feet, Runs, World, _one, _worst, foot_sets, needs_mujoco,
                          perturbations, write_mjcf)
-from .tracker import BUDGET, CONFIRM, Replan, Tracker, mean_pose
+from .tracker import BUDGET, CONFIRM, LOST_PATIENCE, Replan, Tracker, backing, look_back, mean_pose
 from .tracker import SETTLE as AT_REST  # observations of the parts at rest (mujoco_sim's SETTLE is seconds)
 from .trajectory import RATE, Trajectory
 
@@ -266,6 +269,9 @@ class _Loop:
         self._carried: list[tuple[float, str]] = []
         self._spent = 0  # re-plans of the moves left that no move's end asked for
         self._held: tuple[np.ndarray, float] | None = None  # the pusher held still while the moves left are re-planned
+        # Backing off to look at a part hidden while held: (start time, from pose, duration), or None.
+        self._looking: tuple[float, np.ndarray, float] | None = None
+        self._unseen: float | None = None  # since when some part has not been seen while held
         self._window: list[dict[str, np.ndarray]] = []  # every part's observations since
         self._trigger: tuple[str, np.ndarray, tuple[float, float], str, bool] | None = None
         self._strikes: dict[str, int] = {}
@@ -307,8 +313,15 @@ class _Loop:
         """:meth:`.tracker.Tracker.pusher_at` of the tracker, or the pusher held still."""
         if self._held is not None:
             pose, height = self._held
+            if self._backing_off(now):
+                began, start, duration = self._looking
+                moving, rate = backing(now - began, duration, start, pose)
+                return moving, height, rate, False
             return pose.copy(), height, np.zeros(4), False
         return self.tracker.pusher_at(now)
+
+    def _backing_off(self, now: float) -> bool:
+        return self._looking is not None and now < self._looking[0] + self._looking[2]
 
     def observe(self, now: float, seen: dict[str, np.ndarray], taken: float | None = None,
                 lost: Mapping[str, str] | None = None, hidden: Collection[str] = (),
@@ -320,11 +333,7 @@ class _Loop:
         not judged); whether the run has ended."""
         lost = lost or {}
         if self._held is not None:
-            if not lost:  # the mean of the parts at rest needs every part seen
-                self._window.append(seen)
-            if len(self._window) >= AT_REST:
-                self._replan(now)
-            return self.done or bool(self.reason)
+            return self._at_rest(now, seen, lost, hidden)
         if self.moving in lost:
             command = self.tracker.unseen(now, lost[self.moving], self.moving in hidden)
         else:
@@ -345,7 +354,8 @@ class _Loop:
                 continue
             planned = self.plan.starts[name]  # where the plan has it until it is moved
             error = pose_error(pose, planned)
-            beyond = error[0] > self.tracker.threshold[0] or error[1] > self.tracker.threshold[1]
+            limit = self.tracker.threshold_at(now, (covariances or {}).get(name))  # the estimate's own noise too
+            beyond = error[0] > limit[0] or error[1] > limit[1]
             self._strikes[name] = self._strikes.get(name, 0) + 1 if beyond else 0
             if self._strikes[name] >= CONFIRM:
                 why = f"{name} is off the plan by {error[0] * 1000:.1f} mm, {math.degrees(error[1]):.1f} deg"
@@ -358,8 +368,35 @@ class _Loop:
         """Hold the pusher where it is and observe the parts at rest before re-planning the moves
         left, because of part ``name`` observed at ``pose`` (``counted`` against the budget)."""
         pusher, height, _, _ = self.tracker.pusher_at(now)
-        self._held, self._window = (pusher, height), []
+        self._held, self._window, self._looking, self._unseen = (pusher, height), [], None, None
         self._trigger = (name, pose, error, why, counted)
+
+    def _at_rest(self, now: float, seen: dict[str, np.ndarray], lost: Mapping[str, str], hidden: Collection[str]) -> bool:
+        """Observe the parts at rest while held (:meth:`_hold`), then re-plan; whether the run has
+        ended. The mean needs every part seen: where one is hidden (under the arm's hand, say),
+        the pusher first backs off to look, as a tracker does (:func:`.tracker.look_back`), and
+        the run gives up once a part has not been seen for :data:`~.tracker.LOST_PATIENCE` s."""
+        if self._backing_off(now):
+            return False
+        if not lost:
+            self._unseen = None
+            self._window.append(seen)
+            if len(self._window) >= AT_REST:
+                self._replan(now)
+            return self.done or bool(self.reason)
+        self._window = []
+        if self._looking is None and set(lost) & set(hidden):
+            pose, height = self._held
+            back = look_back(self.tracker.scene, self.tracker.session.model, pose)
+            if back is not None:
+                self._held, self._looking, self._unseen = (back[0], height), (now, pose, back[1]), None
+                return False
+        self._unseen = now if self._unseen is None else self._unseen
+        if now - self._unseen >= LOST_PATIENCE:
+            self.reason = (f"lost track of {', '.join(sorted(lost))} for {now - self._unseen:.1f} s while re-planning "
+                           f"the moves left: {'; '.join(lost[n] for n in sorted(lost))}")
+            return True
+        return False
 
     def _replan(self, now: float) -> None:
         """Re-plan the moves left from the parts' mean poses and begin the new plan's first move
@@ -402,7 +439,7 @@ class _Loop:
         self._past += [*self.tracker.replans, Replan(now, means[name], trigger, error, why, latency, found,
                                                      observed.pusher.mu)]
         self._carried += self.tracker.carried
-        self.tracker, self._held, self._strikes, self._seen = tracker, None, {}, lone.start
+        self.tracker, self._held, self._strikes, self._seen, self._looking = tracker, None, {}, lone.start, None
         self._left = left if lone.part != left else None
 
 

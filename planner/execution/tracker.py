@@ -129,15 +129,17 @@ from ..actions.transit import backed_off
 from ..model.bodies import pusher_frame_body, slider_at
 from ..model.fields import SceneError, poses
 from ..model.plan import Plan
+from ..model.scene import Scene
 from ..model.segments import Transit
 from ..queries.session import Planner
+from ..world.validity import CollisionModel
 from .approach import approach, first_edge, free_back_off
 from .squaring import squared
 from .trajectory import LIFT_HEIGHT, MAX_SPEED, Trajectory, planned_part, trajectory
 
 __all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "LOOK_BACK", "LOST_PATIENCE", "REPLAN_LIMIT", "FRACTION",
            "ROOM", "SETTLE", "SIGMAS",
-           "Action", "Command", "Replan", "Tracker", "mean_pose"]
+           "Action", "Command", "Replan", "Tracker", "backing", "look_back", "mean_pose"]
 
 #: Thresholds: this fraction of the goal tolerance, and at least this many deviations of the
 #: observation (module docstring, "When to re-plan").
@@ -211,6 +213,30 @@ class Replan:
     latency: float
     plan: Plan
     mu: float
+
+
+def look_back(scene: Scene, model: CollisionModel, pose: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """Where a pusher stopped at ``pose`` backs off to look at a part it hides: along its own -x,
+    up to :data:`LOOK_BACK` where the way is free (halving down to the transits' standoff,
+    :func:`.approach.free_back_off`), and how long that takes at the pusher's cruising speed; None
+    if it cannot back off."""
+    distance = free_back_off(scene, model, pose, LOOK_BACK)
+    return None if distance is None else (backed_off(pose, distance), 2 * distance / MAX_SPEED)
+
+
+def backing(elapsed: float, duration: float, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pusher's pose and velocity ``(vx, vy, omega, vz)`` ``elapsed`` seconds into a move of
+    ``duration`` seconds from ``start`` to ``end``: a half cosine in time, at rest at both ends, at
+    most pi / 2 times the mean speed on the way.
+
+    >>> pose, rate = backing(1.0, 2.0, np.zeros(3), np.array([0.1, 0.0, 0.0]))
+    >>> pose.round(12).tolist(), rate.round(12).tolist()
+    ([0.05, 0.0, 0.0], [0.07853981634, 0.0, 0.0, 0.0])
+    """
+    phase = math.pi * min(max(elapsed / duration, 0.0), 1.0)
+    share, pace = (1 - math.cos(phase)) / 2, math.pi * math.sin(phase) / (2 * duration)
+    way = end - start
+    return start + share * way, np.array([*(pace * way[:2]), pace * way[2], 0.0])
 
 
 def mean_pose(rows: ArrayLike) -> np.ndarray:
@@ -403,15 +429,14 @@ class Tracker:
         self._held, self._window, self._backing = (pose, height), [], None
 
     def _look_back(self, now: float) -> bool:
-        """Back the held pusher off along its own -x, up to :data:`LOOK_BACK` where the way is
-        free (halving down to the transits' standoff), before holding there (module docstring,
-        "Lost track"); whether it does."""
+        """Back the held pusher off to look (:func:`look_back`), before holding there (module
+        docstring, "Lost track"); whether it does."""
         pose, height = self._held
-        distance = free_back_off(self.scene, self.session.model, pose, LOOK_BACK)
-        if distance is None:
+        back = look_back(self.scene, self.session.model, pose)
+        if back is None:
             return False
-        self._held = (backed_off(pose, distance), height)
-        self._backing = (now, pose, 2 * distance / MAX_SPEED)
+        self._held = (back[0], height)
+        self._backing = (now, pose, back[1])
         return True
 
     def _still_backing(self, now: float) -> bool:
@@ -419,13 +444,10 @@ class Tracker:
         return self._backing is not None and now < self._backing[0] + self._backing[2]
 
     def _backed(self, now: float, end: np.ndarray, height: float) -> tuple[np.ndarray, float, np.ndarray, bool]:
-        """:meth:`pusher_at` while backing off to ``end``: a half cosine in time (at rest at both
-        ends, at most :data:`~.trajectory.MAX_SPEED` times pi/4 on the way)."""
+        """:meth:`pusher_at` while backing off to ``end`` (:func:`backing`)."""
         began, start, duration = self._backing
-        phase = math.pi * (now - began) / duration
-        share, pace = (1 - math.cos(phase)) / 2, math.pi * math.sin(phase) / (2 * duration)
-        way = end - start
-        return start + share * way, height, np.array([*(pace * way[:2]), pace * way[2], 0.0]), False
+        pose, rate = backing(now - began, duration, start, end)
+        return pose, height, rate, False
 
     def planned(self, now: float) -> np.ndarray:
         """The part's planned pose at ``now``."""

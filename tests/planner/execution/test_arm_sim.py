@@ -11,6 +11,7 @@ reported by name; the recording's arm starts at the robot's base.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -176,6 +177,26 @@ def test_the_closed_loop_with_the_arm_delivers_a_part_the_open_loop_misses(tmp_p
     assert "pusher held by the panda arm" in capsys.readouterr().out
     assert main([str(AROUND), "--simulate", "1", "--closed-loop", *error, "--out", str(tmp_path / "closed")]) == 0, \
         capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_the_closed_loop_with_the_arm_delivers_through_the_overhead_camera(tmp_path, capsys):
+    """The same start seen through the default overhead camera: the Panda's forearm and hand hide
+    the part for about half of the run (it is pushed on blind and looked for where the plan has
+    it), and it is delivered (exit 0), no estimate more than 10 degrees off. A corner of it seen
+    alone fitted the outline a quarter turn off as well as the right way, in every run before the
+    estimator kept, of two fits as good, the one nearer the prior (93 degrees off at worst; the loop
+    then lost the part in 3 of 6 runs); tests/planner/perception/test_estimation.py."""
+    from planner.cli import main
+
+    error = ["--sim-start-error", "0.015", "-0.01", "8", "--seed", "1"]
+    code = main([str(AROUND), "--simulate", "1", "--closed-loop", "--observe", "camera", *error,
+                 "--out", str(tmp_path / "camera")])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    lost = float(re.search(r"lost (\d+\.\d) s", out).group(1))
+    worst = float(re.search(r"mm, [\d.]+/[\d.]+/([\d.]+) deg \(median/p95/worst\)", out).group(1))
+    assert lost > 5.0 and worst < 10.0, out
 
 
 def test_the_depth_camera_sees_the_arm_over_the_table():

@@ -90,3 +90,82 @@ def test_the_command_delivers_a_tray_closed_loop_that_it_misses_open_loop(tmp_pa
     out = capsys.readouterr().out
     assert "closed loop: passed: 1/1 runs with every part in its goal without collision" in out
     assert "red started at (-0.1300, 0.0000, 8.00 deg)" in out
+
+
+def _held_for_blue(swap) -> tuple[loop._Loop, float]:
+    """A loop on swap whose pusher is held for the moves left to be re-planned: red, moved first,
+    observed on its plan, and blue, waiting, seen 1 cm off its place on CONFIRM observations."""
+    from planner.execution.tracker import CONFIRM
+
+    session, plan = swap
+    lone = loop._Loop(session, plan, (0.0, 0.0), 1)
+    now = 0.0
+    for _ in range(CONFIRM):
+        assert not lone.observe(now, {"red": lone.tracker.planned(now), "blue": plan.starts["blue"] + [0.01, 0.0, 0.0]})
+        now += 0.05
+    held, _, rate, _ = lone.pusher_at(now)
+    assert lone.pusher_at(now + 1.0)[0] == pytest.approx(held) and not rate.any()
+    return lone, now
+
+
+def test_a_part_hidden_while_the_moves_left_wait_makes_the_pusher_back_off_to_look_then_give_up(swap):
+    """Blue hidden (under the arm's hand, say) while the pusher is held: the mean of the parts at
+    rest needs it, so the pusher backs off along its own -x to look (as a tracker does), then
+    waits; unseen for LOST_PATIENCE s it gives up, saying so, instead of waiting for ever (a tray
+    with an arm over an overhead camera waited 289 s so)."""
+    from planner.execution.tracker import LOST_PATIENCE, look_back
+
+    lone, now = _held_for_blue(swap)
+    held = lone.pusher_at(now)[0]
+    hidden = {"blue": "hidden: something taller stands over 80% of where it was"}
+    assert not lone.observe(now, {"red": lone.tracker.planned(now)}, lost=hidden, hidden={"blue"})
+    end, duration = look_back(lone.tracker.scene, lone.tracker.session.model, held)
+    assert np.linalg.norm(end[:2] - held[:2]) > 0.01 and end[2] == pytest.approx(held[2])
+    assert lone.pusher_at(now + duration / 2)[0][:2] == pytest.approx((held[:2] + end[:2]) / 2)
+    assert lone.pusher_at(now + duration)[0] == pytest.approx(end)
+    t, ended = now + duration, False
+    while not ended and t < now + duration + 2 * LOST_PATIENCE:
+        ended = lone.observe(t, {"red": lone.tracker.planned(now)}, lost=hidden, hidden={"blue"})
+        t += 0.05
+    assert ended and t - (now + duration) == pytest.approx(LOST_PATIENCE, abs=0.11)
+    assert lone.reason.startswith("lost track of blue for 3.0 s"), lone.reason
+
+
+def test_a_part_seen_again_after_backing_off_is_observed_at_rest_and_the_moves_left_re_planned(swap):
+    from planner.execution.tracker import SETTLE, look_back
+
+    lone, now = _held_for_blue(swap)
+    red, blue = lone.tracker.planned(now), swap[1].starts["blue"] + [0.01, 0.0, 0.0]
+    hidden = {"blue": "hidden: something taller stands over 80% of where it was"}
+    _, duration = look_back(lone.tracker.scene, lone.tracker.session.model, lone.pusher_at(now)[0])
+    lone.observe(now, {"red": red}, lost=hidden, hidden={"blue"})
+    # While it backs off nothing is taken; from where it stops, blue is seen.
+    assert not lone.observe(now + duration / 2, {"red": red, "blue": blue}) and not lone.replans
+    now += duration
+    for _ in range(SETTLE):
+        assert not lone.observe(now, {"red": red, "blue": blue})
+        now += 0.05
+    (replan,) = lone.replans
+    assert replan.why.startswith("blue is off the plan") and replan.plan.solved
+
+
+def test_a_waiting_part_is_judged_against_its_estimates_noise():
+    """Blue, waiting, seen 1.2 degrees off its place on every observation: beyond half the angle
+    tolerance (1 degree), so with exact observations the pusher is held for a re-plan; seen through
+    a camera whose estimate has a heading deviation of 0.5 degrees, it is within 3 of them (1.5
+    degrees), noise to be expected, and the run goes on (a tray's hexagon, whose heading a camera
+    estimates to about that, held a run for nothing)."""
+    from planner.execution.tracker import CONFIRM
+
+    session = Planner(load_scene(SWAP))
+    plan = session.plan(seed=1)
+    turned = plan.starts["blue"] + [0.0, 0.0, math.radians(1.2)]
+    noise = np.diag([1e-8, 1e-8, math.radians(0.5) ** 2])
+    for covariance, held in ((None, True), (noise, False)):
+        lone, now = loop._Loop(session, plan, (0.0, 0.0), 1), 0.0
+        for _ in range(CONFIRM):
+            covariances = None if covariance is None else {"red": noise, "blue": covariance}
+            lone.observe(now, {"red": lone.tracker.planned(now), "blue": turned}, covariances=covariances)
+            now += 0.05
+        rate = lone.pusher_at(now)[2]
+        assert (not rate.any() and lone.pusher_at(now + 1.0)[0] == pytest.approx(lone.pusher_at(now)[0])) == held
