@@ -83,8 +83,9 @@ transit, planner ``'squaring'``).
 
 **Going on.** Where no face can be squared either, the pusher goes on with the plan it has, from
 where it stopped: a flat pusher that meets a part askew turns it flush and funnels its error
-(open loop in MuJoCo), after which a plan may exist. Deviations are not looked at until the pusher has moved the part's radius on along the
-plan (or the plan ends); then the loop looks again. Each time counts against the budget.
+(open loop in MuJoCo), after which a plan may exist. Deviations are not looked at until the
+pusher has moved the part's radius on along the plan (or the plan ends); then the loop looks
+again. Each time counts against the budget.
 
 **Lost track.** A camera may not see the part (the pusher or the arm hides it, or it left the
 view): the perception then says so (:meth:`Tracker.unseen`) instead of giving a pose. Where the
@@ -606,7 +607,7 @@ class Tracker:
         # The new plan begins when it is there: the pusher held still until then.
         problem = self._begin(found, pusher, part, now + latency, height)
         if problem:
-            self._held = (pusher, 0.0)
+            self._held = (pusher, height)
             return self._give_up(now, error, problem)
         self.replans.append(Replan(now, part, trigger, trigger_error, why, latency, found, self.session.scene.pusher.mu))
         return self._command(Action.REPLAN, now, error, found)
@@ -645,11 +646,11 @@ class Tracker:
             return None
         model, room = self.session.model, clearance_margin(self.scene)
         (pusher, height), best = self._held, None
+        back = float(wrap_angle(heading - part[2]))
         for edge in self.session.stable_edges:
             square, advance = squared(self.scene.slider, part, edge, heading)
             # The part swept while it turns, and its pusher flush once square, keep the room a push keeps.
-            sweep = [squared(self.scene.slider, part, edge, float(wrap_angle(part[2] + u * float(
-                wrap_angle(heading - part[2])))))[0] for u in (0.25, 0.5, 0.75)]
+            sweep = [squared(self.scene.slider, part, edge, part[2] + u * back)[0] for u in (0.25, 0.5, 0.75)]
             if not (model.is_clear(square, edge, room) and all(model.part_clearance(p, room) > room for p in sweep)):
                 continue
             way = self._approach(pusher, square, edge, height, behind=advance, actual=part)
