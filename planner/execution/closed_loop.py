@@ -77,7 +77,7 @@ from .approach import first_edge, lead_in_pose
 from .camera_observer import CameraObserver
 from .mujoco_sim import (SETTLE, TABLE_MU, ByPart, Feet, Runs, World, _one, _worst, foot_sets, needs_mujoco,
                          perturbations, write_mjcf)
-from .tracker import BUDGET, CONFIRM, LOST_PATIENCE, Replan, Tracker, backing, look_back, mean_pose
+from .tracker import BUDGET, CONFIRM, LOST_PATIENCE, BackOff, Replan, Tracker, look_back, mean_pose
 from .tracker import SETTLE as AT_REST  # observations of the parts at rest (mujoco_sim's SETTLE is seconds)
 from .trajectory import RATE, Trajectory
 
@@ -269,8 +269,7 @@ class _Loop:
         self._carried: list[tuple[float, str]] = []
         self._spent = 0  # re-plans of the moves left that no move's end asked for
         self._held: tuple[np.ndarray, float] | None = None  # the pusher held still while the moves left are re-planned
-        # Backing off to look at a part hidden while held: (start time, from pose, duration), or None.
-        self._looking: tuple[float, np.ndarray, float] | None = None
+        self._looking: BackOff | None = None  # backing off to look at a part hidden while held
         self._unseen: float | None = None  # since when some part has not been seen while held
         self._window: list[dict[str, np.ndarray]] = []  # every part's observations since
         self._trigger: tuple[str, np.ndarray, tuple[float, float], str, bool] | None = None
@@ -314,14 +313,13 @@ class _Loop:
         if self._held is not None:
             pose, height = self._held
             if self._backing_off(now):
-                began, start, duration = self._looking
-                moving, rate = backing(now - began, duration, start, pose)
+                moving, rate = self._looking.at(now)
                 return moving, height, rate, False
             return pose.copy(), height, np.zeros(4), False
         return self.tracker.pusher_at(now)
 
     def _backing_off(self, now: float) -> bool:
-        return self._looking is not None and now < self._looking[0] + self._looking[2]
+        return self._looking is not None and self._looking.moving(now)
 
     def observe(self, now: float, seen: dict[str, np.ndarray], taken: float | None = None,
                 lost: Mapping[str, str] | None = None, hidden: Collection[str] = (),
@@ -387,9 +385,9 @@ class _Loop:
         self._window = []
         if self._looking is None and set(lost) & set(hidden):
             pose, height = self._held
-            back = look_back(self.tracker.scene, self.tracker.session.model, pose)
-            if back is not None:
-                self._held, self._looking, self._unseen = (back[0], height), (now, pose, back[1]), None
+            self._looking = look_back(self.tracker.scene, self.tracker.session.model, pose, now)
+            if self._looking is not None:
+                self._held, self._unseen = (self._looking.end, height), None
                 return False
         self._unseen = now if self._unseen is None else self._unseen
         if now - self._unseen >= LOST_PATIENCE:

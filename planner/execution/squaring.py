@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mechanics import Slider, wrap_angle
+from mechanics import Slider, transform_points, wrap_angle
 
 from ..model.bodies import edge_frame
 
@@ -52,14 +52,12 @@ def squared(slider: Slider, pose: ArrayLike, edge: int, heading: float) -> tuple
     >>> pose.tolist(), round(advance, 12)
     ([0.5, 0.5, 0.0], 0.0)
     """
-    x, y, theta = (float(v) for v in pose)
-    turn = float(wrap_angle(theta - heading))
-    c, s = math.cos(theta), math.sin(theta)
-    corners = [np.array([x + c * px - s * py, y + s * px + c * py]) for px, py in slider.edge(edge)]
+    pose = np.asarray(pose, dtype=float)
+    turn = float(wrap_angle(pose[2] - heading))
+    corners = transform_points(np.asarray(slider.edge(edge), dtype=float), pose)
     push = heading + float(edge_frame(slider, edge)[2])  # the pusher's +x, as the plan has the part
     along = np.array([math.cos(push), math.sin(push)])
     near, far = sorted(corners, key=lambda p: float(p @ along))
-    back = math.cos(-turn), math.sin(-turn)
-    dx, dy = x - far[0], y - far[1]
-    centre = far + np.array([back[0] * dx - back[1] * dy, back[1] * dx + back[0] * dy])
+    # The centre turned back by the turn about the far corner.
+    centre = far + transform_points((pose[:2] - far)[None], [0.0, 0.0, -turn])[0]
     return np.array([*centre, float(wrap_angle(heading))]), float((far - near) @ along)

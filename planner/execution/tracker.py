@@ -140,7 +140,7 @@ from .trajectory import LIFT_HEIGHT, MAX_SPEED, Trajectory, planned_part, trajec
 
 __all__ = ["BUDGET", "CONFIRM", "FRICTION_FLOOR", "FRICTION_STEP", "LOOK_BACK", "LOST_PATIENCE", "REPLAN_LIMIT", "FRACTION",
            "ROOM", "SETTLE", "SIGMAS",
-           "Action", "Command", "Replan", "Tracker", "backing", "look_back", "mean_pose"]
+           "Action", "BackOff", "Command", "Replan", "Tracker", "look_back", "mean_pose"]
 
 #: Thresholds: this fraction of the goal tolerance, and at least this many deviations of the
 #: observation (module docstring, "When to re-plan").
@@ -216,28 +216,43 @@ class Replan:
     mu: float
 
 
-def look_back(scene: Scene, model: CollisionModel, pose: np.ndarray) -> tuple[np.ndarray, float] | None:
-    """Where a pusher stopped at ``pose`` backs off to look at a part it hides: along its own -x,
-    up to :data:`LOOK_BACK` where the way is free (halving down to the transits' standoff,
-    :func:`.approach.free_back_off`), and how long that takes at the pusher's cruising speed; None
-    if it cannot back off."""
-    distance = free_back_off(scene, model, pose, LOOK_BACK)
-    return None if distance is None else (backed_off(pose, distance), 2 * distance / MAX_SPEED)
+@dataclass(frozen=True)
+class BackOff:
+    """The pusher backing straight off to look at a part it hides (:func:`look_back`): from
+    ``start`` at time ``began`` (the caller's clock) to ``end`` in ``duration`` seconds, a half
+    cosine in time, at rest at both ends, at most pi / 2 times the mean speed on the way.
 
+    Half way through 10 cm in 2 s: 5 cm on, at pi / 2 times 5 cm/s:
 
-def backing(elapsed: float, duration: float, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The pusher's pose and velocity ``(vx, vy, omega, vz)`` ``elapsed`` seconds into a move of
-    ``duration`` seconds from ``start`` to ``end``: a half cosine in time, at rest at both ends, at
-    most pi / 2 times the mean speed on the way.
-
-    >>> pose, rate = backing(1.0, 2.0, np.zeros(3), np.array([0.1, 0.0, 0.0]))
+    >>> move = BackOff(0.0, np.zeros(3), np.array([0.1, 0.0, 0.0]), 2.0)
+    >>> pose, rate = move.at(1.0)
     >>> pose.round(12).tolist(), rate.round(12).tolist()
     ([0.05, 0.0, 0.0], [0.07853981634, 0.0, 0.0, 0.0])
     """
-    phase = math.pi * min(max(elapsed / duration, 0.0), 1.0)
-    share, pace = (1 - math.cos(phase)) / 2, math.pi * math.sin(phase) / (2 * duration)
-    way = end - start
-    return start + share * way, np.array([*(pace * way[:2]), pace * way[2], 0.0])
+
+    began: float
+    start: np.ndarray
+    end: np.ndarray
+    duration: float
+
+    def moving(self, now: float) -> bool:
+        """Whether the pusher is still on its way at ``now``: the look begins when it stops."""
+        return now < self.began + self.duration
+
+    def at(self, now: float) -> tuple[np.ndarray, np.ndarray]:
+        """The pusher's pose and velocity ``(vx, vy, omega, vz)`` at ``now``."""
+        phase = math.pi * min(max((now - self.began) / self.duration, 0.0), 1.0)
+        share, pace = (1 - math.cos(phase)) / 2, math.pi * math.sin(phase) / (2 * self.duration)
+        way = self.end - self.start
+        return self.start + share * way, np.array([*(pace * way[:2]), pace * way[2], 0.0])
+
+
+def look_back(scene: Scene, model: CollisionModel, pose: np.ndarray, now: float) -> BackOff | None:
+    """The pusher stopped at ``pose`` backing off from ``now`` to look at a part it hides: along its
+    own -x, up to :data:`LOOK_BACK` where the way is free (halving down to the transits' standoff,
+    :func:`.approach.free_back_off`), at the pusher's cruising speed; None if it cannot back off."""
+    distance = free_back_off(scene, model, pose, LOOK_BACK)
+    return None if distance is None else BackOff(now, pose, backed_off(pose, distance), 2 * distance / MAX_SPEED)
 
 
 def mean_pose(rows: ArrayLike) -> np.ndarray:
@@ -334,8 +349,7 @@ class Tracker:
         self._trigger: tuple[np.ndarray, tuple[float, float], str, bool] | None = None
         self._window: list[np.ndarray] = []  # the observations since the pusher stopped
         self._held: tuple[np.ndarray, float] | None = None  # where the pusher holds still (pose, height)
-        # Backing off to look before holding there: (start time, from pose, duration), or None.
-        self._backing: tuple[float, np.ndarray, float] | None = None
+        self._backing: BackOff | None = None  # backing off to look before holding there
         self._stopped = 0.0  # where on the plan's clock the pusher stopped
         self._edge = -1  # the edge the pusher was on when it stopped
         # The plan followed, from _begin: its segments (the approach first), the pusher's timed
@@ -410,7 +424,8 @@ class Tracker:
         if self._held is not None:
             pose, height = self._held
             if self._still_backing(now):
-                return self._backed(now, pose, height)
+                moving, rate = self._backing.at(now)
+                return moving, height, rate, False
             return pose.copy(), height, np.zeros(4), False
         m, u = self.motion, max(now - self._since, 0.0)  # before a re-plan's start: at its first sample, at rest
         column = [np.interp(u, m.t, c) for c in (m.x, m.y, self._theta, m.z, m.vx, m.vy, m.omega)]
@@ -433,22 +448,15 @@ class Tracker:
         """Back the held pusher off to look (:func:`look_back`), before holding there (module
         docstring, "Lost track"); whether it does."""
         pose, height = self._held
-        back = look_back(self.scene, self.session.model, pose)
-        if back is None:
+        self._backing = look_back(self.scene, self.session.model, pose, now)
+        if self._backing is None:
             return False
-        self._held = (back[0], height)
-        self._backing = (now, pose, back[1])
+        self._held = (self._backing.end, height)
         return True
 
     def _still_backing(self, now: float) -> bool:
-        """Whether the pusher is backing off to look (:meth:`_look_back`): the look begins when it stops."""
-        return self._backing is not None and now < self._backing[0] + self._backing[2]
-
-    def _backed(self, now: float, end: np.ndarray, height: float) -> tuple[np.ndarray, float, np.ndarray, bool]:
-        """:meth:`pusher_at` while backing off to ``end`` (:func:`backing`)."""
-        began, start, duration = self._backing
-        pose, rate = backing(now - began, duration, start, end)
-        return pose, height, rate, False
+        """Whether the pusher is backing off to look (:meth:`_look_back`)."""
+        return self._backing is not None and self._backing.moving(now)
 
     def planned(self, now: float) -> np.ndarray:
         """The part's planned pose at ``now``."""
@@ -456,7 +464,11 @@ class Tracker:
 
     def _sample(self, now: float) -> int:
         """The plan's sample at ``now`` (the caller's clock)."""
-        return min(int(np.searchsorted(self.motion.t, now - self._since)), len(self.motion.t) - 1)
+        return self._row(now - self._since)
+
+    def _row(self, u: float) -> int:
+        """The plan's sample at ``u`` seconds on the plan's own clock."""
+        return min(int(np.searchsorted(self.motion.t, u)), len(self.motion.t) - 1)
 
     def threshold_at(self, now: float, covariance: ArrayLike | None = None) -> tuple[float, float, float]:
         """The thresholds at ``now`` on the plan of an observation of ``covariance`` (3 x 3, m and
@@ -639,8 +651,7 @@ class Tracker:
         other parts, to that part's contact, deaf to deviations on the way, then observe it at
         rest and re-plan. None where the part is not turned beyond the heading threshold, or no
         face has a squared part with room for it and for the pusher flush, and a free way there."""
-        stopped = min(int(np.searchsorted(self.motion.t, self._stopped)), len(self.motion.t) - 1)
-        heading = float(self.expected[stopped, 2])
+        heading = float(self.expected[self._row(self._stopped), 2])
         turn = abs(float(wrap_angle(part[2] - heading)))
         if turn <= self.threshold[1]:
             return None
@@ -661,9 +672,9 @@ class Tracker:
         if best is None:
             return None
         _, edge, square, way = best
-        plan = Plan.of_part(self.plan.part, part, square, [way], solved=True, scene=self.plan.scene,
-                            planner="squaring", seed=self.seed or 0, planning_time_s=time.perf_counter() - clock)
         latency = time.perf_counter() - clock
+        plan = Plan.of_part(self.plan.part, part, square, [way], solved=True, scene=self.plan.scene,
+                            planner="squaring", seed=self.seed or 0, planning_time_s=latency)
         self._begin(plan, None, part, now + latency, height)
         self._quiet = self.motion.duration  # the part turns against the pusher on the way: judged once square
         why = f"{reason}; squaring the part, {math.degrees(turn):.1f} deg askew, against edge {edge}"

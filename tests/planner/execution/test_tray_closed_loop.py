@@ -119,7 +119,8 @@ def test_a_part_hidden_while_the_moves_left_wait_makes_the_pusher_back_off_to_lo
     held = lone.pusher_at(now)[0]
     hidden = {"blue": "hidden: something taller stands over 80% of where it was"}
     assert not lone.observe(now, {"red": lone.tracker.planned(now)}, lost=hidden, hidden={"blue"})
-    end, duration = look_back(lone.tracker.scene, lone.tracker.session.model, held)
+    back = look_back(lone.tracker.scene, lone.tracker.session.model, held, now)
+    end, duration = back.end, back.duration
     assert np.linalg.norm(end[:2] - held[:2]) > 0.01 and end[2] == pytest.approx(held[2])
     assert lone.pusher_at(now + duration / 2)[0][:2] == pytest.approx((held[:2] + end[:2]) / 2)
     assert lone.pusher_at(now + duration)[0] == pytest.approx(end)
@@ -137,7 +138,7 @@ def test_a_part_seen_again_after_backing_off_is_observed_at_rest_and_the_moves_l
     lone, now = _held_for_blue(swap)
     red, blue = lone.tracker.planned(now), swap[1].starts["blue"] + [0.01, 0.0, 0.0]
     hidden = {"blue": "hidden: something taller stands over 80% of where it was"}
-    _, duration = look_back(lone.tracker.scene, lone.tracker.session.model, lone.pusher_at(now)[0])
+    duration = look_back(lone.tracker.scene, lone.tracker.session.model, lone.pusher_at(now)[0], now).duration
     lone.observe(now, {"red": red}, lost=hidden, hidden={"blue"})
     # While it backs off nothing is taken; from where it stops, blue is seen.
     assert not lone.observe(now + duration / 2, {"red": red, "blue": blue}) and not lone.replans
